@@ -1,0 +1,110 @@
+// Scene: what to render, validated and with every default filled in (docs/scene-format.md).
+// The loader (SceneLoader.h) builds it from JSON; the renderer builds only what it names.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace volref {
+
+// A procedural field sampled at the grid's vertices (scene-format.md, volume.source.field).
+struct FieldSpec {
+    enum class Kind { Constant, Linear, Radial, MarschnerLobb, Gaussian, Cells };
+    Kind kind = Kind::Constant;
+    std::array<std::int64_t, 3> dims{2, 2, 2};
+    double value = 0.0;                           // constant
+    std::array<double, 4> coefficients{0, 0, 0, 0};  // linear: f = a x + b y + c z + d (world)
+    glm::dvec3 center{0.0};                       // radial, gaussian (world)
+    double fm = 6.0, alpha = 0.25;                // marschner-lobb
+    double sigma = 1.0, amplitude = 1.0;          // gaussian
+    std::vector<double> values;                   // cells: nx*ny*nz values, i fastest
+};
+
+struct VolumeSourceSpec {
+    // Exactly one of file / field is set.
+    std::optional<std::filesystem::path> file;  // absolute (resolved against the scene file's folder)
+    std::string format;                          // "" (from the extension), "nrrd" or "raw"
+    std::optional<FieldSpec> field;
+};
+
+struct TransferSpec {
+    enum class Domain { Data, Normalized };
+    Domain domain = Domain::Data;
+    std::optional<std::array<double, 2>> window;  // normalised domain: [lo, hi]; absent = default window
+    // Rows sorted by value (non-decreasing). Absent in the file: colour = one white row; opacity = a
+    // ramp from 0 at the window's low end to 1 at its high end (filled by the renderer, which knows
+    // the window), signalled here by an empty vector.
+    std::vector<std::array<double, 4>> color;    // [value, r, g, b]
+    std::vector<std::array<double, 2>> opacity;  // [value, a]
+    double opacity_unit_distance = 1.0;          // l, world units, > 0
+};
+
+enum class Interpolation { Nearest, Trilinear };
+
+struct BoundsSpec {
+    enum class Type { Box };
+    Type type = Type::Box;
+    std::optional<glm::dvec3> min, max;  // box: absent = the volume's domain
+};
+
+struct VolumeSpec {
+    VolumeSourceSpec source;
+    std::optional<glm::dvec3> origin;   // overrides the file's (procedural fields: default 0)
+    std::optional<glm::dvec3> spacing;  // overrides the file's (procedural fields: default 1)
+    Interpolation interpolation = Interpolation::Trilinear;
+    BoundsSpec bounds;
+    TransferSpec transfer;
+};
+
+struct LightSpec {
+    enum class Type { Headlight, Directional };
+    Type type = Type::Headlight;
+    glm::dvec3 direction{0.0, 0.0, 1.0};  // directional: towards the light (normalised by the loader)
+    glm::dvec3 color{1.0};
+};
+
+struct CameraSpec {
+    enum class Type { Default, Perspective, Orthographic, Matrices };
+    Type type = Type::Default;  // Default: 30 degrees, looking along -z at the bounds' centre (camera/Camera.h)
+    glm::dvec3 eye{0.0, 0.0, 1.0}, target{0.0}, up{0.0, 1.0, 0.0};
+    double fov_y = 30.0;   // degrees, in (0, 180)
+    double height = 1.0;   // orthographic view height, world units, > 0
+    glm::dmat4 view{1.0}, projection{1.0};  // matrices (OpenGL conventions; given column-major)
+};
+
+struct ImageSpec {
+    int width = 256, height = 256;
+    glm::dvec4 background{0.0, 0.0, 0.0, 0.0};  // RGBA, not premultiplied, each in [0, 1]
+};
+
+enum class Projection { Composite, Mip, Minip, Average, FirstHit, Xray };
+enum class CompositeOrder { FrontToBack, BackToFront };
+enum class StepUnits { Voxel, World };
+
+struct RenderSpec {
+    Projection projection = Projection::Composite;
+    CompositeOrder order = CompositeOrder::FrontToBack;
+    double step = 0.5;                    // > 0
+    StepUnits step_units = StepUnits::Voxel;
+    std::optional<double> isovalue;       // required by first-hit
+    std::optional<double> early_termination;  // accumulated alpha threshold in (0, 1]; absent = off
+    double gain = 1.0;                    // xray: the line integral is multiplied by this
+};
+
+struct Scene {
+    std::filesystem::path file;  // the scene file (for messages); empty for scenes built in code
+    VolumeSpec volume;
+    std::vector<LightSpec> lights{LightSpec{}};
+    CameraSpec camera;
+    ImageSpec image;
+    RenderSpec render;
+};
+
+}  // namespace volref

@@ -1,0 +1,43 @@
+// The volref command line. Exit status: 0 success; 1 bad input or failure (one line on stderr,
+// "volref: error: ..."); 2 usage errors (CLI11's message).
+#include <cstdio>
+#include <exception>
+#include <new>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/Commands.h"
+#include "core/Error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"volref: a CPU reference volume ray caster, the numerical oracle for GPU volume renderers"};
+    app.require_subcommand(1);
+
+    volref::cli::RenderArgs render;
+    CLI::App* rc = app.add_subcommand("render", "Render a scene file to an image (.exr, .png, .tif)");
+    rc->add_option("scene", render.scene, "Scene file (JSON)")->required();
+    rc->add_option("-o,--output", render.output, "Output image; the format follows the extension")->required();
+    rc->add_option("--threads", render.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+    rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
+        ->take_all();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // CLI11 prints the message (and --help's text); usage errors exit 2, --help exits 0.
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+    try {
+        if (rc->parsed()) return volref::cli::run_render(render);
+    } catch (const volref::Error& e) {
+        std::fprintf(stderr, "volref: error: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "volref: error: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "volref: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

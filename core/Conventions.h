@@ -1,0 +1,37 @@
+// Every numerical choice of the reference profile, in one place, each with its formula.
+// docs/conventions.md states the same choices for users; change both together.
+#pragma once
+
+namespace volref::conventions {
+
+// Sampling a ray interval [t0, t1] of length L with step h (conventions section 4):
+//   n = max(1, ceil(L / h - kSegmentSlack)) segments; segment k < n-1 is [t0 + k h, t0 + (k+1) h],
+//   the last is [t0 + (n-1) h, t1] (length L - (n-1) h, in (0, h (1 + kSegmentSlack)]).
+// The slack absorbs a remainder shorter than kSegmentSlack * h that is only rounding of L / h
+// (e.g. L = 0.3, h = 0.1), instead of creating a sliver segment.
+inline constexpr double kSegmentSlack = 1e-9;
+
+// Intervals shorter than this (world units) are dropped: a ray grazing a box edge or face has a
+// chord of length 0 (or a rounding error of it) and contributes nothing.
+inline constexpr double kMinIntervalLength = 0.0;
+
+// First-hit: the crossing is bracketed between consecutive segment endpoints and refined by
+// bisection until the bracket is at most kFirstHitRelativeTolerance * (t1 - t0) of the interval
+// searched; the hit is the bracket's midpoint.
+inline constexpr double kFirstHitRelativeTolerance = 1e-9;
+
+// Bounding boxes are given to Embree enlarged by this fraction of their largest extent (plus the
+// same absolute amount) so that float traversal never culls a ray the double-precision slab test
+// would hit; the intervals themselves come from the double-precision test.
+inline constexpr double kEmbreeBoundsPadding = 1e-5;
+
+// Pixel (x, y) is sampled through its centre (x + 0.5, y + 0.5); row 0 is the top row.
+inline constexpr double kPixelCentre = 0.5;
+
+// Images are cut into square tiles of this many pixels for the thread pool; results do not depend
+// on it (every pixel is computed independently).
+inline constexpr int kTileSize = 16;
+
+// 8-bit and 16-bit outputs: q = round(clamp(v, 0, 1) * (2^bits - 1)), round half away from zero.
+
+}  // namespace volref::conventions

@@ -1,0 +1,47 @@
+// Camera: the primary ray of each pixel (conventions section 10).
+//
+// Film coordinates: pixel (x, y), x to the right, y downwards, row 0 at the top; the ray goes through
+// (x + 0.5, y + 0.5). With W x H pixels, aspect = W / H and the normalised device coordinates
+//   nx = 2 (x + 0.5) / W - 1,   ny = 1 - 2 (y + 0.5) / H            (both in (-1, 1)):
+// - perspective (eye, target, up, fov_y): forward f = normalize(target - eye), right
+//   r = normalize(f x up), true up u = r x f; direction = normalize(f + nx tan(fov_y/2) aspect r
+//   + ny tan(fov_y/2) u), origin = eye.
+// - orthographic (eye, target, up, height h): direction = f, origin = eye + nx (h/2) aspect r +
+//   ny (h/2) u.
+// - matrices (view V, projection P, OpenGL): the points N = (PV)^-1 (nx, ny, -1, 1) and
+//   F = (PV)^-1 (nx, ny, 1, 1) (dehomogenised) give direction = normalize(F - N); the origin is the
+//   point of that line on the eye's plane (view-space z = 0): the eye itself for a perspective P.
+// - default: perspective, fov_y 30, looking along -z at the centre c of the bounds, up +y, at the
+//   distance d = R / sin(theta) from c, where R is the bounds' half diagonal and theta is half the
+//   smaller of the vertical and horizontal fields of view (as VTK's ResetCamera; the whole bounding
+//   sphere is in view).
+// Rays are integrated for t >= 0 only (there is no near plane).
+#pragma once
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/camera/Ray.h"
+#include "core/scene/Scene.h"
+
+namespace volref {
+
+class Camera {
+public:
+    // `bounds_min`/`bounds_max` are used by the default camera only.
+    Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& bounds_min,
+           const glm::dvec3& bounds_max);
+
+    // The ray through film point (fx, fy) (pixel centres at integer + 0.5).
+    Ray ray(double fx, double fy) const;
+    Ray pixel_ray(int x, int y) const;
+
+private:
+    enum class Kind { Perspective, Orthographic, Matrices } kind_;
+    int width_, height_;
+    double aspect_;
+    glm::dvec3 eye_{0.0}, forward_{0.0}, right_{0.0}, up_{0.0};
+    double tan_half_fov_ = 0.0, half_height_ = 0.0;
+    glm::dmat4 inverse_view_projection_{1.0}, inverse_view_{1.0}, view_{1.0};
+};
+
+}  // namespace volref

@@ -1,0 +1,117 @@
+#include "core/film/ImageWriter.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <system_error>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/Error.h"
+
+namespace volref {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+enum class Format { Exr, Png, Tiff };
+
+Format format_of(const fs::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".exr") return Format::Exr;
+    if (ext == ".png") return Format::Png;
+    if (ext == ".tif" || ext == ".tiff") return Format::Tiff;
+    throw Error(path.string() + ": unsupported output extension '" + ext + "' (use .exr, .png, .tif or .tiff)");
+}
+
+// 8/16-bit pixels: composited over the background, unassociated alpha, quantised.
+template <typename T>
+std::vector<T> quantised_over_background(const Image& image, const glm::dvec4& bg) {
+    constexpr double kMax = double(std::numeric_limits<T>::max());
+    auto q = [](double v) { return T(std::lround(std::clamp(v, 0.0, 1.0) * kMax)); };
+    std::vector<T> out(std::size_t(image.width) * std::size_t(image.height) * 4);
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            const double A = image.at(x, y, 3);
+            const double a = A + (1.0 - A) * bg.a;
+            T* p = &out[(std::size_t(y) * std::size_t(image.width) + std::size_t(x)) * 4];
+            for (int c = 0; c < 3; ++c) {
+                const double premultiplied = image.at(x, y, std::size_t(c)) + (1.0 - A) * bg.a * bg[c];
+                p[c] = q(a > 0.0 ? premultiplied / a : 0.0);
+            }
+            p[3] = q(a);
+        }
+    return out;
+}
+
+}  // namespace
+
+void check_output_path(const fs::path& path) {
+    format_of(path);
+    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error(path.string() + ": the output folder " + dir.string() + " does not exist");
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw Error(path.string() + ": the output folder " + dir.string() + " is not writable");
+    if (fs::is_directory(path, ec)) throw Error(path.string() + ": is a folder");
+}
+
+void write_image(const Image& image, const fs::path& path, const glm::dvec4& background) {
+    check_output_path(path);
+    const Format format = format_of(path);
+    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+    // ".NAME.volref-tmp-PID.EXT": hidden, unique per process, same extension (OIIO picks the format by it).
+    std::string tmp_name(".");
+    tmp_name.append(path.stem().string()).append(".volref-tmp-").append(std::to_string(::getpid()));
+    tmp_name.append(path.extension().string());
+    const fs::path tmp = dir / tmp_name;
+
+    auto out = OIIO::ImageOutput::create(tmp.string());
+    if (!out) throw Error(path.string() + ": cannot create an image writer: " + OIIO::geterror());
+    OIIO::ImageSpec spec;
+    std::vector<float> floats;
+    std::vector<std::uint8_t> bytes;
+    std::vector<std::uint16_t> words;
+    const void* data = nullptr;
+    if (format == Format::Exr) {
+        spec = OIIO::ImageSpec(image.width, image.height, int(image.channel_count()), OIIO::TypeDesc::FLOAT);
+        spec.channelnames = image.channels;
+        spec.alpha_channel = 3;
+        for (std::size_t c = 0; c < image.channels.size(); ++c)
+            if (image.channels[c] == "Z") spec.z_channel = int(c);
+        spec.attribute("compression", "zip");
+        floats.assign(image.pixels.begin(), image.pixels.end());
+        data = floats.data();
+    } else {
+        const bool png = format == Format::Png;
+        spec = OIIO::ImageSpec(image.width, image.height, 4, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+        spec.channelnames = {"R", "G", "B", "A"};
+        spec.alpha_channel = 3;
+        spec.attribute("oiio:UnassociatedAlpha", 1);
+        if (png) {
+            bytes = quantised_over_background<std::uint8_t>(image, background);
+            data = bytes.data();
+        } else {
+            words = quantised_over_background<std::uint16_t>(image, background);
+            data = words.data();
+        }
+    }
+    std::error_code ec;
+    if (!out->open(tmp.string(), spec) || !out->write_image(spec.format, data) || !out->close()) {
+        const std::string why = out->geterror();
+        fs::remove(tmp, ec);
+        throw Error(path.string() + ": cannot write the image: " + why);
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw Error(path.string() + ": cannot move the finished image into place: " + ec.message());
+    }
+}
+
+}  // namespace volref

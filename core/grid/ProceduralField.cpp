@@ -1,0 +1,62 @@
+#include "core/grid/ProceduralField.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+
+namespace volref {
+
+namespace {
+
+double marschner_lobb_coordinate(std::int64_t i, std::int64_t n) {
+    return n == 1 ? 0.0 : -1.0 + 2.0 * double(i) / double(n - 1);
+}
+
+double field_value(const FieldSpec& f, const Volume& v, std::int64_t i, std::int64_t j, std::int64_t k) {
+    const glm::dvec3 p = v.voxel_position(i, j, k);
+    switch (f.kind) {
+        case FieldSpec::Kind::Constant: return f.value;
+        case FieldSpec::Kind::Linear:
+            return f.coefficients[0] * p.x + f.coefficients[1] * p.y + f.coefficients[2] * p.z + f.coefficients[3];
+        case FieldSpec::Kind::Radial: return glm::length(p - f.center);
+        case FieldSpec::Kind::MarschnerLobb: {
+            constexpr double pi = std::numbers::pi;
+            const double x = marschner_lobb_coordinate(i, v.dims[0]);
+            const double y = marschner_lobb_coordinate(j, v.dims[1]);
+            const double z = marschner_lobb_coordinate(k, v.dims[2]);
+            const double r = std::sqrt(x * x + y * y);
+            const double rho = std::cos(2.0 * pi * f.fm * std::cos(pi * r / 2.0));
+            return (1.0 - std::sin(pi * z / 2.0) + f.alpha * (1.0 + rho)) / (2.0 * (1.0 + f.alpha));
+        }
+        case FieldSpec::Kind::Gaussian: {
+            const glm::dvec3 d = p - f.center;
+            return f.amplitude * std::exp(-glm::dot(d, d) / (2.0 * f.sigma * f.sigma));
+        }
+        case FieldSpec::Kind::Cells: return f.values[v.index(i, j, k)];
+    }
+    return 0.0;
+}
+
+}  // namespace
+
+Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing) {
+    Volume v;
+    v.dims = field.dims;
+    v.origin = origin;
+    v.spacing = spacing;
+    v.type = ScalarType::F64;
+    const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims");
+    if (field.kind == FieldSpec::Kind::Cells && field.values.size() != count)
+        throw Error("volume.source.values: expected " + std::to_string(count) + " values (dims product), got " +
+                    std::to_string(field.values.size()));
+    v.values.resize(count);
+    for (std::int64_t k = 0; k < v.dims[2]; ++k)
+        for (std::int64_t j = 0; j < v.dims[1]; ++j)
+            for (std::int64_t i = 0; i < v.dims[0]; ++i) v.values[v.index(i, j, k)] = field_value(field, v, i, j, k);
+    return v;
+}
+
+}  // namespace volref

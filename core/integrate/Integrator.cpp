@@ -1,0 +1,28 @@
+#include "core/integrate/Integrator.h"
+
+#include "core/Error.h"
+#include "core/integrate/CompositeIntegrator.h"
+#include "core/integrate/ExtremumIntegrator.h"
+#include "core/integrate/FirstHitIntegrator.h"
+#include "core/integrate/LineIntegralIntegrator.h"
+
+namespace volref {
+
+std::unique_ptr<Integrator> make_integrator(const IntegrationContext& ctx) {
+    const RenderSpec& r = ctx.render;
+    if (r.early_termination && (r.projection != Projection::Composite || r.order != CompositeOrder::FrontToBack))
+        throw Error("render.early_termination: only the composite projection in front-to-back order terminates early");
+    switch (r.projection) {
+        case Projection::Composite: return std::make_unique<CompositeIntegrator>(ctx);
+        case Projection::Mip: return std::make_unique<ExtremumIntegrator>(ctx, true);
+        case Projection::Minip: return std::make_unique<ExtremumIntegrator>(ctx, false);
+        case Projection::Average: return std::make_unique<LineIntegralIntegrator>(ctx, true);
+        case Projection::Xray: return std::make_unique<LineIntegralIntegrator>(ctx, false);
+        case Projection::FirstHit:
+            if (!r.isovalue) throw Error("render.isovalue: required by projection first-hit");
+            return std::make_unique<FirstHitIntegrator>(ctx);
+    }
+    throw Error("render.projection: unknown projection");
+}
+
+}  // namespace volref

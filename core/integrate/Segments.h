@@ -1,0 +1,52 @@
+// Reference sample placement (conventions section 4): an interval [t0, t1] of length L is cut into
+// n = max(1, ceil(L / h - kSegmentSlack)) segments of length h, the last one shorter
+// (L - (n - 1) h); each segment is sampled at its midpoint and weighted by its own length.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/Conventions.h"
+#include "geometry/RayIntervals.h"
+
+namespace volref {
+
+struct Segment {
+    double t0, t1;
+    double midpoint() const { return 0.5 * (t0 + t1); }
+    double length() const { return t1 - t0; }
+};
+
+inline std::int64_t segment_count(const Interval& iv, double step) {
+    const double n = std::ceil(iv.length() / step - conventions::kSegmentSlack);
+    return std::max<std::int64_t>(1, std::int64_t(n));
+}
+
+// Segment k of n: [t0 + k h, t0 + (k + 1) h], the last ending exactly at t1.
+inline Segment segment(const Interval& iv, double step, std::int64_t k, std::int64_t n) {
+    const double a = iv.t0 + double(k) * step;
+    const double b = k + 1 == n ? iv.t1 : iv.t0 + double(k + 1) * step;
+    return {a, b};
+}
+
+// Calls fn(segment) front to back over every interval; fn returns false to stop early.
+template <typename Fn>
+void for_each_segment(const std::vector<Interval>& intervals, double step, Fn&& fn) {
+    for (const Interval& iv : intervals) {
+        const std::int64_t n = segment_count(iv, step);
+        for (std::int64_t k = 0; k < n; ++k)
+            if (!fn(segment(iv, step, k, n))) return;
+    }
+}
+
+// The same segments, back to front.
+template <typename Fn>
+void for_each_segment_reversed(const std::vector<Interval>& intervals, double step, Fn&& fn) {
+    for (auto it = intervals.rbegin(); it != intervals.rend(); ++it) {
+        const std::int64_t n = segment_count(*it, step);
+        for (std::int64_t k = n - 1; k >= 0; --k)
+            if (!fn(segment(*it, step, k, n))) return;
+    }
+}
+
+}  // namespace volref

@@ -1,0 +1,239 @@
+// Byte-level helpers shared by the volume readers (NrrdReader, RawReader): reading a whole file,
+// inflating gzip/zlib data, cutting the samples out of a data region, and turning stored samples of
+// any ScalarType and byte order into doubles. Every failure is a volref::Error whose one-line message
+// starts with the `where` it is given (the path of the file at fault).
+#pragma once
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include <zlib.h>
+
+#include "core/Error.h"
+#include "core/grid/Volume.h"
+
+namespace volref::io {
+
+static_assert(std::endian::native == std::endian::little || std::endian::native == std::endian::big,
+              "volref's readers assume a little- or big-endian host");
+
+// `text` quoted for an error message: control and non-ASCII bytes escaped as \xNN so the message
+// stays one line of plain text, and cut after `max_len` bytes.
+inline std::string quoted(std::string_view text, std::size_t max_len = 64) {
+    static const char* const kHex = "0123456789abcdef";
+    std::string out = "'";
+    for (std::size_t i = 0; i < text.size() && i < max_len; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c >= 0x7f) {
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 15];
+        } else {
+            out += char(c);
+        }
+    }
+    if (text.size() > max_len) out += "...";
+    return out + "'";
+}
+
+using FileHandle = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+// `path` opened for reading; a directory, a missing or an unreadable file is an Error.
+inline FileHandle open_for_reading(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw Error(path.string() + ": cannot read file: it is a directory");
+    FileHandle f(std::fopen(path.c_str(), "rb"), &std::fclose);
+    if (!f) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
+    return f;
+}
+
+// The whole contents of the file at `path`.
+inline std::string read_file_bytes(const std::filesystem::path& path) {
+    FileHandle f = open_for_reading(path);
+    std::string bytes;
+    std::error_code ec;
+    const auto size_hint = std::filesystem::file_size(path, ec);
+    if (!ec) bytes.reserve(static_cast<std::size_t>(size_hint));
+    std::vector<char> chunk(std::size_t(1) << 16);
+    for (;;) {
+        const std::size_t n = std::fread(chunk.data(), 1, chunk.size(), f.get());
+        bytes.append(chunk.data(), n);
+        if (n < chunk.size()) break;
+    }
+    if (std::ferror(f.get())) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
+    return bytes;
+}
+
+// The result of inflate_stream: how many leading bytes were skipped, and the bytes kept after them.
+struct Inflated {
+    std::uint64_t skipped = 0;
+    std::string data;
+};
+
+// Inflates a gzip or zlib stream, told apart by its header (zlib's inflateInit2 with 15 + 32).
+// Concatenated gzip members are read one after the other, as gunzip does. The first `skip`
+// decompressed bytes are discarded; then at most `keep_limit` bytes are kept and inflation stops, so
+// a caller that asks for one byte more than it needs sees that the stream is too long without
+// inflating all of it. A damaged stream (bad header, bad data, bad CRC, or compressed data that ends
+// early) is an Error.
+inline Inflated inflate_stream(std::string_view in, std::uint64_t skip, std::size_t keep_limit,
+                               const std::string& where) {
+    // zlib counts bytes in uInt, so large buffers are handed over in pieces of at most 1 GiB.
+    constexpr std::size_t kPiece = std::size_t(1) << 30;
+    z_stream zs{};
+    if (inflateInit2(&zs, 15 + 32) != Z_OK) throw Error(where + ": cannot initialise zlib's inflate");
+    std::unique_ptr<z_stream, int (*)(z_stream*)> guard(&zs, &inflateEnd);
+
+    const auto* in_base = reinterpret_cast<const Bytef*>(in.data());
+    zs.next_in = const_cast<Bytef*>(in_base);
+    zs.avail_in = 0;
+    Inflated out;
+    std::size_t kept = 0;
+    std::vector<Bytef> scratch(std::size_t(1) << 16);
+    for (;;) {
+        // Where this call's output goes: the scratch buffer while skipping, then `out.data`.
+        const bool skipping = out.skipped < skip;
+        Bytef* dst = nullptr;
+        std::size_t room = 0;
+        if (skipping) {
+            dst = scratch.data();
+            room = static_cast<std::size_t>(std::min<std::uint64_t>(scratch.size(), skip - out.skipped));
+        } else {
+            if (kept == keep_limit) break;
+            if (kept == out.data.size())
+                out.data.resize(std::min(keep_limit, std::max<std::size_t>(2 * kept, std::size_t(1) << 20)));
+            dst = reinterpret_cast<Bytef*>(out.data.data()) + kept;
+            room = std::min(kPiece, out.data.size() - kept);
+        }
+        zs.next_out = dst;
+        zs.avail_out = static_cast<uInt>(room);
+        const std::size_t in_pos = static_cast<std::size_t>(zs.next_in - in_base);
+        if (zs.avail_in == 0) zs.avail_in = static_cast<uInt>(std::min(kPiece, in.size() - in_pos));
+
+        const int ret = inflate(&zs, Z_NO_FLUSH);
+        const std::size_t produced = room - zs.avail_out;
+        if (skipping)
+            out.skipped += produced;
+        else
+            kept += produced;
+
+        if (ret == Z_OK) continue;
+        if (ret == Z_STREAM_END) {
+            const std::size_t used = static_cast<std::size_t>(zs.next_in - in_base);
+            if (used == in.size()) break;
+            // Another gzip member (magic 1f 8b) may follow; anything else after the end is damage.
+            if (in.size() - used >= 2 && static_cast<unsigned char>(in[used]) == 0x1f &&
+                static_cast<unsigned char>(in[used + 1]) == 0x8b) {
+                inflateReset(&zs);
+                continue;
+            }
+            throw Error(where + ": corrupt gzip stream: " + std::to_string(in.size() - used) +
+                        " bytes of trailing data after the end of the compressed stream");
+        }
+        if (ret == Z_BUF_ERROR && zs.avail_in == 0) {
+            if (static_cast<std::size_t>(zs.next_in - in_base) == in.size())
+                throw Error(where + ": corrupt gzip stream: the compressed data ends early");
+            continue;  // the next piece of input is handed over at the top of the loop
+        }
+        if (ret == Z_MEM_ERROR) throw Error(where + ": out of memory while inflating gzip data");
+        throw Error(where + ": corrupt gzip stream (zlib: " + (zs.msg ? zs.msg : zError(ret)) + ")");
+    }
+    out.data.resize(kept);
+    return out;
+}
+
+// How the samples of a binary data region are stored.
+enum class BinaryEncoding { Raw, Gzip };
+
+// The message for data shorter than the dims and type need.
+inline std::string truncated_message(const std::string& where, std::size_t expected, std::size_t found,
+                                     const char* unit = "bytes") {
+    return where + ": truncated: expected " + std::to_string(expected) + " " + unit + " of data, found " +
+           std::to_string(found);
+}
+
+// The message for data longer than the dims and type need.
+inline std::string too_long_message(const std::string& where, std::size_t expected, const std::string& found,
+                                    const char* unit = "bytes") {
+    return where + ": dims do not match the data size: expected " + std::to_string(expected) + " " + unit +
+           " of data, found " + found;
+}
+
+// The `expected` bytes of samples within `region` (which `storage` may come to hold, for gzip).
+// byte_skip counts the bytes before the samples: of the file region for raw data, of the decompressed
+// data for gzip. byte_skip -1 (raw only) means the samples end the region, whatever precedes them.
+// Otherwise the data must hold exactly byte_skip + expected bytes: fewer is "truncated", more means
+// the dims do not match the data.
+inline std::string_view sample_bytes(std::string_view region, BinaryEncoding encoding, std::int64_t byte_skip,
+                                     std::size_t expected, std::string& storage, const std::string& where) {
+    if (encoding == BinaryEncoding::Raw) {
+        if (byte_skip == -1) {
+            if (region.size() < expected) throw Error(truncated_message(where, expected, region.size()));
+            return region.substr(region.size() - expected);
+        }
+        const auto skip = static_cast<std::uint64_t>(byte_skip);
+        const std::size_t found = skip >= region.size() ? 0 : region.size() - static_cast<std::size_t>(skip);
+        if (found < expected) throw Error(truncated_message(where, expected, found));
+        if (found > expected) throw Error(too_long_message(where, expected, std::to_string(found)));
+        return region.substr(static_cast<std::size_t>(skip));
+    }
+    if (byte_skip < 0) throw Error(where + ": byte skip -1 is only allowed with raw encoding");
+    Inflated inflated = inflate_stream(region, static_cast<std::uint64_t>(byte_skip), expected + 1, where);
+    if (inflated.data.size() < expected)
+        throw Error(truncated_message(where, expected, inflated.data.size()) + " after inflating");
+    if (inflated.data.size() > expected)
+        throw Error(too_long_message(where, expected, "more after inflating"));
+    storage = std::move(inflated.data);
+    return storage;
+}
+
+// One stored value of type T at `p`, its bytes reversed first when `swap`.
+template <typename T>
+T load_value(const char* p, bool swap) {
+    char buf[sizeof(T)];
+    if (swap)
+        std::reverse_copy(p, p + sizeof(T), buf);
+    else
+        std::memcpy(buf, p, sizeof(T));
+    T value;
+    std::memcpy(&value, buf, sizeof(T));
+    return value;
+}
+
+template <typename T>
+void decode_as(std::string_view bytes, bool swap, std::vector<double>& out) {
+    const std::size_t n = bytes.size() / sizeof(T);
+    out.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = static_cast<double>(load_value<T>(bytes.data() + i * sizeof(T), swap));
+}
+
+// The samples in `bytes` (stored as `type` in byte order `order`) as doubles. Every supported type
+// converts to double exactly; non-finite floats are kept as they are.
+inline std::vector<double> decode_samples(std::string_view bytes, ScalarType type, std::endian order) {
+    const bool swap = order != std::endian::native && scalar_type_size(type) > 1;
+    std::vector<double> out;
+    switch (type) {
+        case ScalarType::U8: decode_as<std::uint8_t>(bytes, swap, out); break;
+        case ScalarType::I8: decode_as<std::int8_t>(bytes, swap, out); break;
+        case ScalarType::U16: decode_as<std::uint16_t>(bytes, swap, out); break;
+        case ScalarType::I16: decode_as<std::int16_t>(bytes, swap, out); break;
+        case ScalarType::U32: decode_as<std::uint32_t>(bytes, swap, out); break;
+        case ScalarType::I32: decode_as<std::int32_t>(bytes, swap, out); break;
+        case ScalarType::F32: decode_as<float>(bytes, swap, out); break;
+        case ScalarType::F64: decode_as<double>(bytes, swap, out); break;
+    }
+    return out;
+}
+
+}  // namespace volref::io

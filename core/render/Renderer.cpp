@@ -1,0 +1,135 @@
+#include "core/render/Renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/camera/Camera.h"
+#include "core/grid/ProceduralField.h"
+#include "core/integrate/Integrator.h"
+#include "core/io/VolumeReader.h"
+#include "core/sample/VolumeSampler.h"
+#include "geometry/BoundingGeometry.h"
+#include "transfer/TransferFunction.h"
+
+namespace volref {
+
+Volume load_volume(const VolumeSpec& spec) {
+    Volume v;
+    if (spec.source.field) {
+        v = make_procedural_volume(*spec.source.field, spec.origin.value_or(glm::dvec3(0.0)),
+                                   spec.spacing.value_or(glm::dvec3(1.0)));
+    } else {
+        v = read_volume(*spec.source.file, spec.source.format);
+        if (spec.origin) v.origin = *spec.origin;
+        if (spec.spacing) v.spacing = *spec.spacing;
+    }
+    return v;
+}
+
+double world_step(const RenderSpec& render, const Volume& volume) {
+    if (render.step_units == StepUnits::World) return render.step;
+    return render.step * std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+}
+
+namespace {
+
+// Prints "volref: rendering NN%" on stderr every quarter second once a render has run for a second.
+class ProgressReporter {
+public:
+    ProgressReporter(bool enabled, int total) : total_(total) {
+        if (enabled) thread_ = std::thread([this] { run(); });
+    }
+    ~ProgressReporter() {
+        {
+            std::lock_guard lock(mutex_);
+            done_flag_ = true;
+        }
+        cv_.notify_all();
+        if (thread_.joinable()) thread_.join();
+    }
+    void tile_done() { done_.fetch_add(1, std::memory_order_relaxed); }
+
+private:
+    void run() {
+        using namespace std::chrono;
+        const auto start = steady_clock::now();
+        bool printed = false;
+        std::unique_lock lock(mutex_);
+        while (!cv_.wait_for(lock, milliseconds(250), [this] { return done_flag_; })) {
+            const double elapsed = duration<double>(steady_clock::now() - start).count();
+            if (elapsed < 1.0) continue;
+            std::fprintf(stderr, "\rvolref: rendering %3d%% (%.1f s)", int(100.0 * done_.load() / total_), elapsed);
+            printed = true;
+        }
+        if (printed) std::fprintf(stderr, "\rvolref: rendering 100%%        \n");
+    }
+    int total_;
+    std::atomic<int> done_{0};
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    bool done_flag_ = false;
+    std::thread thread_;
+};
+
+}  // namespace
+
+Image render_scene(const Scene& scene, const RenderOptions& options) {
+    const VolumeSpec& vs = scene.volume;
+    const Volume volume = load_volume(vs);
+    const VolumeSampler sampler(volume, vs.interpolation);
+    const TransferFunction transfer(vs.transfer, volume);
+    const double step = world_step(scene.render, volume);
+
+    const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
+    const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
+    if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
+        throw Error("volume.bounds: min must not exceed max");
+    BoundingGeometry geometry;
+    const int volume_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+    geometry.commit();
+
+    const int W = scene.image.width, H = scene.image.height;
+    const Camera camera(scene.camera, W, H, glm::max(box_lo, domain_lo), glm::min(box_hi, domain_hi));
+    const IntegrationContext ctx{sampler, transfer, step, scene.render};
+    const std::unique_ptr<Integrator> integrator = make_integrator(ctx);
+
+    std::vector<std::string> channels{"R", "G", "B", "A"};
+    if (integrator->writes_depth()) channels.push_back("Z");
+    Image image(W, H, channels);
+
+    const int T = conventions::kTileSize;
+    const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
+    ProgressReporter progress(options.progress, tiles_x * tiles_y);
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
+            std::vector<Interval> intervals;
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+                const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
+                for (int y = y0; y < std::min(y0 + T, H); ++y)
+                    for (int x = x0; x < std::min(x0 + T, W); ++x) {
+                        const Ray ray = camera.pixel_ray(x, y);
+                        geometry.intervals(ray, volume_id, intervals);
+                        const PixelValue p = integrator->integrate(ray, intervals);
+                        for (int c = 0; c < 4; ++c) image.at(x, y, std::size_t(c)) = p.rgba[c];
+                        if (integrator->writes_depth()) image.at(x, y, 4) = p.depth;
+                    }
+                progress.tile_done();
+            }
+        });
+    });
+    return image;
+}
+
+}  // namespace volref

@@ -1,0 +1,27 @@
+// Rendering a scene: builds what the scene names (volume, sampler, transfer function, bounding
+// geometry, camera, integrator) and computes every pixel in parallel over tiles.
+//
+// Every pixel is computed from its own ray alone (no shared accumulators), so the image is bitwise
+// the same for any thread count and any tile order.
+#pragma once
+#include "core/film/Image.h"
+#include "core/grid/Volume.h"
+#include "core/scene/Scene.h"
+
+namespace volref {
+
+struct RenderOptions {
+    int threads = 0;        // 0: all cores
+    bool progress = false;  // print progress on stderr after about a second
+};
+
+// The volume a VolumeSpec names: read from its file or made from its procedural field, with the
+// spec's origin and spacing overriding the file's.
+Volume load_volume(const VolumeSpec& spec);
+
+// The world-space step: render.step, times the smallest spacing when step_units is voxel.
+double world_step(const RenderSpec& render, const Volume& volume);
+
+Image render_scene(const Scene& scene, const RenderOptions& options = {});
+
+}  // namespace volref

@@ -1,0 +1,553 @@
+// Scene loading: JSON text -> --set overrides -> strict validation -> Scene (docs/scene-format.md).
+//
+// Every problem is a volref::Error "<file>: <json path>: <problem>". Keys of the format that later work
+// implements (shading, classification, transforms, ...) are recognised and rejected as "not
+// implemented yet" rather than reported as unknown or silently ignored.
+#include "core/scene/SceneLoader.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "core/scene/JsonReader.h"
+
+namespace volref {
+
+namespace {
+
+namespace fs = std::filesystem;
+using json_reader::Choice;
+using json_reader::Context;
+using json_reader::Json;
+using json_reader::ObjectReader;
+using json_reader::Range;
+using json_reader::child_path;
+using json_reader::describe;
+using json_reader::element;
+using json_reader::format_number;
+using json_reader::index_path;
+using json_reader::read_array_size;
+using json_reader::read_integer;
+using json_reader::read_number;
+using json_reader::read_numbers;
+using json_reader::read_string;
+using json_reader::read_vec3;
+
+// Limits.
+constexpr std::int64_t kMaxFieldVoxels = std::int64_t{1} << 31;  // procedural fields: at most 2^31 voxels
+constexpr std::int64_t kMaxImageSide = 32768;                    // image width and height: [1, 32768]
+constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 28;  // width * height <= 2^28
+
+// Values of keys that are validated but not stored in Scene (only one value is implemented).
+enum class Classify { Post };
+enum class Integrator { Midpoint };
+
+// ------------------------------------------------------------------------------------------------
+// --set PATH=VALUE overrides
+// ------------------------------------------------------------------------------------------------
+
+// One step of an override path: a key, or an [index] into an array.
+struct PathStep {
+    bool is_index = false;
+    std::string key;
+    std::size_t index = 0;
+};
+
+bool is_key_char(char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
+// PATH: keys ([A-Za-z0-9_-]+) separated by '.', each optionally followed by [index] suffixes,
+// e.g. `volume.transfer.opacity[2][1]`.
+std::vector<PathStep> parse_override_path(const std::string& path, const Context& ctx) {
+    const auto malformed = [&](std::size_t at, const std::string& what) {
+        ctx.fail_plain("malformed path \"" + path + "\": " + what + " at character " + std::to_string(at + 1));
+    };
+    std::vector<PathStep> steps;
+    std::size_t i = 0;
+    const std::size_t n = path.size();
+    while (true) {
+        const std::size_t start = i;
+        while (i < n && is_key_char(path[i])) ++i;
+        if (i == start) malformed(i, "expected a key");
+        steps.push_back({false, path.substr(start, i - start), 0});
+        while (i < n && path[i] == '[') {
+            const std::size_t digits = ++i;
+            while (i < n && path[i] >= '0' && path[i] <= '9') ++i;
+            if (i == digits || i == n || path[i] != ']') malformed(i, "expected [index]");
+            std::size_t index = 0;
+            const auto r = std::from_chars(path.data() + digits, path.data() + i, index);
+            if (r.ec != std::errc()) malformed(digits, "index too large");
+            steps.push_back({true, {}, index});
+            ++i;
+        }
+        if (i == n) return steps;
+        if (path[i] != '.') malformed(i, std::string("unexpected '") + path[i] + "'");
+        ++i;
+    }
+}
+
+// Applies `text` ("PATH=VALUE") to `root`. Missing intermediate objects are created; an index must
+// name an existing element. VALUE is JSON when it parses as JSON, otherwise a string.
+void apply_override(Json& root, const std::string& text, Context& scene_ctx) {
+    const Context ctx("--set " + text);
+    const std::size_t eq = text.find('=');
+    if (eq == std::string::npos) ctx.fail_plain("missing '='");
+    const std::vector<PathStep> steps = parse_override_path(text.substr(0, eq), ctx);
+
+    Json* at = &root;
+    std::string path;
+    for (const PathStep& step : steps) {
+        if (!step.is_index) {
+            if (at->is_null()) *at = Json::object();  // a missing intermediate object
+            if (!at->is_object())
+                ctx.fail(path, "expected an object to set \"" + step.key + "\" in, got " + describe(*at));
+            at = &(*at)[step.key];
+            path = child_path(path, step.key);
+        } else {
+            if (!at->is_array())
+                ctx.fail(path, at->is_null() ? std::string("no such array") : "expected an array, got " + describe(*at));
+            if (step.index >= at->size())
+                ctx.fail(index_path(path, step.index),
+                         "index past the end (the array has " + std::to_string(at->size()) + " elements)");
+            at = &(*at)[step.index];
+            path = index_path(path, step.index);
+        }
+    }
+    const std::string value = text.substr(eq + 1);
+    std::optional<Json> parsed = json_reader::try_parse_json(value, ctx.name(), path);
+    *at = parsed ? std::move(*parsed) : Json(value);
+    scene_ctx.add_override(path, text);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Small readers
+// ------------------------------------------------------------------------------------------------
+
+double max_abs(const glm::dvec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+
+bool all_finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Relative paths are relative to the scene file's folder; stored absolute (weakly canonical).
+fs::path resolve_file(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
+    const std::string s = read_string(v, path, ctx);
+    if (s.empty()) ctx.fail(path, "expected a file path, got \"\"");
+    fs::path p(s);
+    if (p.is_relative()) p = base_dir / p;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(p, ec);
+    return ec ? p.lexically_normal() : canonical;
+}
+
+// A non-zero direction, normalised (scaled first, so that tiny or huge components do not under- or
+// overflow).
+glm::dvec3 read_direction(ObjectReader& r, std::string_view key) {
+    const glm::dvec3 d = read_vec3(r.required(key), r.path(key), r.context());
+    const double m = max_abs(d);
+    if (m == 0.0) r.fail(key, "expected a non-zero direction, got [0, 0, 0]");
+    return glm::normalize(d / m);
+}
+
+// Rows [value, x1, ..., x(N-1)] sorted by value (non-decreasing), at least one; x in `range`.
+template <std::size_t N>
+std::vector<std::array<double, N>> read_rows(const Json& v, const std::string& path, const Context& ctx,
+                                             std::string_view shape, const Range& range) {
+    const std::size_t n = read_array_size(v, path, ctx);
+    if (n == 0) ctx.fail(path, "expected at least one row " + std::string(shape));
+    std::vector<std::array<double, N>> rows;
+    rows.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Json& row = element(v, i);
+        const std::string row_path = index_path(path, i);
+        if (!row.is_array() || row.size() != N)
+            ctx.fail(row_path, "expected a row " + std::string(shape) + " of " + std::to_string(N) +
+                                   " numbers, got " + describe(row));
+        std::array<double, N> out{};
+        out[0] = read_number(row[0], index_path(row_path, 0), ctx);
+        for (std::size_t k = 1; k < N; ++k) out[k] = read_number(row[k], index_path(row_path, k), ctx, range);
+        if (i > 0 && out[0] < rows.back()[0])
+            ctx.fail(row_path, "rows must be sorted by value (non-decreasing): " + format_number(out[0]) +
+                                   " follows " + format_number(rows.back()[0]));
+        rows.push_back(out);
+    }
+    return rows;
+}
+
+// ------------------------------------------------------------------------------------------------
+// volume
+// ------------------------------------------------------------------------------------------------
+
+// dims: 3 integers >= 1 (default [2, 2, 2]), at most 2^31 voxels in all.
+std::array<std::int64_t, 3> read_dims(ObjectReader& r) {
+    std::array<std::int64_t, 3> dims{2, 2, 2};
+    const Json* v = r.find("dims");
+    if (!v) return dims;
+    const std::string path = r.path("dims");
+    if (!v->is_array() || v->size() != 3)
+        r.fail("dims", "expected an array of 3 integers >= 1, got " + describe(*v));
+    for (std::size_t i = 0; i < 3; ++i)
+        dims[i] = read_integer(element(*v, i), index_path(path, i), r.context(), Range::at_least(1));
+    // Each factor is >= 1, so checking the partial products in order never overflows.
+    const bool too_many = dims[0] > kMaxFieldVoxels || dims[1] > kMaxFieldVoxels || dims[2] > kMaxFieldVoxels ||
+                          dims[0] * dims[1] > kMaxFieldVoxels || dims[0] * dims[1] * dims[2] > kMaxFieldVoxels;
+    if (too_many)
+        r.fail("dims", std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " + std::to_string(dims[2]) +
+                           " voxels exceed the limit of 2^31 (2147483648) voxels for procedural fields");
+    return dims;
+}
+
+// cells: `values`, exactly nx*ny*nz numbers, i fastest.
+std::vector<double> read_cell_values(ObjectReader& r, const std::array<std::int64_t, 3>& dims) {
+    const Json& v = r.required("values");
+    const std::string path = r.path("values");
+    const auto count = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+    const std::size_t n = read_array_size(v, path, r.context());
+    if (n != count)
+        r.fail("values", "expected " + std::to_string(count) + " values (dims " + std::to_string(dims[0]) + " x " +
+                             std::to_string(dims[1]) + " x " + std::to_string(dims[2]) + "), got " + std::to_string(n));
+    std::vector<double> values;
+    values.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) values.push_back(read_number(element(v, i), index_path(path, i), r.context()));
+    return values;
+}
+
+// {"field": NAME, "dims": [nx, ny, nz], ...}: each field takes only its own parameters.
+FieldSpec read_field(ObjectReader& r) {
+    using K = FieldSpec::Kind;
+    FieldSpec f;
+    f.kind = r.required_choice<K>("field", {{"constant", K::Constant},
+                                            {"linear", K::Linear},
+                                            {"radial", K::Radial},
+                                            {"marschner-lobb", K::MarschnerLobb},
+                                            {"gaussian", K::Gaussian},
+                                            {"cells", K::Cells}});
+    const std::string what = "for field \"" + r.string("field", "") + "\"";
+    switch (f.kind) {
+        case K::Constant: r.allow({"field", "dims", "value"}, what); break;
+        case K::Linear: r.allow({"field", "dims", "coefficients"}, what); break;
+        case K::Radial: r.allow({"field", "dims", "center"}, what); break;
+        case K::MarschnerLobb: r.allow({"field", "dims", "fm", "alpha"}, what); break;
+        case K::Gaussian: r.allow({"field", "dims", "center", "sigma", "amplitude"}, what); break;
+        case K::Cells: r.allow({"field", "dims", "values"}, what); break;
+    }
+    f.dims = read_dims(r);
+    switch (f.kind) {
+        case K::Constant: f.value = r.number("value", 0.0); break;
+        case K::Linear:
+            if (const Json* c = r.find("coefficients")) {
+                const std::vector<double> a = read_numbers(*c, r.path("coefficients"), r.context(), 4);
+                std::copy(a.begin(), a.end(), f.coefficients.begin());
+            }
+            break;
+        case K::Radial: f.center = r.vec3("center", glm::dvec3(0.0)); break;
+        case K::MarschnerLobb:
+            f.fm = r.number("fm", 6.0, Range::non_negative());
+            f.alpha = r.number("alpha", 0.25, Range::non_negative());
+            break;
+        case K::Gaussian:
+            f.center = r.vec3("center", glm::dvec3(0.0));
+            f.sigma = r.number("sigma", 1.0, Range::positive());
+            f.amplitude = r.number("amplitude", 1.0);
+            break;
+        case K::Cells: f.values = read_cell_values(r, f.dims); break;
+    }
+    return f;
+}
+
+// A file path (format from the extension), {"file": PATH, "format": "nrrd" | "raw"} or a field.
+VolumeSourceSpec read_source(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
+    VolumeSourceSpec s;
+    if (v.is_string()) {
+        s.file = resolve_file(v, path, ctx, base_dir);
+        return s;
+    }
+    if (!v.is_object())
+        ctx.fail(path, "expected a file path or an object with \"file\" or \"field\", got " + describe(v));
+    ObjectReader r(v, path, ctx);
+    const bool has_file = r.has("file"), has_field = r.has("field");
+    if (has_file && has_field) r.fail_here("give either \"file\" or \"field\", not both");
+    if (!has_file && !has_field) {
+        r.allow({"file", "format", "field"});
+        r.fail_here("expected an object with \"file\" or \"field\"");
+    }
+    if (has_field) {
+        s.field = read_field(r);
+        return s;
+    }
+    r.allow({"file", "format"}, "for a file source");
+    s.file = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
+    s.format = std::string(r.choice<std::string_view>("format", "", {{"nrrd", "nrrd"}, {"raw", "raw"}}));
+    return s;
+}
+
+// {"type": "box", "min": [3], "max": [3]}: min < max on every axis when both are given.
+BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ctx) {
+    using T = BoundsSpec::Type;
+    ObjectReader r(v, path, ctx);
+    BoundsSpec b;
+    b.type = r.choice<T>("type", T::Box, {{"box", T::Box}}, {"mesh", "cylindrical", "spherical"});
+    r.allow({"type", "min", "max"}, "for bounds type \"box\"");
+    b.min = r.optional_vec3("min");
+    b.max = r.optional_vec3("max");
+    if (b.min && b.max && !(b.min->x < b.max->x && b.min->y < b.max->y && b.min->z < b.max->z))
+        r.fail("max", "expected max > min on every axis, got min " + describe(*r.find("min")) + " and max " +
+                          describe(*r.find("max")));
+    return b;
+}
+
+// Piecewise-linear colour and opacity; absent rows stay empty (the renderer fills its defaults).
+TransferSpec read_transfer(const Json& v, const std::string& path, const Context& ctx) {
+    using D = TransferSpec::Domain;
+    ObjectReader r(v, path, ctx);
+    r.allow({"domain", "window", "color", "opacity", "gradient_opacity", "opacity_unit_distance"});
+    r.reject("gradient_opacity", "gradient opacity is not implemented yet");
+    TransferSpec t;
+    t.domain = r.choice<D>("domain", D::Data, {{"data", D::Data}, {"normalized", D::Normalized}});
+    if (const Json* w = r.find("window")) {
+        if (t.domain != D::Normalized)
+            r.fail("window", "a window applies only to \"domain\": \"normalized\" (the data domain uses values as they are)");
+        const std::vector<double> x = read_numbers(*w, r.path("window"), ctx, 2);
+        if (!(x[0] < x[1])) r.fail("window", "expected [lo, hi] with lo < hi, got " + describe(*w));
+        t.window = std::array<double, 2>{x[0], x[1]};
+    }
+    if (const Json* c = r.find("color")) t.color = read_rows<4>(*c, r.path("color"), ctx, "[value, r, g, b]", Range::non_negative());
+    if (const Json* o = r.find("opacity")) t.opacity = read_rows<2>(*o, r.path("opacity"), ctx, "[value, a]", Range::closed(0, 1));
+    t.opacity_unit_distance = r.number("opacity_unit_distance", 1.0, Range::positive());
+    return t;
+}
+
+VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"source", "origin", "spacing", "interpolation", "bounds", "classify", "transfer", "classification",
+             "shading", "transform", "clip_planes", "crop"});
+    // Recognised keys that later work implements.
+    r.reject("shading", "shading is not implemented yet");
+    r.reject("classification", "classification (isovalue contours, region boundaries) is not implemented yet");
+    r.reject("transform", "volume transforms are not implemented yet");
+    r.reject("clip_planes", "clip planes are not implemented yet");
+    r.reject("crop", "cropping is not implemented yet");
+
+    VolumeSpec spec;
+    spec.source = read_source(r.required("source"), r.path("source"), ctx, base_dir);
+    spec.origin = r.optional_vec3("origin");
+    spec.spacing = r.optional_vec3("spacing", Range::positive());
+    spec.interpolation = r.choice<Interpolation>("interpolation", Interpolation::Trilinear,
+                                                 {{"nearest", Interpolation::Nearest}, {"trilinear", Interpolation::Trilinear}},
+                                                 {"tricubic-bspline", "tricubic-catmull-rom"});
+    r.choice<Classify>("classify", Classify::Post, {{"post", Classify::Post}}, {"pre"});
+    if (const Json* b = r.find("bounds")) spec.bounds = read_bounds(*b, r.path("bounds"), ctx);
+    if (const Json* t = r.find("transfer")) spec.transfer = read_transfer(*t, r.path("transfer"), ctx);
+    return spec;
+}
+
+// "volume": {...}, or "volumes": [{...}] with exactly one element (several: not implemented yet).
+VolumeSpec read_volume_key(ObjectReader& r, const fs::path& base_dir) {
+    const Json* one = r.find("volume");
+    const Json* many = r.find("volumes");
+    if (one && many) r.fail("volumes", "give either \"volume\" or \"volumes\", not both");
+    if (many) {
+        const std::size_t n = read_array_size(*many, r.path("volumes"), r.context());
+        if (n == 0) r.fail("volumes", "expected one volume, got an empty array");
+        if (n > 1) r.fail("volumes", "several volumes are not implemented yet (got " + std::to_string(n) + ")");
+        return read_volume(element(*many, 0), index_path(r.path("volumes"), 0), r.context(), base_dir);
+    }
+    if (!one) r.fail("volume", "required");
+    return read_volume(*one, r.path("volume"), r.context(), base_dir);
+}
+
+// ------------------------------------------------------------------------------------------------
+// lights, camera, image, render
+// ------------------------------------------------------------------------------------------------
+
+// {"type": "headlight" | "directional", "direction": [3] (directional only), "color": [3] >= 0}.
+LightSpec read_light(const Json& v, const std::string& path, const Context& ctx) {
+    using T = LightSpec::Type;
+    ObjectReader r(v, path, ctx);
+    LightSpec l;
+    l.type = r.choice<T>("type", T::Headlight, {{"headlight", T::Headlight}, {"directional", T::Directional}});
+    if (l.type == T::Headlight) {
+        r.allow({"type", "color"}, "for a headlight");
+    } else {
+        r.allow({"type", "direction", "color"}, "for a directional light");
+        l.direction = read_direction(r, "direction");
+    }
+    l.color = r.vec3("color", glm::dvec3(1.0), Range::non_negative());
+    return l;
+}
+
+// An array of lights; [] means no lights.
+std::vector<LightSpec> read_lights(const Json& v, const std::string& path, const Context& ctx) {
+    const std::size_t n = read_array_size(v, path, ctx);
+    std::vector<LightSpec> lights;
+    for (std::size_t i = 0; i < n; ++i) lights.push_back(read_light(element(v, i), index_path(path, i), ctx));
+    return lights;
+}
+
+// eye, target, up: eye != target; up non-zero and not parallel to target - eye.
+void read_look_at(ObjectReader& r, CameraSpec& c) {
+    c.eye = r.vec3("eye", glm::dvec3(0.0, 0.0, 1.0));
+    c.target = r.vec3("target", glm::dvec3(0.0));
+    c.up = r.vec3("up", glm::dvec3(0.0, 1.0, 0.0));
+    const glm::dvec3 forward = c.target - c.eye;
+    if (max_abs(forward) == 0.0) r.fail("eye", "the eye is at the target (they must differ)");
+    if (!all_finite(forward)) r.fail("target", "target - eye overflows a double");
+    if (max_abs(c.up) == 0.0) r.fail("up", "expected a non-zero up vector, got [0, 0, 0]");
+    // |up x f| > 1e-12 |up| |f|, on vectors scaled to a largest component of 1 (no under-/overflow).
+    const glm::dvec3 u = c.up / max_abs(c.up), f = forward / max_abs(forward);
+    if (!(glm::length(glm::cross(u, f)) > 1e-12 * glm::length(u) * glm::length(f)))
+        r.fail("up", "the up vector is parallel to the view direction (target - eye)");
+}
+
+// 16 numbers, column-major as OpenGL stores them (m[col][row] = a[4 col + row]); invertible.
+glm::dmat4 read_matrix(ObjectReader& r, std::string_view key) {
+    const std::vector<double> a = read_numbers(r.required(key), r.path(key), r.context(), 16);
+    glm::dmat4 m(1.0);
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row) m[col][row] = a[static_cast<std::size_t>(4 * col + row)];
+    const double det = glm::determinant(m);
+    if (!(std::fabs(det) > 1e-300))
+        r.fail(key, "the matrix is not invertible (determinant " + format_number(det) + ")");
+    const glm::dmat4 inverse = glm::inverse(m);
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row)
+            if (!std::isfinite(inverse[col][row])) r.fail(key, "the matrix is not invertible (its inverse overflows)");
+    return m;
+}
+
+CameraSpec read_camera(const Json& v, const std::string& path, const Context& ctx) {
+    using T = CameraSpec::Type;
+    ObjectReader r(v, path, ctx);
+    CameraSpec c;
+    c.type = r.required_choice<T>(
+        "type", {{"perspective", T::Perspective}, {"orthographic", T::Orthographic}, {"matrices", T::Matrices}});
+    switch (c.type) {
+        case T::Perspective:
+            r.allow({"type", "eye", "target", "up", "fov_y"}, "for camera type \"perspective\"");
+            read_look_at(r, c);
+            c.fov_y = r.number("fov_y", 30.0, Range::open(0, 180));
+            break;
+        case T::Orthographic:
+            r.allow({"type", "eye", "target", "up", "height"}, "for camera type \"orthographic\"");
+            read_look_at(r, c);
+            c.height = r.number("height", 1.0, Range::positive());
+            break;
+        case T::Matrices:
+            r.allow({"type", "view", "projection"}, "for camera type \"matrices\"");
+            c.view = read_matrix(r, "view");
+            c.projection = read_matrix(r, "projection");
+            break;
+        case T::Default: break;  // not a value of "type"
+    }
+    return c;
+}
+
+ImageSpec read_image(const Json& v, const std::string& path, const Context& ctx) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"width", "height", "background"});
+    ImageSpec im;
+    const std::int64_t w = r.integer("width", 256, Range::closed(1, kMaxImageSide));
+    const std::int64_t h = r.integer("height", 256, Range::closed(1, kMaxImageSide));
+    if (w * h > kMaxImagePixels)
+        r.fail(r.has("height") ? "height" : "width", std::to_string(w) + " x " + std::to_string(h) + " = " +
+                                                        std::to_string(w * h) +
+                                                        " pixels exceed the limit of 2^28 (268435456) pixels");
+    im.width = static_cast<int>(w);
+    im.height = static_cast<int>(h);
+    if (const Json* b = r.find("background")) {
+        const std::vector<double> c = read_numbers(*b, r.path("background"), ctx, 4, Range::closed(0, 1));
+        im.background = glm::dvec4(c[0], c[1], c[2], c[3]);
+    }
+    return im;
+}
+
+RenderSpec read_render(const Json& v, const std::string& path, const Context& ctx) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
+             "profile", "gain"});
+    RenderSpec s;
+    s.projection = r.choice<Projection>("projection", Projection::Composite,
+                                        {{"composite", Projection::Composite},
+                                         {"mip", Projection::Mip},
+                                         {"minip", Projection::Minip},
+                                         {"average", Projection::Average},
+                                         {"first-hit", Projection::FirstHit},
+                                         {"xray", Projection::Xray}});
+    s.order = r.choice<CompositeOrder>("order", CompositeOrder::FrontToBack,
+                                       {{"front-to-back", CompositeOrder::FrontToBack},
+                                        {"back-to-front", CompositeOrder::BackToFront}});
+    s.step = r.number("step", 0.5, Range::positive());
+    s.step_units = r.choice<StepUnits>("step_units", StepUnits::Voxel,
+                                       {{"voxel", StepUnits::Voxel}, {"world", StepUnits::World}});
+    s.isovalue = r.optional_number("isovalue");
+    s.early_termination = r.optional_number("early_termination", Range::left_open(0, 1));
+    r.choice<Integrator>("integrator", Integrator::Midpoint, {{"midpoint", Integrator::Midpoint}}, {"adaptive"});
+    r.reject("tolerance", "tolerance (of the adaptive integrator) is not implemented yet");
+    if (const std::optional<std::string> p = r.optional_string("profile"); p && *p != "reference")
+        r.fail("profile", "profile " + describe(Json(*p)) + " is not implemented yet (implemented: \"reference\")");
+    s.gain = r.number("gain", 1.0, Range::positive());
+    if (s.projection == Projection::FirstHit && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
+    return s;
+}
+
+// ------------------------------------------------------------------------------------------------
+// The scene
+// ------------------------------------------------------------------------------------------------
+
+Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir) {
+    ObjectReader r(root, "", ctx);
+    r.allow({"description", "volume", "volumes", "lights", "camera", "image", "render"});
+    r.optional_string("description");  // a note for humans; ignored
+    Scene scene;
+    scene.volume = read_volume_key(r, base_dir);
+    if (const Json* v = r.find("lights")) scene.lights = read_lights(*v, r.path("lights"), ctx);
+    if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
+    if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);
+    if (const Json* v = r.find("render")) scene.render = read_render(*v, r.path("render"), ctx);
+    return scene;
+}
+
+std::string read_text(const fs::path& path, const Context& ctx) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) ctx.fail_plain("cannot read the scene file: no such file");
+    if (fs::is_directory(path, ec)) ctx.fail_plain("cannot read the scene file: it is a directory");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) ctx.fail_plain(std::string("cannot open the scene file: ") + std::strerror(errno));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) ctx.fail_plain("error while reading the scene file");
+    return text;
+}
+
+fs::path absolute_dir(const fs::path& dir) { return dir.empty() ? fs::current_path() : fs::absolute(dir); }
+
+}  // namespace
+
+Scene parse_scene(const std::string& json_text, const std::filesystem::path& base_dir, const std::string& name,
+                  const std::vector<std::string>& overrides) {
+    Context ctx(name);
+    Json root = json_reader::parse_json(json_text, name);
+    if (!root.is_object()) ctx.fail("", "expected an object, got " + describe(root));
+    for (const std::string& o : overrides) apply_override(root, o, ctx);
+    Scene scene = read_scene(root, ctx, absolute_dir(base_dir));
+    scene.file = name;
+    return scene;
+}
+
+Scene load_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+    const std::string name = path.string();
+    const std::string text = read_text(path, Context(name));
+    Scene scene = parse_scene(text, fs::absolute(path).parent_path(), name, overrides);
+    scene.file = path;
+    return scene;
+}
+
+}  // namespace volref

@@ -1,0 +1,34 @@
+// The slab test in double precision: the interval of t where origin + t * direction lies in the
+// closed box [lo, hi]. On an axis where the direction is exactly 0 the slab holds for every t if
+// lo <= origin <= hi and for none otherwise (no 0 * inf). Returns false when the interval is empty.
+#pragma once
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+#include <glm/vec3.hpp>
+
+#include "core/camera/Ray.h"
+#include "geometry/RayIntervals.h"
+
+namespace volref {
+
+inline bool intersect_box(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi, Interval& out) {
+    double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        const double o = ray.origin[a], d = ray.direction[a];
+        if (d == 0.0) {
+            if (o < lo[a] || o > hi[a]) return false;
+            continue;
+        }
+        double ta = (lo[a] - o) / d, tb = (hi[a] - o) / d;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    if (!(t0 <= t1)) return false;
+    out = {t0, t1};
+    return true;
+}
+
+}  // namespace volref

@@ -1,0 +1,92 @@
+// Cameras: pixel centres, perspective and orthographic rays, and OpenGL matrices giving the same rays.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/camera/Camera.h"
+
+using namespace volref;
+
+namespace {
+CameraSpec perspective() {
+    CameraSpec c;
+    c.type = CameraSpec::Type::Perspective;
+    c.eye = {1, 2, 10};
+    c.target = {1, 2, 0};
+    c.up = {0, 1, 0};
+    c.fov_y = 60;
+    return c;
+}
+}  // namespace
+
+TEST(Camera, PerspectiveCornersAndCentre) {
+    const Camera cam(perspective(), 4, 2, glm::dvec3(0), glm::dvec3(1));
+    // The image centre (2, 1) looks at the target.
+    const Ray c = cam.ray(2.0, 1.0);
+    EXPECT_NEAR(c.direction.z, -1.0, 1e-15);
+    // Pixel (3, 0)'s centre is at nx = 0.75, ny = 0.5; tan(30 deg) = 1/sqrt(3); aspect 2.
+    const Ray r = cam.pixel_ray(3, 0);
+    const double t = 1.0 / std::sqrt(3.0);
+    const glm::dvec3 expected = glm::normalize(glm::dvec3(0.75 * t * 2.0, 0.5 * t, -1.0));
+    EXPECT_NEAR(r.direction.x, expected.x, 1e-15);
+    EXPECT_NEAR(r.direction.y, expected.y, 1e-15);
+    EXPECT_NEAR(r.direction.z, expected.z, 1e-15);
+    EXPECT_EQ(r.origin, glm::dvec3(1, 2, 10));
+}
+
+TEST(Camera, OrthographicOrigins) {
+    CameraSpec c = perspective();
+    c.type = CameraSpec::Type::Orthographic;
+    c.height = 4.0;
+    const Camera cam(c, 4, 4, glm::dvec3(0), glm::dvec3(1));
+    const Ray r = cam.pixel_ray(0, 0);  // top left: x = 1 - 1.5, y = 2 + 1.5
+    EXPECT_NEAR(r.origin.x, -0.5, 1e-15);
+    EXPECT_NEAR(r.origin.y, 3.5, 1e-15);
+    EXPECT_EQ(r.origin.z, 10.0);
+    EXPECT_EQ(r.direction, glm::dvec3(0, 0, -1));
+}
+
+// A GPU program's view and projection matrices (glm::lookAt / glm::perspective / glm::ortho, as
+// OpenGL programs build them) give the same rays as the equivalent camera.
+TEST(Camera, MatricesMatchPerspectiveAndOrthographic) {
+    const CameraSpec p = perspective();
+    CameraSpec m;
+    m.type = CameraSpec::Type::Matrices;
+    m.view = glm::lookAt(p.eye, p.target, p.up);
+    m.projection = glm::perspective(p.fov_y * std::numbers::pi / 180.0, 3.0 / 2.0, 0.1, 100.0);
+    const Camera a(p, 6, 4, glm::dvec3(0), glm::dvec3(1)), b(m, 6, 4, glm::dvec3(0), glm::dvec3(1));
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 6; ++x) {
+            const Ray ra = a.pixel_ray(x, y), rb = b.pixel_ray(x, y);
+            EXPECT_NEAR(glm::length(ra.direction - rb.direction), 0.0, 1e-12);
+            EXPECT_NEAR(glm::length(ra.origin - rb.origin), 0.0, 1e-9);
+        }
+    CameraSpec o = p;
+    o.type = CameraSpec::Type::Orthographic;
+    o.height = 4.0;
+    m.projection = glm::ortho(-3.0, 3.0, -2.0, 2.0, 0.1, 100.0);
+    const Camera c(o, 6, 4, glm::dvec3(0), glm::dvec3(1)), d(m, 6, 4, glm::dvec3(0), glm::dvec3(1));
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 6; ++x) {
+            const Ray rc = c.pixel_ray(x, y), rd = d.pixel_ray(x, y);
+            EXPECT_NEAR(glm::length(rc.direction - rd.direction), 0.0, 1e-12);
+            EXPECT_NEAR(glm::length(rc.origin - rd.origin), 0.0, 1e-9);
+        }
+}
+
+// The default camera looks along -z at the bounds' centre from d = R / sin(15 deg).
+TEST(Camera, DefaultFitsTheBoundingSphere) {
+    CameraSpec c;  // Type::Default
+    const Camera cam(c, 8, 8, glm::dvec3(0, 0, 0), glm::dvec3(2, 2, 2));
+    const Ray r = cam.ray(4.0, 4.0);
+    const double d = std::sqrt(3.0) / std::sin(15.0 * std::numbers::pi / 180.0);
+    EXPECT_NEAR(r.origin.x, 1.0, 1e-15);
+    EXPECT_NEAR(r.origin.y, 1.0, 1e-15);
+    EXPECT_NEAR(r.origin.z, 1.0 + d, 1e-13);
+    EXPECT_NEAR(r.direction.z, -1.0, 1e-15);
+}

@@ -1,0 +1,20 @@
+// volref: the whole public API in one include (installed as <volref/volref.h>'s folder on the path:
+// #include "volref.h"). See README.md and docs/architecture.md.
+#pragma once
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/camera/Camera.h"
+#include "core/film/Image.h"
+#include "core/film/ImageWriter.h"
+#include "core/grid/ProceduralField.h"
+#include "core/grid/Volume.h"
+#include "core/integrate/Integrator.h"
+#include "core/io/VolumeReader.h"
+#include "core/render/Renderer.h"
+#include "core/sample/Trilinear.h"
+#include "core/sample/VolumeSampler.h"
+#include "core/scene/Scene.h"
+#include "core/scene/SceneLoader.h"
+#include "geometry/BoundingGeometry.h"
+#include "transfer/OpacityCorrection.h"
+#include "transfer/TransferFunction.h"

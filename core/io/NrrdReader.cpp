@@ -340,14 +340,17 @@ std::array<std::optional<double>, 3> parse_spacings(const Fields& fields, int di
     return spacings;
 }
 
+// "(x,y,z)" with each number in its shortest round-trip form, for messages.
 std::string vector_text(const std::vector<double>& v) {
     std::string s = "(";
     for (std::size_t i = 0; i < v.size(); ++i) {
+        if (i > 0) s += ',';
         char buf[32];
-        std::snprintf(buf, sizeof(buf), "%.17g", v[i]);
-        s += (i ? "," : "") + std::string(buf);
+        const auto end = std::to_chars(buf, buf + sizeof(buf), v[i]).ptr;
+        s.append(buf, end);
     }
-    return s + ")";
+    s += ')';
+    return s;
 }
 
 // `space directions`: one vector per axis. volref supports only axis-aligned, unflipped grids: the

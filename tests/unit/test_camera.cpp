@@ -22,6 +22,16 @@ CameraSpec perspective() {
     c.fov_y = 60;
     return c;
 }
+// Every pixel of a 6 x 4 image gets the same ray from both cameras.
+void expect_same_rays(const CameraSpec& a_spec, const CameraSpec& b_spec) {
+    const Camera a(a_spec, 6, 4, glm::dvec3(0), glm::dvec3(1)), b(b_spec, 6, 4, glm::dvec3(0), glm::dvec3(1));
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 6; ++x) {
+            const Ray ra = a.pixel_ray(x, y), rb = b.pixel_ray(x, y);
+            EXPECT_NEAR(glm::length(ra.direction - rb.direction), 0.0, 1e-12);
+            EXPECT_NEAR(glm::length(ra.origin - rb.origin), 0.0, 1e-9);
+        }
+}
 }  // namespace
 
 TEST(Camera, PerspectiveCornersAndCentre) {
@@ -59,24 +69,12 @@ TEST(Camera, MatricesMatchPerspectiveAndOrthographic) {
     m.type = CameraSpec::Type::Matrices;
     m.view = glm::lookAt(p.eye, p.target, p.up);
     m.projection = glm::perspective(p.fov_y * std::numbers::pi / 180.0, 3.0 / 2.0, 0.1, 100.0);
-    const Camera a(p, 6, 4, glm::dvec3(0), glm::dvec3(1)), b(m, 6, 4, glm::dvec3(0), glm::dvec3(1));
-    for (int y = 0; y < 4; ++y)
-        for (int x = 0; x < 6; ++x) {
-            const Ray ra = a.pixel_ray(x, y), rb = b.pixel_ray(x, y);
-            EXPECT_NEAR(glm::length(ra.direction - rb.direction), 0.0, 1e-12);
-            EXPECT_NEAR(glm::length(ra.origin - rb.origin), 0.0, 1e-9);
-        }
+    expect_same_rays(p, m);
     CameraSpec o = p;
     o.type = CameraSpec::Type::Orthographic;
     o.height = 4.0;
     m.projection = glm::ortho(-3.0, 3.0, -2.0, 2.0, 0.1, 100.0);
-    const Camera c(o, 6, 4, glm::dvec3(0), glm::dvec3(1)), d(m, 6, 4, glm::dvec3(0), glm::dvec3(1));
-    for (int y = 0; y < 4; ++y)
-        for (int x = 0; x < 6; ++x) {
-            const Ray rc = c.pixel_ray(x, y), rd = d.pixel_ray(x, y);
-            EXPECT_NEAR(glm::length(rc.direction - rd.direction), 0.0, 1e-12);
-            EXPECT_NEAR(glm::length(rc.origin - rd.origin), 0.0, 1e-9);
-        }
+    expect_same_rays(o, m);
 }
 
 // The default camera looks along -z at the bounds' centre from d = R / sin(15 deg).

@@ -175,3 +175,22 @@ TEST_F(Cli, WritesPngAndTiff) {
         EXPECT_TRUE(fs::exists(out));
     }
 }
+
+// A render longer than about a second shows progress when stderr is a terminal (`script` gives the
+// command a pseudo-terminal), and nothing when it is not.
+TEST_F(Cli, ProgressOnlyOnATerminal) {
+    const std::string render = std::string(VOLREF_CLI) + " render " + std::string(VOLREF_SOURCE_DIR) +
+                               "/reference_scenes/default.json -o " + (dir_ / "p.exr").string() +
+                               " --threads 1 --set image.width=1200 --set image.height=1200";
+    const fs::path log = dir_ / "tty.txt";
+    const std::string cmd = "script -qec '" + render + "' " + log.string() + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    EXPECT_NE(ss.str().find("volref: rendering"), std::string::npos) << ss.str();
+    const Result r = run("render " + std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/default.json -o " +
+                         (dir_ / "q.exr").string() + " --threads 1 --set image.width=1200 --set image.height=1200");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.err.find("volref: rendering"), std::string::npos) << r.err;
+}

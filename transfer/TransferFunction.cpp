@@ -1,8 +1,11 @@
 #include "transfer/TransferFunction.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "core/Error.h"
+#include "transfer/BoundaryClassifier.h"
+#include "transfer/IsovalueClassifier.h"
 
 namespace volref {
 
@@ -55,6 +58,33 @@ TransferFunction::TransferFunction(const TransferSpec& spec, const Volume& volum
         oy = {{0.0}, {1.0}};
     }
     opacity_ = PiecewiseLinear<1>(std::move(ox), std::move(oy));
+
+    if (!spec.gradient_opacity.empty()) {
+        has_gradient_opacity_ = true;
+        std::vector<double> gx;
+        std::vector<std::array<double, 1>> gy;
+        for (const auto& row : spec.gradient_opacity) {
+            gx.push_back(row[0]);
+            gy.push_back({row[1]});
+        }
+        gradient_opacity_ = PiecewiseLinear<1>(std::move(gx), std::move(gy));
+    }
+}
+
+Classified TransferFunction::classify(double value, double gradient_magnitude) const {
+    Classified out;
+    out.color = color(value);
+    out.opacity = opacity(value);
+    if (has_gradient_opacity_) out.opacity = std::clamp(out.opacity * gradient_opacity_(gradient_magnitude)[0], 0.0, 1.0);
+    return out;
+}
+
+std::unique_ptr<Classifier> make_classifier(const VolumeSpec& spec, const Volume& volume) {
+    if (!spec.classification) return std::make_unique<TransferFunction>(spec.transfer, volume);
+    const ClassificationSpec& c = *spec.classification;
+    if (c.type == ClassificationSpec::Type::Isovalue)
+        return std::make_unique<IsovalueClassifier>(c.isovalues, c.opacity_unit_distance);
+    return std::make_unique<BoundaryClassifier>(c.regions, c.opacity_unit_distance);
 }
 
 }  // namespace volref

@@ -6,6 +6,8 @@
 // data's [min, max] for float data). Defaults when rows are absent: colour white; opacity a ramp
 // from 0 at the window's low end to 1 at its high end (in the function's own coordinate: [lo, hi]
 // for "data", [0, 1] for "normalized").
+// Gradient opacity (`gradient_opacity` rows [|grad f|, factor]): the opacity is multiplied by the
+// piecewise-linear factor of |grad f| and clamped to [0, 1] (as VTK's gradient opacity).
 #pragma once
 #include <array>
 
@@ -13,22 +15,25 @@
 
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
+#include "transfer/Classifier.h"
 #include "transfer/PiecewiseLinear.h"
 
 namespace volref {
 
-class TransferFunction {
+class TransferFunction final : public Classifier {
 public:
     TransferFunction(const TransferSpec& spec, const Volume& volume);
 
+    Classified classify(double value, double gradient_magnitude) const override;
+    bool needs_gradient() const override { return has_gradient_opacity_; }
+    double unit_distance() const override { return unit_distance_; }
     // The transfer function's coordinate for data value v.
-    double coordinate(double v) const { return normalized_ ? (v - lo_) * inv_width_ : v; }
+    double coordinate(double v) const override { return normalized_ ? (v - lo_) * inv_width_ : v; }
     glm::dvec3 color(double v) const {
         const auto c = color_(coordinate(v));
         return {c[0], c[1], c[2]};
     }
     double opacity(double v) const { return opacity_(coordinate(v))[0]; }
-    double unit_distance() const { return unit_distance_; }
     // The window [lo, hi] used for the normalised domain and the default rows.
     std::array<double, 2> window() const { return {lo_, hi_}; }
 
@@ -38,6 +43,8 @@ private:
     double unit_distance_ = 1.0;
     PiecewiseLinear<3> color_;
     PiecewiseLinear<1> opacity_;
+    bool has_gradient_opacity_ = false;
+    PiecewiseLinear<1> gradient_opacity_;
 };
 
 }  // namespace volref

@@ -14,26 +14,25 @@ PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Inte
 }
 
 PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals) const {
-    const TransferFunction& tf = ctx_.transfer;
-    const double l = tf.unit_distance();
+    const double l = ctx_.pipeline.classifier().unit_distance();
     const bool terminate = ctx_.render.early_termination.has_value();
     const double threshold = terminate ? *ctx_.render.early_termination : 0.0;
     CompensatedSum tau;
     glm::dvec3 C(0.0);
     bool opaque = false;
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
-        const double v = ctx_.field(ray, s.midpoint());
-        const double a = tf.opacity(v);
+        const PipelineSample p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        const double a = p.opacity;
         if (a <= 0.0) return true;
         const double T = std::exp(-tau.value());
         if (a >= 1.0) {  // opaque: alpha = 1, nothing behind is visible
-            C += T * tf.color(v);
+            C += T * p.color;
             opaque = true;
             return false;
         }
         const double tau_k = optical_depth(a, s.length(), l);
         const double alpha = -std::expm1(-tau_k);
-        C += (T * alpha) * tf.color(v);
+        C += (T * alpha) * p.color;
         tau.add(tau_k);
         return !(terminate && -std::expm1(-tau.value()) > threshold);
     });
@@ -43,23 +42,22 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
 }
 
 PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals) const {
-    const TransferFunction& tf = ctx_.transfer;
-    const double l = tf.unit_distance();
+    const double l = ctx_.pipeline.classifier().unit_distance();
     CompensatedSum tau;
     glm::dvec3 C(0.0);
     bool opaque = false;
     for_each_segment_reversed(intervals, ctx_.step, [&](const Segment& s) {
-        const double v = ctx_.field(ray, s.midpoint());
-        const double a = tf.opacity(v);
+        const PipelineSample p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        const double a = p.opacity;
         if (a <= 0.0) return true;
         if (a >= 1.0) {
-            C = tf.color(v);
+            C = p.color;
             opaque = true;
             return true;
         }
         const double tau_k = optical_depth(a, s.length(), l);
         const double alpha = -std::expm1(-tau_k);
-        C = alpha * tf.color(v) + (1.0 - alpha) * C;
+        C = alpha * p.color + (1.0 - alpha) * C;
         tau.add(tau_k);
         return true;
     });

@@ -54,7 +54,7 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
     }
     PixelValue out;
     if (hit) {
-        out.rgba = glm::dvec4(ctx_.transfer.color(ctx_.field(ray, *hit)), 1.0);
+        out.rgba = glm::dvec4(ctx_.pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color, 1.0);
         out.depth = *hit;
     }
     return out;

@@ -9,10 +9,9 @@
 #include <glm/vec4.hpp>
 
 #include "core/camera/Ray.h"
-#include "core/sample/VolumeSampler.h"
+#include "core/integrate/SamplePipeline.h"
 #include "core/scene/Scene.h"
 #include "geometry/RayIntervals.h"
-#include "transfer/TransferFunction.h"
 
 namespace volref {
 
@@ -21,13 +20,12 @@ struct PixelValue {
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)
 };
 
-// What every integrator reads: the field, the transfer function, the step in world units.
+// What every integrator reads: the sample pipeline, the step in world units, the render settings.
 struct IntegrationContext {
-    const VolumeSampler& sampler;
-    const TransferFunction& transfer;
+    const SamplePipeline& pipeline;
     double step;  // world units, > 0
     const RenderSpec& render;
-    double field(const Ray& ray, double t) const { return sampler.value(ray.at(t)); }
+    double field(const Ray& ray, double t) const { return pipeline.value(ray, t); }
 };
 
 class Integrator {

@@ -10,7 +10,7 @@ PixelValue LineIntegralIntegrator::integrate(const Ray& ray, const std::vector<I
     if (intervals.empty()) return out;
     CompensatedSum integral, length;
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
-        integral.add(ctx_.transfer.coordinate(ctx_.field(ray, s.midpoint())) * s.length());
+        integral.add(ctx_.pipeline.classifier().coordinate(ctx_.field(ray, s.midpoint())) * s.length());
         length.add(s.length());
         return true;
     });

@@ -17,10 +17,14 @@
 #include "core/camera/Camera.h"
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/Integrator.h"
+#include "core/integrate/SamplePipeline.h"
+#include "core/sample/GradientField.h"
+#include "core/sample/PreClassifiedVolume.h"
 #include "core/io/VolumeReader.h"
 #include "core/sample/VolumeSampler.h"
 #include "geometry/BoundingGeometry.h"
-#include "transfer/TransferFunction.h"
+#include "transfer/Classifier.h"
+#include "transfer/Shader.h"
 
 namespace volref {
 
@@ -88,8 +92,26 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
     const VolumeSpec& vs = scene.volume;
     const Volume volume = load_volume(vs);
     const VolumeSampler sampler(volume, vs.interpolation);
-    const TransferFunction transfer(vs.transfer, volume);
+    const std::unique_ptr<Classifier> classifier = make_classifier(vs, volume);
     const double step = world_step(scene.render, volume);
+
+    // Only what the scene uses is built: gradients for shading or gradient-based classification,
+    // the pre-classified volume for classify "pre", the shader for shading.
+    const bool shades = vs.shading.has_value() &&
+                        (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
+    std::unique_ptr<GradientField> gradient;
+    if (shades || classifier->needs_gradient()) gradient = std::make_unique<GradientField>(sampler, vs.gradient);
+    std::unique_ptr<PreClassifiedVolume> preclassified;
+    if (vs.classify == VolumeSpec::Classify::Pre)
+        preclassified = std::make_unique<PreClassifiedVolume>(sampler, *classifier, gradient.get());
+    std::unique_ptr<Shader> shader;
+    if (shades) {
+        const auto [vmin, vmax] = volume.value_range();
+        const double min_spacing = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+        shader = std::make_unique<Shader>(*vs.shading, scene.lights,
+                                          conventions::kZeroGradientRelative * (vmax - vmin) / min_spacing);
+    }
+    const SamplePipeline pipeline(sampler, *classifier, gradient.get(), preclassified.get(), shader.get());
 
     const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
     const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
@@ -101,7 +123,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
 
     const int W = scene.image.width, H = scene.image.height;
     const Camera camera(scene.camera, W, H, glm::max(box_lo, domain_lo), glm::min(box_hi, domain_hi));
-    const IntegrationContext ctx{sampler, transfer, step, scene.render};
+    const IntegrationContext ctx{pipeline, step, scene.render};
     const std::unique_ptr<Integrator> integrator = make_integrator(ctx);
 
     std::vector<std::string> channels{"R", "G", "B", "A"};

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/sample/Trilinear.h"
+#include "core/sample/Tricubic.h"
 
 namespace volref {
 
@@ -43,6 +44,20 @@ double VolumeSampler::trilinear(const glm::dvec3& world) const {
     glm::dvec3 frac;
     locate(continuous_index(world), cell, frac);
     return volref::trilinear(corners(cell), frac.x, frac.y, frac.z);
+}
+
+namespace {
+CubicKernel kernel_of(Interpolation i) {
+    return i == Interpolation::TricubicBSpline ? CubicKernel::BSpline : CubicKernel::CatmullRom;
+}
+}  // namespace
+
+double VolumeSampler::tricubic(const glm::dvec3& world) const {
+    return volref::tricubic(volume_, kernel_of(interpolation_), continuous_index(world));
+}
+
+glm::dvec3 VolumeSampler::tricubic_gradient(const glm::dvec3& world) const {
+    return tricubic_index_gradient(volume_, kernel_of(interpolation_), continuous_index(world)) * inv_spacing_;
 }
 
 double VolumeSampler::nearest(const glm::dvec3& world) const {

@@ -5,7 +5,9 @@
 // inside it). Then
 //   nearest:   the voxel floor(u + 0.5) (round half up), clamped to [0, n - 1];
 //   trilinear: the cell i = min(floor(u), n - 2) (0 when n = 1) with fraction p = u - i, evaluated by
-//              trilinear() in Levoy's corner order; an axis with n = 1 uses the same voxel twice.
+//              trilinear() in Levoy's corner order; an axis with n = 1 uses the same voxel twice;
+//   tricubic:  the same cell and fraction, the B-spline or Catmull-Rom tensor-product cubic over the
+//              4 x 4 x 4 taps i-1 .. i+2 with indices clamped to [0, n - 1] (Tricubic.h).
 #pragma once
 #include <array>
 
@@ -21,10 +23,21 @@ public:
     VolumeSampler(const Volume& volume, Interpolation interpolation);
 
     double value(const glm::dvec3& world) const {
-        return interpolation_ == Interpolation::Nearest ? nearest(world) : trilinear(world);
+        switch (interpolation_) {
+            case Interpolation::Nearest: return nearest(world);
+            case Interpolation::Trilinear: return trilinear(world);
+            default: return tricubic(world);
+        }
     }
     double nearest(const glm::dvec3& world) const;
     double trilinear(const glm::dvec3& world) const;
+    double tricubic(const glm::dvec3& world) const;
+    // The analytic gradient of the tricubic reconstruction, in world units (tricubic kernels only).
+    glm::dvec3 tricubic_gradient(const glm::dvec3& world) const;
+    Interpolation interpolation() const { return interpolation_; }
+    bool is_tricubic() const {
+        return interpolation_ == Interpolation::TricubicBSpline || interpolation_ == Interpolation::TricubicCatmullRom;
+    }
 
     // The continuous index u of a world point, clamped to the domain.
     glm::dvec3 continuous_index(const glm::dvec3& world) const;

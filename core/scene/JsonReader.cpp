@@ -317,6 +317,11 @@ std::string read_string(const Json& v, const std::string& path, const Context& c
     return v.get<std::string>();
 }
 
+bool read_boolean(const Json& v, const std::string& path, const Context& ctx) {
+    if (!v.is_boolean()) ctx.fail(path, "expected true or false, got " + describe(v));
+    return v.get<bool>();
+}
+
 std::vector<double> read_numbers(const Json& v, const std::string& path, const Context& ctx,
                                  std::size_t count, const Range& range) {
     if (!v.is_array() || v.size() != count) {
@@ -419,6 +424,11 @@ std::optional<std::string> ObjectReader::optional_string(std::string_view key) {
     const Json* v = find(key);
     if (!v) return std::nullopt;
     return read_string(*v, path(key), ctx_);
+}
+
+bool ObjectReader::boolean(std::string_view key, bool fallback) {
+    const Json* v = find(key);
+    return v ? read_boolean(*v, path(key), ctx_) : fallback;
 }
 
 glm::dvec3 ObjectReader::vec3(std::string_view key, const glm::dvec3& fallback, const Range& range) {

@@ -98,6 +98,8 @@ double read_number(const Json& v, const std::string& path, const Context& ctx, c
 std::int64_t read_integer(const Json& v, const std::string& path, const Context& ctx,
                           const Range& range = {});
 std::string read_string(const Json& v, const std::string& path, const Context& ctx);
+// true or false (not 0/1, not "true").
+bool read_boolean(const Json& v, const std::string& path, const Context& ctx);
 // An array of exactly `count` numbers, each in `range`.
 std::vector<double> read_numbers(const Json& v, const std::string& path, const Context& ctx,
                                  std::size_t count, const Range& range = {});
@@ -149,6 +151,7 @@ public:
     std::int64_t integer(std::string_view key, std::int64_t fallback, const Range& range = {});
     std::string string(std::string_view key, std::string_view fallback);
     std::optional<std::string> optional_string(std::string_view key);
+    bool boolean(std::string_view key, bool fallback);
     glm::dvec3 vec3(std::string_view key, const glm::dvec3& fallback, const Range& range = {});
     std::optional<glm::dvec3> optional_vec3(std::string_view key, const Range& range = {});
 

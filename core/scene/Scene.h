@@ -44,9 +44,49 @@ struct TransferSpec {
     std::vector<std::array<double, 4>> color;    // [value, r, g, b]
     std::vector<std::array<double, 2>> opacity;  // [value, a]
     double opacity_unit_distance = 1.0;          // l, world units, > 0
+    // Gradient-magnitude opacity modulation: rows [|grad f|, factor >= 0] sorted by |grad f|; the
+    // opacity is multiplied by the piecewise-linear factor. Empty = none (no gradient is computed).
+    std::vector<std::array<double, 2>> gradient_opacity;
 };
 
-enum class Interpolation { Nearest, Trilinear };
+// Levoy's classification (conventions section 7), instead of a transfer function.
+struct IsovalueContour {
+    double value = 0.0;
+    double opacity = 1.0;    // av in [0, 1]
+    double thickness = 1.0;  // r, world units, > 0
+    glm::dvec3 color{1.0};
+};
+struct BoundaryRegion {
+    double value = 0.0;
+    double opacity = 1.0;  // av in [0, 1]
+    glm::dvec3 color{1.0};
+};
+struct ClassificationSpec {
+    enum class Type { Isovalue, Boundary };
+    Type type = Type::Isovalue;
+    std::vector<IsovalueContour> isovalues;  // Isovalue: at least one
+    std::vector<BoundaryRegion> regions;     // Boundary: at least two, strictly increasing values
+    double opacity_unit_distance = 1.0;
+};
+
+// Gradient shading (conventions section 8). Absent in the scene = unshaded.
+struct ShadingSpec {
+    enum class Model { BlinnPhong, Phong, Nodal };
+    Model model = Model::BlinnPhong;
+    double ka = 0.1, kd = 0.7, ks = 0.2, n = 10.0;  // ks is 0 for nodal
+    double kc = 1.0, kl = 0.0;                      // depth cueing 1 / (kc + kl d)
+    bool two_sided = false;
+};
+
+// How gradients are computed when shading or classification needs them.
+struct GradientSpec {
+    // Default: analytic for the tricubic kernels, central otherwise.
+    enum class Scheme { Default, Central, Forward, Analytic };
+    Scheme scheme = Scheme::Default;
+    bool cache = false;  // precompute a per-voxel gradient volume and interpolate it
+};
+
+enum class Interpolation { Nearest, Trilinear, TricubicBSpline, TricubicCatmullRom };
 
 struct BoundsSpec {
     enum class Type { Box };
@@ -60,7 +100,12 @@ struct VolumeSpec {
     std::optional<glm::dvec3> spacing;  // overrides the file's (procedural fields: default 1)
     Interpolation interpolation = Interpolation::Trilinear;
     BoundsSpec bounds;
-    TransferSpec transfer;
+    TransferSpec transfer;                              // used when classification is absent
+    std::optional<ClassificationSpec> classification;  // Levoy's isovalue / boundary classification
+    enum class Classify { Post, Pre };
+    Classify classify = Classify::Post;  // post: interpolate, then classify; pre: classify voxels, then interpolate
+    std::optional<ShadingSpec> shading;  // absent: unshaded
+    GradientSpec gradient;
 };
 
 struct LightSpec {

@@ -1,8 +1,8 @@
 // Scene loading: JSON text -> --set overrides -> strict validation -> Scene (docs/scene-format.md).
 //
 // Every problem is a volref::Error "<file>: <json path>: <problem>". Keys of the format that later work
-// implements (shading, classification, transforms, ...) are recognised and rejected as "not
-// implemented yet" rather than reported as unknown or silently ignored.
+// implements (transforms, clip planes, cropping, meshes and shells, ...) are recognised and rejected as
+// "not implemented yet" rather than reported as unknown or silently ignored.
 #include "core/scene/SceneLoader.h"
 
 #include <algorithm>
@@ -49,7 +49,6 @@ constexpr std::int64_t kMaxImageSide = 32768;                    // image width 
 constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 28;  // width * height <= 2^28
 
 // Values of keys that are validated but not stored in Scene (only one value is implemented).
-enum class Classify { Post };
 enum class Integrator { Midpoint };
 
 // ------------------------------------------------------------------------------------------------
@@ -158,10 +157,12 @@ glm::dvec3 read_direction(ObjectReader& r, std::string_view key) {
     return glm::normalize(d / m);
 }
 
-// Rows [value, x1, ..., x(N-1)] sorted by value (non-decreasing), at least one; x in `range`.
+// Rows [key, x1, ..., x(N-1)] sorted by key (non-decreasing), at least one; x in `range`, the key in
+// `key_range`. `key_name` names the key in messages ("value", "|grad f|").
 template <std::size_t N>
 std::vector<std::array<double, N>> read_rows(const Json& v, const std::string& path, const Context& ctx,
-                                             std::string_view shape, const Range& range) {
+                                             std::string_view shape, const Range& range,
+                                             const Range& key_range = {}, std::string_view key_name = "value") {
     const std::size_t n = read_array_size(v, path, ctx);
     if (n == 0) ctx.fail(path, "expected at least one row " + std::string(shape));
     std::vector<std::array<double, N>> rows;
@@ -173,10 +174,11 @@ std::vector<std::array<double, N>> read_rows(const Json& v, const std::string& p
             ctx.fail(row_path, "expected a row " + std::string(shape) + " of " + std::to_string(N) +
                                    " numbers, got " + describe(row));
         std::array<double, N> out{};
-        out[0] = read_number(row[0], index_path(row_path, 0), ctx);
+        out[0] = read_number(row[0], index_path(row_path, 0), ctx, key_range);
         for (std::size_t k = 1; k < N; ++k) out[k] = read_number(row[k], index_path(row_path, k), ctx, range);
         if (i > 0 && out[0] < rows.back()[0])
-            ctx.fail(row_path, "rows must be sorted by value (non-decreasing): " + format_number(out[0]) +
+            ctx.fail(row_path, "rows must be sorted by " + std::string(key_name) + " (non-decreasing): " +
+                                   format_number(out[0]) +
                                    " follows " + format_number(rows.back()[0]));
         rows.push_back(out);
     }
@@ -310,7 +312,6 @@ TransferSpec read_transfer(const Json& v, const std::string& path, const Context
     using D = TransferSpec::Domain;
     ObjectReader r(v, path, ctx);
     r.allow({"domain", "window", "color", "opacity", "gradient_opacity", "opacity_unit_distance"});
-    r.reject("gradient_opacity", "gradient opacity is not implemented yet");
     TransferSpec t;
     t.domain = r.choice<D>("domain", D::Data, {{"data", D::Data}, {"normalized", D::Normalized}});
     if (const Json* w = r.find("window")) {
@@ -323,16 +324,119 @@ TransferSpec read_transfer(const Json& v, const std::string& path, const Context
     if (const Json* c = r.find("color")) t.color = read_rows<4>(*c, r.path("color"), ctx, "[value, r, g, b]", Range::non_negative());
     if (const Json* o = r.find("opacity")) t.opacity = read_rows<2>(*o, r.path("opacity"), ctx, "[value, a]", Range::closed(0, 1));
     t.opacity_unit_distance = r.number("opacity_unit_distance", 1.0, Range::positive());
+    if (const Json* g = r.find("gradient_opacity"))
+        t.gradient_opacity = read_rows<2>(*g, r.path("gradient_opacity"), ctx, "[|grad f|, factor]",
+                                          Range::non_negative(), Range::non_negative(), "|grad f|");
     return t;
+}
+
+// One element of classification.isovalues: {"value" (required), "opacity", "thickness", "color"}.
+IsovalueContour read_isovalue(const Json& v, const std::string& path, const Context& ctx) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"value", "opacity", "thickness", "color"}, "for an isovalue contour");
+    IsovalueContour c;
+    c.value = read_number(r.required("value"), r.path("value"), ctx);
+    c.opacity = r.number("opacity", 1.0, Range::closed(0, 1));
+    c.thickness = r.number("thickness", 1.0, Range::positive());
+    c.color = r.vec3("color", glm::dvec3(1.0), Range::non_negative());
+    return c;
+}
+
+// One element of classification.regions: {"value" (required), "opacity", "color"}.
+BoundaryRegion read_region(const Json& v, const std::string& path, const Context& ctx) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"value", "opacity", "color"}, "for a boundary region");
+    BoundaryRegion b;
+    b.value = read_number(r.required("value"), r.path("value"), ctx);
+    b.opacity = r.number("opacity", 1.0, Range::closed(0, 1));
+    b.color = r.vec3("color", glm::dvec3(1.0), Range::non_negative());
+    return b;
+}
+
+// Levoy's classification (conventions section 7): {"type": "isovalue", "isovalues": [...]} or
+// {"type": "boundary", "regions": [...]}, each with "opacity_unit_distance".
+ClassificationSpec read_classification(const Json& v, const std::string& path, const Context& ctx) {
+    using T = ClassificationSpec::Type;
+    ObjectReader r(v, path, ctx);
+    // Without "type", a misspelt key is reported before "type: required".
+    if (!r.has("type")) r.allow({"type", "isovalues", "regions", "opacity_unit_distance"});
+    ClassificationSpec c;
+    c.type = r.required_choice<T>("type", {{"isovalue", T::Isovalue}, {"boundary", T::Boundary}});
+    if (c.type == T::Isovalue) {
+        r.allow({"type", "isovalues", "opacity_unit_distance"}, "for classification type \"isovalue\"");
+        const Json& list = r.required("isovalues");
+        const std::string list_path = r.path("isovalues");
+        const std::size_t n = read_array_size(list, list_path, ctx);
+        if (n == 0) r.fail("isovalues", "expected at least one isovalue contour, got []");
+        for (std::size_t i = 0; i < n; ++i)
+            c.isovalues.push_back(read_isovalue(element(list, i), index_path(list_path, i), ctx));
+    } else {
+        r.allow({"type", "regions", "opacity_unit_distance"}, "for classification type \"boundary\"");
+        const Json& list = r.required("regions");
+        const std::string list_path = r.path("regions");
+        const std::size_t n = read_array_size(list, list_path, ctx);
+        if (n < 2) r.fail("regions", "expected at least two regions, got " + std::to_string(n));
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::string region_path = index_path(list_path, i);
+            c.regions.push_back(read_region(element(list, i), region_path, ctx));
+            if (i > 0 && !(c.regions[i].value > c.regions[i - 1].value))
+                ctx.fail(child_path(region_path, "value"),
+                         "region values must be strictly increasing: " + format_number(c.regions[i].value) +
+                             " follows " + format_number(c.regions[i - 1].value));
+        }
+    }
+    c.opacity_unit_distance = r.number("opacity_unit_distance", 1.0, Range::positive());
+    return c;
+}
+
+// Gradient shading (conventions section 8). Nodal shading has no specular term: "ks" and "n" are
+// errors with it, and ks is stored as 0.
+ShadingSpec read_shading(const Json& v, const std::string& path, const Context& ctx) {
+    using M = ShadingSpec::Model;
+    ObjectReader r(v, path, ctx);
+    r.allow({"model", "ka", "kd", "ks", "n", "kc", "kl", "two_sided"});
+    ShadingSpec s;
+    s.model = r.choice<M>("model", M::BlinnPhong,
+                          {{"blinn-phong", M::BlinnPhong}, {"phong", M::Phong}, {"nodal", M::Nodal}});
+    if (s.model == M::Nodal) {
+        r.reject("ks", "the nodal model has no specular term");
+        r.reject("n", "the nodal model has no specular term (n is its exponent)");
+    }
+    s.ka = r.number("ka", 0.1, Range::non_negative());
+    s.kd = r.number("kd", 0.7, Range::non_negative());
+    s.ks = s.model == M::Nodal ? 0.0 : r.number("ks", 0.2, Range::non_negative());
+    s.n = r.number("n", 10.0, Range::positive());
+    s.kc = r.number("kc", 1.0, Range::non_negative());
+    s.kl = r.number("kl", 0.0, Range::non_negative());
+    if (s.kc == 0.0 && s.kl == 0.0)
+        r.fail("kc", "kc and kl are both 0, so the depth cueing 1 / (kc + kl d) divides by 0 (give kc > 0 or kl > 0)");
+    s.two_sided = r.boolean("two_sided", false);
+    return s;
+}
+
+// {"scheme": "central" | "forward" | "analytic", "cache": bool} (an extension of the format).
+GradientSpec read_gradient(const Json& v, const std::string& path, const Context& ctx, Interpolation interpolation) {
+    using S = GradientSpec::Scheme;
+    ObjectReader r(v, path, ctx);
+    r.allow({"scheme", "cache"});
+    GradientSpec g;
+    g.scheme = r.choice<S>("scheme", S::Default,
+                           {{"central", S::Central}, {"forward", S::Forward}, {"analytic", S::Analytic}});
+    const bool tricubic =
+        interpolation == Interpolation::TricubicBSpline || interpolation == Interpolation::TricubicCatmullRom;
+    if (g.scheme == S::Analytic && !tricubic)
+        r.fail("scheme", "analytic gradients need a tricubic interpolation (\"tricubic-bspline\" or "
+                         "\"tricubic-catmull-rom\"); use \"central\" or \"forward\" with \"" +
+                             std::string(interpolation == Interpolation::Nearest ? "nearest" : "trilinear") + "\"");
+    g.cache = r.boolean("cache", false);
+    return g;
 }
 
 VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     ObjectReader r(v, path, ctx);
     r.allow({"source", "origin", "spacing", "interpolation", "bounds", "classify", "transfer", "classification",
-             "shading", "transform", "clip_planes", "crop"});
+             "shading", "gradient", "transform", "clip_planes", "crop"});
     // Recognised keys that later work implements.
-    r.reject("shading", "shading is not implemented yet");
-    r.reject("classification", "classification (isovalue contours, region boundaries) is not implemented yet");
     r.reject("transform", "volume transforms are not implemented yet");
     r.reject("clip_planes", "clip planes are not implemented yet");
     r.reject("crop", "cropping is not implemented yet");
@@ -342,11 +446,22 @@ VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ct
     spec.origin = r.optional_vec3("origin");
     spec.spacing = r.optional_vec3("spacing", Range::positive());
     spec.interpolation = r.choice<Interpolation>("interpolation", Interpolation::Trilinear,
-                                                 {{"nearest", Interpolation::Nearest}, {"trilinear", Interpolation::Trilinear}},
-                                                 {"tricubic-bspline", "tricubic-catmull-rom"});
-    r.choice<Classify>("classify", Classify::Post, {{"post", Classify::Post}}, {"pre"});
+                                                 {{"nearest", Interpolation::Nearest},
+                                                  {"trilinear", Interpolation::Trilinear},
+                                                  {"tricubic-bspline", Interpolation::TricubicBSpline},
+                                                  {"tricubic-catmull-rom", Interpolation::TricubicCatmullRom}});
+    using C = VolumeSpec::Classify;
+    spec.classify = r.choice<C>("classify", C::Post, {{"post", C::Post}, {"pre", C::Pre}});
     if (const Json* b = r.find("bounds")) spec.bounds = read_bounds(*b, r.path("bounds"), ctx);
-    if (const Json* t = r.find("transfer")) spec.transfer = read_transfer(*t, r.path("transfer"), ctx);
+    const Json* transfer = r.find("transfer");
+    const Json* classification = r.find("classification");
+    if (transfer && classification)
+        r.fail("classification", "give either \"transfer\" or \"classification\", not both");
+    if (transfer) spec.transfer = read_transfer(*transfer, r.path("transfer"), ctx);
+    if (classification) spec.classification = read_classification(*classification, r.path("classification"), ctx);
+    if (const Json* s = r.find("shading")) spec.shading = read_shading(*s, r.path("shading"), ctx);
+    if (const Json* g = r.find("gradient"))
+        spec.gradient = read_gradient(*g, r.path("gradient"), ctx, spec.interpolation);
     return spec;
 }
 

@@ -125,6 +125,12 @@ TEST(SceneLoaderDefaults, MinimalSceneFillsEveryDefault) {
     EXPECT_TRUE(s.volume.transfer.color.empty());
     EXPECT_TRUE(s.volume.transfer.opacity.empty());
     EXPECT_EQ(s.volume.transfer.opacity_unit_distance, 1.0);
+    EXPECT_TRUE(s.volume.transfer.gradient_opacity.empty());
+    EXPECT_FALSE(s.volume.classification.has_value());
+    EXPECT_EQ(s.volume.classify, VolumeSpec::Classify::Post);
+    EXPECT_FALSE(s.volume.shading.has_value());  // unshaded
+    EXPECT_EQ(s.volume.gradient.scheme, GradientSpec::Scheme::Default);
+    EXPECT_FALSE(s.volume.gradient.cache);
 
     // lights: one white headlight
     ASSERT_EQ(s.lights.size(), 1u);
@@ -364,6 +370,12 @@ TEST(SceneLoaderFull, EnumValues) {
         EXPECT_EQ(parse(scene_with(std::string(R"("render": {"projection": ")") + name + "\"}")).render.projection, value)
             << name;
     EXPECT_EQ(parse(volume_with(R"("interpolation": "trilinear")")).volume.interpolation, Interpolation::Trilinear);
+    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-bspline")")).volume.interpolation,
+              Interpolation::TricubicBSpline);
+    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-catmull-rom")")).volume.interpolation,
+              Interpolation::TricubicCatmullRom);
+    EXPECT_EQ(parse(volume_with(R"("classify": "post")")).volume.classify, VolumeSpec::Classify::Post);
+    EXPECT_EQ(parse(volume_with(R"("classify": "pre")")).volume.classify, VolumeSpec::Classify::Pre);
     EXPECT_EQ(parse(scene_with(R"("render": {"step_units": "voxel"})")).render.step_units, StepUnits::Voxel);
     EXPECT_EQ(parse(scene_with(R"("render": {"order": "front-to-back"})")).render.order, CompositeOrder::FrontToBack);
     EXPECT_EQ(parse(transfer_with(R"("domain": "data")")).volume.transfer.domain, TransferSpec::Domain::Data);
@@ -392,6 +404,299 @@ TEST(SceneLoaderFull, RangeEndsThatAreIncluded) {
 TEST(SceneLoaderFull, DescriptionIsIgnored) {
     EXPECT_NO_THROW(parse(scene_with(R"("description": "a note for humans")")));
     EXPECT_TRUE(fails_with(scene_with(R"("description": 3)"), "description", "expected a string, got 3"));
+}
+
+// ------------------------------------------------------------------------------------------------
+// Gradient opacity, classification, shading, gradients
+// ------------------------------------------------------------------------------------------------
+
+std::string classification_with(const std::string& keys) { return volume_with(R"("classification": {)" + keys + "}"); }
+std::string shading_with(const std::string& keys) { return volume_with(R"("shading": {)" + keys + "}"); }
+
+void expect_shading(const ShadingSpec& s, ShadingSpec::Model model, double ka, double kd, double ks, double n,
+                    double kc, double kl, bool two_sided) {
+    EXPECT_EQ(s.model, model);
+    EXPECT_EQ(s.ka, ka);
+    EXPECT_EQ(s.kd, kd);
+    EXPECT_EQ(s.ks, ks);
+    EXPECT_EQ(s.n, n);
+    EXPECT_EQ(s.kc, kc);
+    EXPECT_EQ(s.kl, kl);
+    EXPECT_EQ(s.two_sided, two_sided);
+}
+
+TEST(SceneLoaderGradientOpacity, RowsAreRead) {
+    // A factor may exceed 1; equal |grad f| make a step.
+    const Scene s = parse(transfer_with(R"("gradient_opacity": [[0, 0], [10, 0.5], [10, 2], [100, 3]])"));
+    const auto& g = s.volume.transfer.gradient_opacity;
+    ASSERT_EQ(g.size(), 4u);
+    EXPECT_EQ(g[0], (std::array<double, 2>{0, 0}));
+    EXPECT_EQ(g[1], (std::array<double, 2>{10, 0.5}));
+    EXPECT_EQ(g[2], (std::array<double, 2>{10, 2}));
+    EXPECT_EQ(g[3], (std::array<double, 2>{100, 3}));
+    EXPECT_EQ(parse(transfer_with(R"("gradient_opacity": [[5, 1]])")).volume.transfer.gradient_opacity.size(), 1u);
+    // Absent: none.
+    EXPECT_TRUE(parse(transfer_with(R"("opacity": [[0, 1]])")).volume.transfer.gradient_opacity.empty());
+}
+
+TEST(SceneLoaderGradientOpacity, Errors) {
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [])"), "volume.transfer.gradient_opacity",
+                           "expected at least one row [|grad f|, factor]"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, 1], [-1, 1]])"),
+                           "volume.transfer.gradient_opacity[1][0]", "expected a number >= 0, got -1"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, -0.5]])"), "volume.transfer.gradient_opacity[0][1]",
+                           "expected a number >= 0, got -0.5"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, 1], [20, 1], [10, 1]])"),
+                           "volume.transfer.gradient_opacity[2]", "sorted by |grad f| (non-decreasing): 10 follows 20"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, 1, 1]])"), "volume.transfer.gradient_opacity[0]",
+                           "expected a row [|grad f|, factor] of 2 numbers"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": {})"), "volume.transfer.gradient_opacity",
+                           "expected an array"));
+    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, "1"]])"), "volume.transfer.gradient_opacity[0][1]",
+                           "expected a number >= 0"));
+}
+
+TEST(SceneLoaderClassification, IsovalueDefaults) {
+    const Scene s = parse(classification_with(R"("type": "isovalue", "isovalues": [{"value": 5}])"));
+    ASSERT_TRUE(s.volume.classification.has_value());
+    const ClassificationSpec& c = *s.volume.classification;
+    EXPECT_EQ(c.type, ClassificationSpec::Type::Isovalue);
+    ASSERT_EQ(c.isovalues.size(), 1u);
+    EXPECT_EQ(c.isovalues[0].value, 5.0);
+    EXPECT_EQ(c.isovalues[0].opacity, 1.0);
+    EXPECT_EQ(c.isovalues[0].thickness, 1.0);
+    expect_vec(c.isovalues[0].color, 1, 1, 1);
+    EXPECT_TRUE(c.regions.empty());
+    EXPECT_EQ(c.opacity_unit_distance, 1.0);
+    // The transfer function keeps its defaults (it is not used).
+    EXPECT_TRUE(s.volume.transfer.color.empty());
+    EXPECT_TRUE(s.volume.transfer.opacity.empty());
+}
+
+TEST(SceneLoaderClassification, IsovalueFull) {
+    const Scene s = parse(volume_with(R"("interpolation": "tricubic-bspline", "classify": "pre",
+        "classification": {"type": "isovalue", "opacity_unit_distance": 2.5, "isovalues": [
+            {"value": 0.5, "opacity": 0.8, "thickness": 0.25, "color": [1, 0.5, 0]},
+            {"value": -3, "opacity": 0, "thickness": 4, "color": [0, 0, 2]}]})"));
+    EXPECT_EQ(s.volume.interpolation, Interpolation::TricubicBSpline);
+    EXPECT_EQ(s.volume.classify, VolumeSpec::Classify::Pre);
+    const ClassificationSpec& c = *s.volume.classification;
+    EXPECT_EQ(c.type, ClassificationSpec::Type::Isovalue);
+    EXPECT_EQ(c.opacity_unit_distance, 2.5);
+    ASSERT_EQ(c.isovalues.size(), 2u);  // in the given order (they need not be sorted)
+    EXPECT_EQ(c.isovalues[0].value, 0.5);
+    EXPECT_EQ(c.isovalues[0].opacity, 0.8);
+    EXPECT_EQ(c.isovalues[0].thickness, 0.25);
+    expect_vec(c.isovalues[0].color, 1, 0.5, 0);
+    EXPECT_EQ(c.isovalues[1].value, -3.0);
+    EXPECT_EQ(c.isovalues[1].opacity, 0.0);
+    EXPECT_EQ(c.isovalues[1].thickness, 4.0);
+    expect_vec(c.isovalues[1].color, 0, 0, 2);
+}
+
+TEST(SceneLoaderClassification, BoundaryDefaults) {
+    const Scene s = parse(classification_with(R"("type": "boundary", "regions": [{"value": 0}, {"value": 1}])"));
+    const ClassificationSpec& c = *s.volume.classification;
+    EXPECT_EQ(c.type, ClassificationSpec::Type::Boundary);
+    ASSERT_EQ(c.regions.size(), 2u);
+    EXPECT_EQ(c.regions[0].value, 0.0);
+    EXPECT_EQ(c.regions[1].value, 1.0);
+    for (const BoundaryRegion& r : c.regions) {
+        EXPECT_EQ(r.opacity, 1.0);
+        expect_vec(r.color, 1, 1, 1);
+    }
+    EXPECT_TRUE(c.isovalues.empty());
+    EXPECT_EQ(c.opacity_unit_distance, 1.0);
+}
+
+TEST(SceneLoaderClassification, BoundaryFull) {
+    const Scene s = parse(classification_with(R"("type": "boundary", "opacity_unit_distance": 0.5, "regions": [
+        {"value": -10, "opacity": 0, "color": [0, 0, 0]},
+        {"value": 20, "opacity": 0.2, "color": [0.9, 0.8, 0.7]},
+        {"value": 80, "opacity": 1, "color": [1, 1, 3]}])"));
+    const ClassificationSpec& c = *s.volume.classification;
+    EXPECT_EQ(c.type, ClassificationSpec::Type::Boundary);
+    EXPECT_EQ(c.opacity_unit_distance, 0.5);
+    ASSERT_EQ(c.regions.size(), 3u);
+    EXPECT_EQ(c.regions[0].value, -10.0);
+    EXPECT_EQ(c.regions[0].opacity, 0.0);
+    expect_vec(c.regions[0].color, 0, 0, 0);
+    EXPECT_EQ(c.regions[1].value, 20.0);
+    EXPECT_EQ(c.regions[1].opacity, 0.2);
+    expect_vec(c.regions[1].color, 0.9, 0.8, 0.7);
+    EXPECT_EQ(c.regions[2].value, 80.0);
+    EXPECT_EQ(c.regions[2].opacity, 1.0);
+    expect_vec(c.regions[2].color, 1, 1, 3);
+}
+
+TEST(SceneLoaderClassification, Errors) {
+    EXPECT_EQ(message_of(volume_with(R"("transfer": {}, "classification": {"type": "isovalue", "isovalues": [{"value": 1}]})")),
+              "scene.json: volume.classification: give either \"transfer\" or \"classification\", not both");
+    EXPECT_TRUE(fails_with(volume_with(R"("classification": [])"), "volume.classification", "expected an object"));
+    EXPECT_TRUE(fails_with(classification_with(R"("isovalues": [{"value": 1}])"), "volume.classification.type",
+                           "required"));
+    // Without "type", a misspelt key is reported as unknown rather than "type: required".
+    EXPECT_TRUE(fails_with(classification_with(R"("typ": "isovalue")"), "volume.classification.typ", "unknown key"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "levoy")"), "volume.classification.type",
+                           "expected one of \"isovalue\", \"boundary\", got \"levoy\""));
+    // Each type takes only its own keys.
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}], "regions": [])"),
+                           "volume.classification.regions", "unknown key for classification type \"isovalue\""));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "isovalues": [], "regions": [{"value": 1}, {"value": 2}])"),
+                           "volume.classification.isovalues", "unknown key for classification type \"boundary\""));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}], "window": [0, 1])"),
+                           "volume.classification.window", "unknown key"));
+
+    // isovalue
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue")"), "volume.classification.isovalues", "required"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [])"),
+                           "volume.classification.isovalues", "expected at least one isovalue contour"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": 5)"),
+                           "volume.classification.isovalues", "expected an array, got 5"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [5])"),
+                           "volume.classification.isovalues[0]", "expected an object, got 5"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}, {"opacity": 1}])"),
+                           "volume.classification.isovalues[1].value", "required"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": "1"}])"),
+                           "volume.classification.isovalues[0].value", "expected a number, got \"1\""));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1, "opacity": 1.5}])"),
+                           "volume.classification.isovalues[0].opacity", "expected a number in [0, 1], got 1.5"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1, "thickness": 0}])"),
+                           "volume.classification.isovalues[0].thickness", "expected a number > 0, got 0"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1, "color": [1, -1, 1]}])"),
+                           "volume.classification.isovalues[0].color[1]", "expected a number >= 0, got -1"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1, "color": [1, 1]}])"),
+                           "volume.classification.isovalues[0].color", "expected an array of 3 numbers >= 0"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1, "width": 2}])"),
+                           "volume.classification.isovalues[0].width", "unknown key for an isovalue contour"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}],
+                                                  "opacity_unit_distance": 0)"),
+                           "volume.classification.opacity_unit_distance", "expected a number > 0, got 0"));
+
+    // boundary
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary")"), "volume.classification.regions", "required"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1}])"),
+                           "volume.classification.regions", "expected at least two regions, got 1"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [])"),
+                           "volume.classification.regions", "expected at least two regions, got 0"));
+    EXPECT_EQ(message_of(classification_with(R"("type": "boundary", "regions": [{"value": 1}, {"value": 1}])")),
+              "scene.json: volume.classification.regions[1].value: region values must be strictly increasing: 1 "
+              "follows 1");
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1}, {"value": 5}, {"value": 3}])"),
+                           "volume.classification.regions[2].value", "strictly increasing: 3 follows 5"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1}, {"opacity": 1}])"),
+                           "volume.classification.regions[1].value", "required"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1, "opacity": -0.1}, {"value": 2}])"),
+                           "volume.classification.regions[0].opacity", "in [0, 1]"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1}, {"value": 2, "color": [0, 0, -1]}])"),
+                           "volume.classification.regions[1].color[2]", ">= 0"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1, "thickness": 1}, {"value": 2}])"),
+                           "volume.classification.regions[0].thickness", "unknown key for a boundary region"));
+    EXPECT_TRUE(fails_with(classification_with(R"("type": "boundary", "regions": [{"value": 1}, {"value": 2}],
+                                                  "opacity_unit_distance": -1)"),
+                           "volume.classification.opacity_unit_distance", "> 0"));
+}
+
+TEST(SceneLoaderShading, Defaults) {
+    const Scene s = parse(shading_with(""));
+    ASSERT_TRUE(s.volume.shading.has_value());
+    expect_shading(*s.volume.shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0.2, 10, 1, 0, false);
+    const Scene p = parse(shading_with(R"("model": "phong")"));
+    expect_shading(*p.volume.shading, ShadingSpec::Model::Phong, 0.1, 0.7, 0.2, 10, 1, 0, false);
+    // Nodal: no specular term, ks is stored as 0.
+    const Scene n = parse(shading_with(R"("model": "nodal")"));
+    expect_shading(*n.volume.shading, ShadingSpec::Model::Nodal, 0.1, 0.7, 0, 10, 1, 0, false);
+}
+
+TEST(SceneLoaderShading, Full) {
+    const Scene s = parse(scene_with(R"("lights": [{"type": "directional", "direction": [0, 0, 2]}])",
+                                     R"("shading": {"model": "phong", "ka": 0, "kd": 1.5, "ks": 0.75, "n": 64,
+                                                    "kc": 0.5, "kl": 0.01, "two_sided": true})"));
+    expect_shading(*s.volume.shading, ShadingSpec::Model::Phong, 0, 1.5, 0.75, 64, 0.5, 0.01, true);
+    ASSERT_EQ(s.lights.size(), 1u);
+    expect_vec(s.lights[0].direction, 0, 0, 1);
+    const Scene b = parse(shading_with(R"("model": "blinn-phong", "ks": 0, "n": 0.5, "two_sided": false)"));
+    expect_shading(*b.volume.shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0, 0.5, 1, 0, false);
+    const Scene n = parse(shading_with(R"("model": "nodal", "ka": 0.2, "kd": 0.6, "kc": 0, "kl": 2, "two_sided": true)"));
+    expect_shading(*n.volume.shading, ShadingSpec::Model::Nodal, 0.2, 0.6, 0, 10, 0, 2, true);
+}
+
+TEST(SceneLoaderShading, Errors) {
+    EXPECT_TRUE(fails_with(volume_with(R"("shading": true)"), "volume.shading", "expected an object, got true"));
+    EXPECT_TRUE(fails_with(shading_with(R"("model": "gouraud")"), "volume.shading.model",
+                           "expected one of \"blinn-phong\", \"phong\", \"nodal\", got \"gouraud\""));
+    EXPECT_TRUE(fails_with(shading_with(R"("shininess": 10)"), "volume.shading.shininess",
+                           "unknown key (expected one of: model, ka, kd, ks, n, kc, kl, two_sided)"));
+    EXPECT_TRUE(fails_with(shading_with(R"("ka": -0.1)"), "volume.shading.ka", "expected a number >= 0, got -0.1"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kd": -1)"), "volume.shading.kd", ">= 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("ks": -1)"), "volume.shading.ks", ">= 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("n": 0)"), "volume.shading.n", "expected a number > 0, got 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kc": -1)"), "volume.shading.kc", ">= 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kl": -1)"), "volume.shading.kl", ">= 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kd": "0.7")"), "volume.shading.kd", "expected a number >= 0, got \"0.7\""));
+    // Depth cueing 1 / (kc + kl d) needs kc > 0 or kl > 0.
+    EXPECT_TRUE(fails_with(shading_with(R"("kc": 0)"), "volume.shading.kc", "kc and kl are both 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kc": 0, "kl": 0)"), "volume.shading.kc", "give kc > 0 or kl > 0"));
+    EXPECT_TRUE(fails_with(shading_with(R"("kl": 0, "kc": 0, "model": "nodal")"), "volume.shading.kc", "both 0"));
+    // two_sided is a JSON boolean.
+    EXPECT_TRUE(fails_with(shading_with(R"("two_sided": 1)"), "volume.shading.two_sided",
+                           "expected true or false, got 1"));
+    EXPECT_TRUE(fails_with(shading_with(R"("two_sided": "true")"), "volume.shading.two_sided",
+                           "expected true or false, got \"true\""));
+    // Nodal shading has no specular term.
+    EXPECT_EQ(message_of(shading_with(R"("model": "nodal", "ks": 0.2)")),
+              "scene.json: volume.shading.ks: the nodal model has no specular term");
+    EXPECT_TRUE(fails_with(shading_with(R"("model": "nodal", "ks": 0)"), "volume.shading.ks",
+                           "the nodal model has no specular term"));
+    EXPECT_TRUE(fails_with(shading_with(R"("model": "nodal", "n": 10)"), "volume.shading.n",
+                           "the nodal model has no specular term"));
+}
+
+TEST(SceneLoaderGradient, DefaultsAndSchemes) {
+    const Scene d = parse(volume_with(R"("gradient": {})"));
+    EXPECT_EQ(d.volume.gradient.scheme, GradientSpec::Scheme::Default);
+    EXPECT_FALSE(d.volume.gradient.cache);
+    const Scene c = parse(volume_with(R"("gradient": {"scheme": "central", "cache": true})"));
+    EXPECT_EQ(c.volume.gradient.scheme, GradientSpec::Scheme::Central);
+    EXPECT_TRUE(c.volume.gradient.cache);
+    const Scene f = parse(volume_with(R"("interpolation": "nearest", "gradient": {"scheme": "forward", "cache": false})"));
+    EXPECT_EQ(f.volume.gradient.scheme, GradientSpec::Scheme::Forward);
+    EXPECT_FALSE(f.volume.gradient.cache);
+    for (const char* interpolation : {"tricubic-bspline", "tricubic-catmull-rom"}) {
+        const Scene a = parse(volume_with(std::string(R"("interpolation": ")") + interpolation +
+                                          R"(", "gradient": {"scheme": "analytic", "cache": true})"));
+        EXPECT_EQ(a.volume.gradient.scheme, GradientSpec::Scheme::Analytic) << interpolation;
+        EXPECT_TRUE(a.volume.gradient.cache) << interpolation;
+    }
+    // Default stays Default whatever the interpolation (the renderer resolves it).
+    const Scene t = parse(volume_with(R"("interpolation": "tricubic-bspline", "gradient": {"cache": true})"));
+    EXPECT_EQ(t.volume.gradient.scheme, GradientSpec::Scheme::Default);
+}
+
+TEST(SceneLoaderGradient, Errors) {
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": "central")"), "volume.gradient", "expected an object"));
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"scheme": "sobel"})"), "volume.gradient.scheme",
+                           "expected one of \"central\", \"forward\", \"analytic\", got \"sobel\""));
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"scheme": "analytic"})"), "volume.gradient.scheme",
+                           "analytic gradients need a tricubic interpolation"));
+    EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "nearest", "gradient": {"scheme": "analytic"})"),
+                           "volume.gradient.scheme", "analytic gradients need a tricubic interpolation"));
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"cache": "yes"})"), "volume.gradient.cache",
+                           "expected true or false, got \"yes\""));
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"step": 1})"), "volume.gradient.step",
+                           "unknown key (expected one of: scheme, cache)"));
+}
+
+TEST(SceneLoaderGradient, OverridesReachTheNewKeys) {
+    const std::string base = classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}])");
+    const Scene s = parse(base, {"volume.shading.two_sided=true", "volume.shading.model=nodal",
+                                 "volume.classification.isovalues[0].opacity=0.5", "volume.gradient.scheme=forward"});
+    EXPECT_TRUE(s.volume.shading->two_sided);
+    EXPECT_EQ(s.volume.shading->model, ShadingSpec::Model::Nodal);
+    EXPECT_EQ(s.volume.classification->isovalues[0].opacity, 0.5);
+    EXPECT_EQ(s.volume.gradient.scheme, GradientSpec::Scheme::Forward);
+    EXPECT_TRUE(fails_with(base, "volume.shading.ks", "no specular term (set by --set volume.shading.ks=0.3)",
+                           {"volume.shading.model=nodal", "volume.shading.ks=0.3"}));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -484,7 +789,10 @@ TEST(SceneLoaderErrors, UnknownEnumValues) {
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"order": "random"})"), "render.order", "expected one of"));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"step_units": "mm"})"), "render.step_units", "expected one of"));
     EXPECT_TRUE(fails_with(transfer_with(R"("domain": "normalised")"), "volume.transfer.domain", "expected one of"));
-    EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "cubic")"), "volume.interpolation", "expected one of"));
+    EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "cubic")"), "volume.interpolation",
+                           "expected one of \"nearest\", \"trilinear\", \"tricubic-bspline\", \"tricubic-catmull-rom\""));
+    EXPECT_TRUE(fails_with(volume_with(R"("classify": "before")"), "volume.classify",
+                           "expected one of \"post\", \"pre\", got \"before\""));
     EXPECT_TRUE(fails_with(source_with(R"({"field": "sphere"})"), "volume.source.field", "expected one of"));
     EXPECT_TRUE(fails_with(source_with(R"({"file": "a.vtk", "format": "vtk"})"), "volume.source.format",
                            "expected one of \"nrrd\", \"raw\""));
@@ -564,19 +872,6 @@ TEST(SceneLoaderErrors, Sources) {
 }
 
 TEST(SceneLoaderErrors, NotImplementedYet) {
-    EXPECT_EQ(message_of(volume_with(R"("shading": {"model": "phong"})")),
-              "scene.json: volume.shading: shading is not implemented yet");
-    EXPECT_TRUE(fails_with(volume_with(R"("classification": {"type": "isovalue"})"), "volume.classification",
-                           "not implemented yet"));
-    EXPECT_TRUE(fails_with(transfer_with(R"("gradient_opacity": [[0, 1]])"), "volume.transfer.gradient_opacity",
-                           "not implemented yet"));
-    EXPECT_TRUE(fails_with(volume_with(R"("classify": "pre")"), "volume.classify", "\"pre\" is not implemented yet"));
-    EXPECT_NO_THROW(parse(volume_with(R"("classify": "post")")));
-    EXPECT_TRUE(fails_with(volume_with(R"("classify": "before")"), "volume.classify", "expected one of \"post\""));
-    EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "tricubic-bspline")"), "volume.interpolation",
-                           "\"tricubic-bspline\" is not implemented yet"));
-    EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "tricubic-catmull-rom")"), "volume.interpolation",
-                           "not implemented yet"));
     for (const char* type : {"mesh", "cylindrical", "spherical"})
         EXPECT_TRUE(fails_with(volume_with(std::string(R"("bounds": {"type": ")") + type + "\"}"), "volume.bounds.type",
                                "is not implemented yet"))

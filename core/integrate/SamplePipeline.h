@@ -1,0 +1,69 @@
+// SamplePipeline: what one sample point of a ray becomes, stage by stage (the pipeline of Levoy 1988):
+//   value f = sampler(x)  ->  gradient grad f (only when shading or the classifier needs it)
+//   -> classification (c, a): post = classify(f, |grad f|); pre = the pre-classified volume at x
+//   -> shading c' = shader(c, grad f, V, d) (only when the scene asks for shading).
+// Integrators ask it for samples; they never build a stage themselves.
+#pragma once
+#include <glm/geometric.hpp>
+
+#include "core/camera/Ray.h"
+#include "core/sample/GradientField.h"
+#include "core/sample/PreClassifiedVolume.h"
+#include "core/sample/VolumeSampler.h"
+#include "transfer/Classifier.h"
+#include "transfer/Shader.h"
+
+namespace volref {
+
+struct PipelineSample {
+    double value = 0.0;
+    glm::dvec3 color{0.0};  // shaded when the scene is shaded; not premultiplied
+    double opacity = 0.0;   // per unit distance
+};
+
+class SamplePipeline {
+public:
+    // `gradient`, `preclassified` and `shader` may be null (not used by the scene).
+    SamplePipeline(const VolumeSampler& sampler, const Classifier& classifier, const GradientField* gradient,
+                   const PreClassifiedVolume* preclassified, const Shader* shader)
+        : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader) {}
+
+    double value(const Ray& ray, double t) const { return sampler_.value(ray.at(t)); }
+
+    // What the caller needs: compositing ignores the colour of transparent samples (so they are not
+    // shaded), a surface (first hit) always needs its shaded colour, projections of values never shade.
+    enum class Use { Composite, Surface, Unshaded };
+
+    // Value, classification and shading at ray(t). The gradient is computed at most once, and only
+    // when the classifier or the shader needs it.
+    PipelineSample sample(const Ray& ray, double t, Use use) const {
+        const glm::dvec3 x = ray.at(t);
+        PipelineSample s;
+        s.value = sampler_.value(x);
+        glm::dvec3 g(0.0);
+        bool have_gradient = false;
+        auto gradient = [&]() -> const glm::dvec3& {
+            if (!have_gradient) g = gradient_->gradient(x);
+            have_gradient = true;
+            return g;
+        };
+        const Classified c = pre_ ? pre_->sample(x)
+                                  : classifier_.classify(s.value, classifier_.needs_gradient() ? glm::length(gradient()) : 0.0);
+        s.opacity = c.opacity;
+        const bool shade = shader_ && (use == Use::Surface || (use == Use::Composite && c.opacity > 0.0));
+        s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
+        return s;
+    }
+
+    const Classifier& classifier() const { return classifier_; }
+    bool shaded() const { return shader_ != nullptr; }
+
+private:
+    const VolumeSampler& sampler_;
+    const Classifier& classifier_;
+    const GradientField* gradient_;
+    const PreClassifiedVolume* pre_;
+    const Shader* shader_;
+};
+
+}  // namespace volref

@@ -1,0 +1,82 @@
+#include "core/sample/GradientField.h"
+
+#include <algorithm>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/Error.h"
+
+namespace volref {
+
+struct GradientField::Cache {
+    Volume components[3];
+    std::unique_ptr<VolumeSampler> samplers[3];
+};
+
+GradientField::GradientField(const VolumeSampler& sampler, GradientSpec spec) : sampler_(sampler) {
+    scheme_ = spec.scheme;
+    if (scheme_ == GradientSpec::Scheme::Default)
+        scheme_ = sampler.is_tricubic() ? GradientSpec::Scheme::Analytic : GradientSpec::Scheme::Central;
+    if (scheme_ == GradientSpec::Scheme::Analytic && !sampler.is_tricubic())
+        throw Error("volume.gradient.scheme: analytic gradients need a tricubic interpolation");
+    const Volume& v = sampler.volume();
+    lo_ = v.domain_min();
+    hi_ = v.domain_max();
+    if (!spec.cache) return;
+
+    cache_ = std::make_unique<Cache>();
+    for (auto& c : cache_->components) {
+        c.dims = v.dims;
+        c.origin = v.origin;
+        c.spacing = v.spacing;
+        c.type = ScalarType::F64;
+        c.values.resize(v.values.size());
+    }
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
+        for (std::int64_t k = r.begin(); k != r.end(); ++k)
+            for (std::int64_t j = 0; j < v.dims[1]; ++j)
+                for (std::int64_t i = 0; i < v.dims[0]; ++i) {
+                    const glm::dvec3 g = on_the_fly(v.voxel_position(i, j, k));
+                    for (int a = 0; a < 3; ++a) cache_->components[a].values[v.index(i, j, k)] = g[a];
+                }
+    });
+    for (int a = 0; a < 3; ++a)
+        cache_->samplers[a] = std::make_unique<VolumeSampler>(cache_->components[a], Interpolation::Trilinear);
+}
+
+GradientField::~GradientField() = default;
+
+glm::dvec3 GradientField::gradient(const glm::dvec3& world) const {
+    if (cache_)
+        return {cache_->samplers[0]->trilinear(world), cache_->samplers[1]->trilinear(world),
+                cache_->samplers[2]->trilinear(world)};
+    return on_the_fly(world);
+}
+
+glm::dvec3 GradientField::on_the_fly(const glm::dvec3& x) const {
+    if (scheme_ == GradientSpec::Scheme::Analytic) return sampler_.tricubic_gradient(x);
+    const Volume& v = sampler_.volume();
+    glm::dvec3 g(0.0);
+    for (int a = 0; a < 3; ++a) {
+        if (v.dims[a] == 1) continue;
+        const double h = v.spacing[a];
+        const double c = std::max(x[a] - h, lo_[a]);
+        glm::dvec3 pc = x, pb = x;
+        if (scheme_ == GradientSpec::Scheme::Central) {
+            const double b = std::min(x[a] + h, hi_[a]);
+            pc[a] = c;
+            pb[a] = b;
+            g[a] = (sampler_.value(pb) - sampler_.value(pc)) / (b - c);
+        } else if (x[a] + h <= hi_[a]) {
+            pb[a] = x[a] + h;
+            g[a] = (sampler_.value(pb) - sampler_.value(x)) / h;
+        } else {
+            pc[a] = c;
+            g[a] = (sampler_.value(x) - sampler_.value(pc)) / (x[a] - c);
+        }
+    }
+    return g;
+}
+
+}  // namespace volref

@@ -1,0 +1,31 @@
+// BoundaryClassifier: Levoy's region boundaries (conventions section 7).
+// Regions fv_1 < ... < fv_N with opacities av_n and colours c_n; for fv_n <= f <= fv_n+1 with
+// w = (f - fv_n) / (fv_n+1 - fv_n) and g = |grad f|:
+//   a = g (av_n+1 w + av_n (1 - w))                         (clamped to [0, 1])
+//   colour = (av_n+1 w c_n+1 + av_n (1 - w) c_n) / (av_n+1 w + av_n (1 - w))
+//            (the opacity-weighted mix, as for isovalues; the linear mix (1 - w) c_n + w c_n+1 where
+//             both weights are 0)
+// and a = 0 outside [fv_1, fv_N]. At f = fv_n exactly, the lower of the two intervals is used
+// (both give the same a). The opacity is per unit distance like any other; a = g (...) can exceed 1
+// for steep gradients, and is clamped to 1 (opaque), a choice Levoy's formula leaves open.
+#pragma once
+#include <vector>
+
+#include "transfer/Classifier.h"
+
+namespace volref {
+
+class BoundaryClassifier final : public Classifier {
+public:
+    BoundaryClassifier(std::vector<BoundaryRegion> regions, double unit_distance)
+        : regions_(std::move(regions)), unit_distance_(unit_distance) {}
+    Classified classify(double value, double gradient_magnitude) const override;
+    bool needs_gradient() const override { return true; }
+    double unit_distance() const override { return unit_distance_; }
+
+private:
+    std::vector<BoundaryRegion> regions_;
+    double unit_distance_;
+};
+
+}  // namespace volref

@@ -25,9 +25,11 @@ inline constexpr double kFirstHitRelativeTolerance = 1e-9;
 // would hit; the intervals themselves come from the double-precision test.
 inline constexpr double kEmbreeBoundsPadding = 1e-5;
 
-// Shading: a sample whose |grad f| <= kZeroGradientRelative * (max - min of the data) / (smallest
-// spacing) is unshaded (c_out = m): its normal is undefined. A constant volume has tolerance 0, so
-// only an exactly zero gradient is unshaded there.
+// Shading: a sample whose |grad f| <= kZeroGradientRelative * max(|min|, |max| of the data) /
+// (smallest spacing) is unshaded (c_out = m): its normal is undefined. The scale is the data's
+// magnitude, not its range, because reconstruction rounds at that magnitude: trilinear weights
+// that sum to 1 - 2^-53 turn a constant field of 3 into 3 - 4e-16, a spurious gradient that this
+// tolerance removes. An all-zero volume has tolerance 0 (and exactly zero gradients).
 inline constexpr double kZeroGradientRelative = 1e-9;
 
 // Pixel (x, y) is sampled through its centre (x + 0.5, y + 0.5); row 0 is the top row.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
@@ -109,7 +110,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
         const auto [vmin, vmax] = volume.value_range();
         const double min_spacing = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
         shader = std::make_unique<Shader>(*vs.shading, scene.lights,
-                                          conventions::kZeroGradientRelative * (vmax - vmin) / min_spacing);
+                                          conventions::kZeroGradientRelative * std::max(std::fabs(vmin), std::fabs(vmax)) / min_spacing);
     }
     const SamplePipeline pipeline(sampler, *classifier, gradient.get(), preclassified.get(), shader.get());
 

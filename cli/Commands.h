@@ -10,6 +10,7 @@ struct RenderArgs {
     std::filesystem::path scene;
     std::filesystem::path output;
     int threads = 0;
+    bool no_skipping = false;  // --no-skipping: RenderOptions::empty_space_skipping = false
     std::vector<std::string> overrides;  // --set PATH=VALUE
 };
 

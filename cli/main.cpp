@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
     rc->add_option("scene", render.scene, "Scene file (JSON)")->required();
     rc->add_option("-o,--output", render.output, "Output image; the format follows the extension")->required();
     rc->add_option("--threads", render.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+    rc->add_flag("--no-skipping", render.no_skipping,
+                 "Sample every segment (no empty-space skipping); the image is the same, only slower");
     rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
         ->take_all();
 

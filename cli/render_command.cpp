@@ -1,4 +1,4 @@
-// volref render SCENE -o OUT [--threads N] [--set PATH=VALUE ...]
+// volref render SCENE -o OUT [--threads N] [--no-skipping] [--set PATH=VALUE ...]
 #include <unistd.h>
 
 #include <chrono>
@@ -16,6 +16,7 @@ int run_render(const RenderArgs& args) {
     const Scene scene = load_scene(args.scene, args.overrides);
     RenderOptions options;
     options.threads = args.threads;
+    options.empty_space_skipping = !args.no_skipping;
     options.progress = ::isatty(STDERR_FILENO) != 0;
     const auto start = std::chrono::steady_clock::now();
     const Image image = render_scene(scene, options);

@@ -32,6 +32,14 @@ inline constexpr double kEmbreeBoundsPadding = 1e-5;
 // tolerance removes. An all-zero volume has tolerance 0 (and exactly zero gradients).
 inline constexpr double kZeroGradientRelative = 1e-9;
 
+// Empty-space skipping (composite projection; core/sample/MacrocellGrid.h): the cells of the volume
+// are grouped into macrocells of kMacrocellSize^3 cells (fewer at the high ends of an axis), each
+// holding the [min, max] of every voxel a sample inside it can read (its cells' corners, plus one
+// voxel on each side for the tricubic kernels). A ray skips the segments whose midpoints lie in a
+// macrocell the classification makes transparent; the image does not change. 8 keeps the grid small
+// (1/512 of the cells) while skipping whole blocks of typical empty space.
+inline constexpr int kMacrocellSize = 8;
+
 // Pixel (x, y) is sampled through its centre (x + 0.5, y + 0.5); row 0 is the top row.
 inline constexpr double kPixelCentre = 0.5;
 

@@ -5,7 +5,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libembree-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev zlib1g-dev
   # openimageio-tools: OpenImageIO's CMake package lists its command-line tools and fails without them
-  libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libhwy-dev libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -18,4 +18,24 @@ Classified BoundaryClassifier::classify(double f, double g) const {
     return out;
 }
 
+bool BoundaryClassifier::may_have_opacity(double lo, double hi) const {
+    if (!(lo <= hi)) return true;  // empty or NaN: unsure
+    if (regions_.size() < 2) return false;  // classify() gives a = 0 everywhere
+    for (std::size_t n = 1; n < regions_.size(); ++n)
+        if (!(regions_[n].value > regions_[n - 1].value)) return true;  // not strictly increasing: unsure
+    if (hi < regions_.front().value || lo > regions_.back().value) return false;
+    // The interval n that classify() picks for f (the first n with f <= fv_n+1, at most N - 2) is
+    // non-decreasing in f, so [lo, hi] uses the intervals n(max(lo, fv_1)) .. n(min(hi, fv_N)).
+    auto interval_of = [&](double f) {
+        std::size_t n = 0;
+        while (n + 2 < regions_.size() && f > regions_[n + 1].value) ++n;
+        return n;
+    };
+    const std::size_t n0 = interval_of(std::max(lo, regions_.front().value));
+    const std::size_t n1 = interval_of(std::min(hi, regions_.back().value));
+    for (std::size_t n = n0; n <= n1 + 1; ++n)
+        if (regions_[n].opacity != 0.0) return true;
+    return false;
+}
+
 }  // namespace volref

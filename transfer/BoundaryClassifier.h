@@ -22,6 +22,10 @@ public:
     Classified classify(double value, double gradient_magnitude) const override;
     bool needs_gradient() const override { return true; }
     double unit_distance() const override { return unit_distance_; }
+    // False when [lo, hi] does not meet [fv_1, fv_N] (a = 0 there whatever g), or when every region
+    // whose opacity the values of [lo, hi] within [fv_1, fv_N] interpolate has av = 0 (then a = g * 0 = 0
+    // for a finite g; an infinite g would give NaN, which is why the contract asks for finite g).
+    bool may_have_opacity(double lo, double hi) const override;
 
 private:
     std::vector<BoundaryRegion> regions_;

@@ -27,6 +27,16 @@ public:
     virtual double unit_distance() const = 0;
     // The value that average and x-ray projections integrate (the transfer function's coordinate).
     virtual double coordinate(double value) const { return value; }
+    // Can a value in [lo, hi], with any finite gradient magnitude, have opacity > 0? False only when
+    // classify() gives opacity exactly 0 (or -0) for every such value; true when unsure (also for an
+    // empty or NaN range). Empty-space skipping (MacrocellGrid) relies on it. The default (true)
+    // never skips; IsovalueClassifier keeps it: its tent av (1 - |fv - f| / (r g)) is > 0 for every
+    // f once g >= |fv - f| / r, so no value range is transparent (unless every av is 0).
+    virtual bool may_have_opacity(double lo, double hi) const {
+        (void)lo;
+        (void)hi;
+        return true;
+    }
 };
 
 // The classifier a volume names: its `classification`, else its `transfer`.

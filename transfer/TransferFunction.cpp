@@ -79,6 +79,25 @@ Classified TransferFunction::classify(double value, double gradient_magnitude) c
     return out;
 }
 
+bool TransferFunction::may_have_opacity(double lo, double hi) const {
+    if (!(lo <= hi)) return true;  // empty or NaN: unsure
+    const double a = coordinate(lo), b = coordinate(hi);
+    if (!(a <= b)) return true;
+    const std::vector<double>& xs = opacity_.xs();
+    const auto& ys = opacity_.ys();
+    if (xs.empty()) return true;
+    // A coordinate c uses row 0 (c < x_0), the last row (c >= x_last), or rows k-1 and k with k the
+    // first row with x_k > c; over [a, b], k runs from upper_bound(a) to upper_bound(b).
+    const std::size_t ka = std::size_t(std::upper_bound(xs.begin(), xs.end(), a) - xs.begin());
+    const std::size_t kb = std::size_t(std::upper_bound(xs.begin(), xs.end(), b) - xs.begin());
+    std::size_t first = ka > 0 ? ka - 1 : 0, last = std::min(kb, xs.size() - 1);
+    // b exactly on row kb - 1 takes that row's value (w = 0): row kb is not reached.
+    if (kb > 0 && kb < xs.size() && b == xs[kb - 1]) last = kb - 1;
+    for (std::size_t k = first; k <= last; ++k)
+        if (ys[k][0] != 0.0) return true;
+    return false;
+}
+
 std::unique_ptr<Classifier> make_classifier(const VolumeSpec& spec, const Volume& volume) {
     if (!spec.classification) return std::make_unique<TransferFunction>(spec.transfer, volume);
     const ClassificationSpec& c = *spec.classification;

@@ -34,8 +34,19 @@ public:
         return {c[0], c[1], c[2]};
     }
     double opacity(double v) const { return opacity_(coordinate(v))[0]; }
+    // False when every opacity row that classify() can interpolate for a value in [lo, hi] is 0: rows
+    // k-1 .. k' for [a, b] = [coordinate(lo), coordinate(hi)] (coordinate() is monotone in floating
+    // point), k and k' the first rows with x > a and x > b; row k' is left out when b is exactly on
+    // row k'-1 (w = 0 there). Then the opacity is 0 + w (0 - 0) = 0 exactly, and the gradient-opacity
+    // factor (finite for any |grad f|) keeps it 0.
+    bool may_have_opacity(double lo, double hi) const override;
     // The window [lo, hi] used for the normalised domain and the default rows.
     std::array<double, 2> window() const { return {lo_, hi_}; }
+    // The pieces the SIMD path reads (PacketComposite.h).
+    bool normalized() const { return normalized_; }
+    double inverse_window_width() const { return inv_width_; }
+    const PiecewiseLinear<3>& color_function() const { return color_; }
+    const PiecewiseLinear<1>& opacity_function() const { return opacity_; }
 
 private:
     bool normalized_ = false;

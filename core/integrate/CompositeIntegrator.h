@@ -8,19 +8,37 @@
 // Both give A = -expm1(-tau_total) (1 where a segment has a = 1, which makes everything behind it
 // invisible). The pixel is (C, A), premultiplied, accumulated in double.
 // Early termination (front to back only): stop after the segment where A first exceeds the threshold.
+//
+// Empty-space skipping (ctx.macrocells set): runs of segments whose midpoints lie in an empty macrocell
+// are not sampled. Such a segment has opacity exactly 0, which both orders ignore, so every pixel is
+// bitwise the one without skipping: the other segments are sampled at the same t, with the same length,
+// in the same order. The walk, per interval: the macrocell m of segment k's midpoint (macrocell_at, the
+// sampler's own placement); the segments up to where the ray leaves m (exit_distance, an estimate);
+// if m is empty, the last of them is checked to lie in m too (else the last one in m is found by
+// bisection) and the run is skipped: each axis' macrocell index is monotone in k (ray.at, the index
+// map, floor and the midpoints are monotone in floating point), so every segment between two in m is
+// in m. Otherwise the run is sampled. Back to front walks the same way from the far end (entry_distance).
 #pragma once
+#include <optional>
+
 #include "core/integrate/Integrator.h"
+#include "core/integrate/PacketComposite.h"
 
 namespace volref {
 
 class CompositeIntegrator final : public Integrator {
 public:
-    using Integrator::Integrator;
+    explicit CompositeIntegrator(const IntegrationContext& ctx);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    // The SIMD path (PacketComposite.h) where the scene allows it, else one ray at a time.
+    void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                          int count) const override;
+    bool has_packet_path() const { return packet_.has_value(); }
 
 private:
     PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue back_to_front(const Ray& ray, const std::vector<Interval>& intervals) const;
+    std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
 };
 
 }  // namespace volref

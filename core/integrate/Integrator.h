@@ -15,6 +15,8 @@
 
 namespace volref {
 
+class MacrocellGrid;
+
 struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)
@@ -25,6 +27,8 @@ struct IntegrationContext {
     const SamplePipeline& pipeline;
     double step;  // world units, > 0
     const RenderSpec& render;
+    // Composite only: empty-space skipping (core/sample/MacrocellGrid.h); null: every segment is sampled.
+    const MacrocellGrid* macrocells = nullptr;
     double field(const Ray& ray, double t) const { return pipeline.value(ray, t); }
 };
 
@@ -34,6 +38,13 @@ public:
     virtual ~Integrator() = default;
     // `intervals` are sorted and disjoint; an empty list gives the background (all zero, depth inf).
     virtual PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const = 0;
+    // `count` rays at once (count <= kMaxPacketRays); the default integrates them one by one.
+    // Integrators with a SIMD path override it; each out[i] must equal integrate(rays[i],
+    // intervals[i]) up to the documented rounding of that path.
+    virtual void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                                  int count) const {
+        for (int i = 0; i < count; ++i) out[i] = integrate(rays[i], intervals[i]);
+    }
     // The extra channels this projection writes (e.g. "Z" for first-hit).
     virtual bool writes_depth() const { return false; }
 

@@ -56,7 +56,9 @@ public:
     }
 
     const Classifier& classifier() const { return classifier_; }
+    const VolumeSampler& sampler() const { return sampler_; }
     bool shaded() const { return shader_ != nullptr; }
+    bool preclassified() const { return pre_ != nullptr; }
 
 private:
     const VolumeSampler& sampler_;

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -18,8 +19,10 @@
 #include "core/camera/Camera.h"
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/Integrator.h"
+#include "core/integrate/PacketComposite.h"
 #include "core/integrate/SamplePipeline.h"
 #include "core/sample/GradientField.h"
+#include "core/sample/MacrocellGrid.h"
 #include "core/sample/PreClassifiedVolume.h"
 #include "core/io/VolumeReader.h"
 #include "core/sample/VolumeSampler.h"
@@ -87,6 +90,30 @@ private:
     std::thread thread_;
 };
 
+// Empty-space skipping needs a classifier whose opacity can be 0 on a range of values: not Levoy's
+// isovalue contours (see Classifier::may_have_opacity). A classifier that reads |grad f| is trusted
+// to give 0 only for a finite |grad f| (g * 0 is NaN for g = inf), so skipping is also off where a
+// gradient could overflow: non-finite data, |f| / spacing above 1e150 (every scheme's |grad f| is a
+// few times that, whose square must stay finite), a domain so far from the origin that x +- h rounds
+// away the spacing, or forward differences on an axis of two voxels (one-sided over x - lo, which can
+// be tiny).
+bool skipping_applies(const Scene& scene, const Classifier& classifier, const Volume& volume) {
+    const VolumeSpec& vs = scene.volume;
+    if (scene.render.projection != Projection::Composite) return false;
+    if (vs.classification && vs.classification->type == ClassificationSpec::Type::Isovalue) return false;
+    if (!classifier.needs_gradient()) return true;
+    const auto [vmin, vmax] = volume.value_range();
+    const double h = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+    const double far = std::max({glm::length(volume.domain_min()), glm::length(volume.domain_max())});
+    if (!(std::isfinite(vmin) && std::isfinite(vmax))) return false;
+    if (!(std::max(std::fabs(vmin), std::fabs(vmax)) / h <= 1e150)) return false;
+    if (!(far <= 0x1p40 * h)) return false;
+    if (vs.gradient.scheme == GradientSpec::Scheme::Forward)
+        for (int a = 0; a < 3; ++a)
+            if (volume.dims[a] == 2) return false;
+    return true;
+}
+
 }  // namespace
 
 Image render_scene(const Scene& scene, const RenderOptions& options) {
@@ -113,6 +140,13 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
                                           conventions::kZeroGradientRelative * std::max(std::fabs(vmin), std::fabs(vmax)) / min_spacing);
     }
     const SamplePipeline pipeline(sampler, *classifier, gradient.get(), preclassified.get(), shader.get());
+    // The macrocell grid of empty-space skipping, kept only if some macrocell is empty.
+    std::unique_ptr<MacrocellGrid> macrocells;
+    if (options.empty_space_skipping && skipping_applies(scene, *classifier, volume)) {
+        macrocells = std::make_unique<MacrocellGrid>(
+            sampler, *classifier, preclassified ? MacrocellGrid::Classification::Pre : MacrocellGrid::Classification::Post);
+        if (macrocells->empty_count() == 0) macrocells.reset();
+    }
 
     const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
     const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
@@ -124,7 +158,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
 
     const int W = scene.image.width, H = scene.image.height;
     const Camera camera(scene.camera, W, H, glm::max(box_lo, domain_lo), glm::min(box_hi, domain_hi));
-    const IntegrationContext ctx{pipeline, step, scene.render};
+    const IntegrationContext ctx{pipeline, step, scene.render, macrocells.get()};
     const std::unique_ptr<Integrator> integrator = make_integrator(ctx);
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
@@ -137,16 +171,28 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
-            std::vector<Interval> intervals;
+            // Each tile row is integrated in packets of up to kMaxPacketRays pixels.
+            std::vector<Interval> intervals[kMaxPacketRays];
+            Ray rays[kMaxPacketRays];
+            PixelValue values[kMaxPacketRays];
             for (int tile = r.begin(); tile != r.end(); ++tile) {
                 const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
+                const int x_end = std::min(x0 + T, W);
                 for (int y = y0; y < std::min(y0 + T, H); ++y)
-                    for (int x = x0; x < std::min(x0 + T, W); ++x) {
-                        const Ray ray = camera.pixel_ray(x, y);
-                        geometry.intervals(ray, volume_id, intervals);
-                        const PixelValue p = integrator->integrate(ray, intervals);
-                        for (int c = 0; c < 4; ++c) image.at(x, y, std::size_t(c)) = p.rgba[c];
-                        if (integrator->writes_depth()) image.at(x, y, 4) = p.depth;
+                    for (int xs = x0; xs < x_end; xs += kMaxPacketRays) {
+                        const int count = std::min(kMaxPacketRays, x_end - xs);
+                        for (int i = 0; i < count; ++i) {
+                            rays[i] = camera.pixel_ray(xs + i, y);
+                            geometry.intervals(rays[i], volume_id, intervals[i]);
+                        }
+                        if (options.simd)
+                            integrator->integrate_packet(rays, intervals, values, count);
+                        else
+                            for (int i = 0; i < count; ++i) values[i] = integrator->integrate(rays[i], intervals[i]);
+                        for (int i = 0; i < count; ++i) {
+                            for (int c = 0; c < 4; ++c) image.at(xs + i, y, std::size_t(c)) = values[i].rgba[c];
+                            if (integrator->writes_depth()) image.at(xs + i, y, 4) = values[i].depth;
+                        }
                     }
                 progress.tile_done();
             }

@@ -13,6 +13,10 @@ namespace volref {
 struct RenderOptions {
     int threads = 0;        // 0: all cores
     bool progress = false;  // print progress on stderr after about a second
+    // Composite projection: skip the segments in macrocells the classification makes transparent
+    // (conventions section 4). The image is bitwise the same either way; false is for checking that.
+    bool empty_space_skipping = true;
+    bool simd = true;       // use the SIMD packet paths where the scene allows (PacketComposite.h)
 };
 
 // The volume a VolumeSpec names: read from its file or made from its procedural field, with the

@@ -1,0 +1,140 @@
+#include "core/sample/MacrocellGrid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include "core/Conventions.h"
+
+namespace volref {
+
+namespace {
+constexpr std::int64_t M = conventions::kMacrocellSize;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+std::array<double, 2> MacrocellGrid::reconstruction_bounds(Interpolation interpolation, double lo, double hi) {
+    if (interpolation == Interpolation::Nearest) return {lo, hi};
+    if (interpolation == Interpolation::TricubicCatmullRom) {
+        const double mid = 0.5 * lo + 0.5 * hi, r = 0.5 * hi - 0.5 * lo;
+        const double e = 1.953125 * r;  // (5/4)^3 r
+        lo = std::min(lo, mid - e);
+        hi = std::max(hi, mid + e);
+    }
+    const double m = std::max(std::fabs(lo), std::fabs(hi));
+    if (m == 0.0) return {lo, hi};
+    const double margin = 1e-12 * m + 1e-300;
+    return {lo - margin, hi + margin};
+}
+
+MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& classifier, Classification classification)
+    : sampler_(sampler) {
+    const Volume& v = sampler.volume();
+    for (int a = 0; a < 3; ++a) {
+        cells_[a] = std::max<std::int64_t>(v.dims[a] - 1, 1);
+        counts_[a] = (cells_[a] + M - 1) / M;
+    }
+    apron_ = sampler.is_tricubic() ? 1 : 0;
+    const std::size_t total = std::size_t(counts_[0] * counts_[1] * counts_[2]);
+    ranges_.resize(total);
+    empty_.assign(total, 0);
+
+    const Interpolation interpolation = sampler.interpolation();
+    const bool pre = classification == Classification::Pre;
+    const bool value_only = !classifier.needs_gradient();
+    // Pre-classification: can voxel value x have a pre-classified opacity a_i != 0?
+    auto voxel_visible = [&](double x) {
+        return value_only ? classifier.classify(x, 0.0).opacity != 0.0 : classifier.may_have_opacity(x, x);
+    };
+
+    empty_count_ = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, total), std::int64_t(0),
+        [&](const tbb::blocked_range<std::size_t>& r, std::int64_t count) {
+            for (std::size_t id = r.begin(); id != r.end(); ++id) {
+                const std::int64_t s = std::int64_t(id);
+                const Index m{s % counts_[0], (s / counts_[0]) % counts_[1], s / (counts_[0] * counts_[1])};
+                Index first, last;
+                voxel_box(m, first, last);
+                double lo = kInf, hi = -kInf;
+                bool finite = true, visible = false;
+                for (std::int64_t k = first[2]; k <= last[2]; ++k)
+                    for (std::int64_t j = first[1]; j <= last[1]; ++j)
+                        for (std::int64_t i = first[0]; i <= last[0]; ++i) {
+                            const double x = v.at(i, j, k);
+                            if (!std::isfinite(x)) {
+                                finite = false;
+                                continue;
+                            }
+                            lo = std::min(lo, x);
+                            hi = std::max(hi, x);
+                            if (pre && !visible) visible = voxel_visible(x);
+                        }
+                if (!finite) {
+                    ranges_[id] = {-kInf, kInf};
+                    continue;
+                }
+                ranges_[id] = {lo, hi};
+                if (!pre) {
+                    const auto b = reconstruction_bounds(interpolation, lo, hi);
+                    visible = classifier.may_have_opacity(b[0], b[1]);
+                }
+                if (!visible) {
+                    empty_[id] = 1;
+                    ++count;
+                }
+            }
+            return count;
+        },
+        [](std::int64_t a, std::int64_t b) { return a + b; });
+}
+
+void MacrocellGrid::voxel_box(const Index& m, Index& first, Index& last) const {
+    const Volume& v = sampler_.volume();
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t c0 = m[a] * M, c1 = std::min(c0 + M, cells_[a]);  // cells [c0, c1)
+        first[a] = std::clamp<std::int64_t>(c0 - apron_, 0, v.dims[a] - 1);
+        last[a] = std::clamp<std::int64_t>(c1 + apron_, 0, v.dims[a] - 1);
+    }
+}
+
+MacrocellGrid::Index MacrocellGrid::macrocell_at(const glm::dvec3& world) const {
+    const glm::dvec3 u = sampler_.continuous_index(world);
+    if (std::isnan(u.x) || std::isnan(u.y) || std::isnan(u.z)) return {-1, -1, -1};
+    std::array<std::int64_t, 3> cell;
+    glm::dvec3 frac;
+    sampler_.locate(u, cell, frac);
+    return {cell[0] / M, cell[1] / M, cell[2] / M};
+}
+
+double MacrocellGrid::exit_distance(const Ray& ray, const Index& m) const {
+    const Volume& v = sampler_.volume();
+    double t = kInf;
+    for (int a = 0; a < 3; ++a) {
+        const double d = ray.direction[a];
+        std::int64_t plane;
+        if (d > 0.0 && m[a] + 1 < counts_[a]) plane = (m[a] + 1) * M;
+        else if (d < 0.0 && m[a] > 0) plane = m[a] * M;
+        else continue;
+        t = std::min(t, (v.origin[a] + double(plane) * v.spacing[a] - ray.origin[a]) / d);
+    }
+    return t;
+}
+
+double MacrocellGrid::entry_distance(const Ray& ray, const Index& m) const {
+    const Volume& v = sampler_.volume();
+    double t = -kInf;
+    for (int a = 0; a < 3; ++a) {
+        const double d = ray.direction[a];
+        std::int64_t plane;
+        if (d > 0.0 && m[a] > 0) plane = m[a] * M;
+        else if (d < 0.0 && m[a] + 1 < counts_[a]) plane = (m[a] + 1) * M;
+        else continue;
+        t = std::max(t, (v.origin[a] + double(plane) * v.spacing[a] - ray.origin[a]) / d);
+    }
+    return t;
+}
+
+}  // namespace volref

@@ -1,0 +1,91 @@
+// MacrocellGrid: the min/max grid of empty-space skipping (conventions section 4, "Empty-space
+// skipping"), for the composite projection.
+//
+// The cells of the volume (cell i = [i, i + 1] per axis, as VolumeSampler::locate picks it; one cell on
+// an axis with n = 1) are grouped into macrocells of M^3 cells, M = conventions::kMacrocellSize (fewer at
+// the high end of an axis whose cell count is not a multiple of M). A sample belongs to the macrocell of
+// the cell that VolumeSampler::locate gives for it (computed by the same code, so a sample on a
+// macrocell face belongs to exactly the macrocell whose voxels it reads), and reads only:
+//   nearest, trilinear: the corners of its cell (nearest: voxel floor(u + 1/2), a corner of that cell);
+//   tricubic:           the taps i-1 .. i+2 per axis (indices clamped), an apron of one voxel.
+// Macrocell m covers cells [c0, c1) per axis (c0 = m M, c1 = min(c0 + M, cells)), so its voxels are
+// [c0, c1] (nearest, trilinear) or [c0 - 1, c1 + 1] (tricubic), clamped to [0, n - 1]. It stores their
+// [min, max] and an `empty` flag, true only when no sample in it can have opacity > 0:
+//   post-classification: the classifier says no value in reconstruction_bounds(min, max) can;
+//   pre-classification:  every voxel it reads has pre-classified opacity a_i = 0 (so the interpolated
+//                        opacity is 0 exactly for every kernel): a_i = classify(v_i, 0) for classifiers
+//                        that ignore the gradient, else "classify cannot give > 0 at v_i" (any |grad f|).
+// A macrocell with a non-finite voxel is never empty.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/camera/Ray.h"
+#include "core/sample/VolumeSampler.h"
+#include "transfer/Classifier.h"
+
+namespace volref {
+
+class MacrocellGrid {
+public:
+    using Index = std::array<std::int64_t, 3>;
+    enum class Classification { Post, Pre };
+
+    // `sampler` places samples (continuous_index, locate) and names the interpolation; it must outlive
+    // the grid. The classifier is only used while building.
+    MacrocellGrid(const VolumeSampler& sampler, const Classifier& classifier, Classification classification);
+
+    // Macrocells per axis: ceil(cells / M), cells = max(n - 1, 1).
+    const Index& counts() const { return counts_; }
+    std::int64_t empty_count() const { return empty_count_; }
+    // [min, max] of the voxels the samples in macrocell m read ([-inf, +inf] if one is not finite).
+    std::array<double, 2> range(const Index& m) const { return ranges_[linear(m)]; }
+    // False for an index outside the grid.
+    bool empty(const Index& m) const { return inside(m) && empty_[linear(m)] != 0; }
+    // The voxels (first, last, inclusive, per axis) that the samples in macrocell m read.
+    void voxel_box(const Index& m, Index& first, Index& last) const;
+
+    // The macrocell of a sample at world point x (the cell of VolumeSampler::locate divided by M);
+    // {-1, -1, -1} if x is NaN.
+    Index macrocell_at(const glm::dvec3& world) const;
+    // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
+    // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
+    // integrator checks it against macrocell_at.
+    double exit_distance(const Ray& ray, const Index& m) const;
+    double entry_distance(const Ray& ray, const Index& m) const;
+
+    // An interval that holds every value the interpolation can reconstruct, rounding included, from
+    // taps whose values lie in [lo, hi] (finite):
+    //   nearest:            [lo, hi] (a voxel value, exactly);
+    //   trilinear, B-spline: non-negative weights summing to 1: [lo, hi] widened by the rounding margin;
+    //   Catmull-Rom:        the weights sum to 1 but w0, w3 <= 0, and sum |w| = 1 + t (1 - t) <= 5/4 per
+    //                       axis, so |f - mid| <= (5/4)^3 r = 1.953125 r (mid, r: the centre and
+    //                       half-width of [lo, hi]), widened by the rounding margin.
+    // Rounding margin: 1e-12 max(|lo|, |hi|) + 1e-300 (0 when lo = hi = 0, which reconstructs to 0
+    // exactly). The weights' rounding and the three 4-tap passes stay below 400 u = 4.4e-14 of the
+    // taps' magnitude (times 1.95 for Catmull-Rom); 1e-300 covers subnormal taps.
+    static std::array<double, 2> reconstruction_bounds(Interpolation interpolation, double lo, double hi);
+
+private:
+    bool inside(const Index& m) const {
+        for (int a = 0; a < 3; ++a)
+            if (m[a] < 0 || m[a] >= counts_[a]) return false;
+        return true;
+    }
+    std::size_t linear(const Index& m) const {
+        return std::size_t(m[0] + counts_[0] * (m[1] + counts_[1] * m[2]));
+    }
+
+    const VolumeSampler& sampler_;
+    Index counts_{1, 1, 1};
+    Index cells_{1, 1, 1};
+    std::int64_t apron_ = 0;
+    std::vector<std::array<double, 2>> ranges_;
+    std::vector<unsigned char> empty_;
+    std::int64_t empty_count_ = 0;
+};
+
+}  // namespace volref

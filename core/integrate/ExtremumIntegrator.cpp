@@ -4,6 +4,30 @@
 
 namespace volref {
 
+ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
+    const VolumeSampler& sampler = ctx.pipeline.sampler();
+    if (sampler.interpolation() != Interpolation::Trilinear) return;
+    const Volume& v = sampler.volume();
+    PacketExtremumInputs in;
+    in.voxels = v.values.data();
+    for (int a = 0; a < 3; ++a) {
+        in.dims[a] = v.dims[a];
+        in.origin[a] = v.origin[a];
+        in.inv_spacing[a] = 1.0 / v.spacing[a];
+    }
+    in.step = ctx.step;
+    in.maximum = maximum;
+    packet_ = in;
+}
+
+void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                                          int count) const {
+    if (!packet_) return Integrator::integrate_packet(rays, intervals, out, count);
+    RayExtremum e[kMaxPacketRays];
+    extremum_packet(*packet_, rays, intervals, e, count);
+    for (int i = 0; i < count; ++i) out[i] = pixel(rays[i], e[i].any, e[i].t);
+}
+
 PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
     bool any = false;
     double best = 0.0, t_best = 0.0;
@@ -16,6 +40,10 @@ PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Inter
         any = true;
         return true;
     });
+    return pixel(ray, any, t_best);
+}
+
+PixelValue ExtremumIntegrator::pixel(const Ray& ray, bool any, double t_best) const {
     PixelValue out;
     if (any) {
         const PipelineSample p = ctx_.pipeline.sample(ray, t_best, SamplePipeline::Use::Unshaded);

@@ -3,17 +3,25 @@
 // Segments.h); the pixel is the classification's colour and opacity at that sample (the first of
 // equal extrema), premultiplied: (a c, a), unshaded. A ray with no interval is (0, 0, 0, 0).
 #pragma once
+#include <optional>
+
 #include "core/integrate/Integrator.h"
+#include "core/integrate/PacketExtremum.h"
 
 namespace volref {
 
 class ExtremumIntegrator final : public Integrator {
 public:
-    ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {}
+    ExtremumIntegrator(const IntegrationContext& ctx, bool maximum);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    // The SIMD path (PacketExtremum.h) for trilinear volumes, bitwise the scalar result.
+    void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                          int count) const override;
 
 private:
+    PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
+    std::optional<PacketExtremumInputs> packet_;
 };
 
 }  // namespace volref

@@ -17,6 +17,9 @@ namespace volref {
 
 class MacrocellGrid;
 
+// The largest number of rays the renderer hands to Integrator::integrate_packet at once.
+inline constexpr int kMaxPacketRays = 16;
+
 struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)

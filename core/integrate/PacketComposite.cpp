@@ -7,7 +7,7 @@
 #include <hwy/highway.h>
 
 #include "core/integrate/PacketComposite.h"
-#include "core/integrate/Segments.h"
+#include "core/integrate/PacketKernels-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace volref {
@@ -16,10 +16,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace {
 
-using D = hn::ScalableTag<double>;
-using DI = hn::RebindToSigned<D>;
-using V = hn::Vec<D>;
-using M = hn::Mask<D>;
+using namespace packet;
 
 // A piecewise-linear function of one channel of `ys` (rows of `stride` values) at v, as
 // PiecewiseLinear::operator(): k = the number of rows with x <= v; k = 0 -> y_0, k = R -> y_{R-1},
@@ -55,132 +52,25 @@ HWY_INLINE V table_channel(D d, const TableLookup& t, const double* ys, int rows
     return hn::IfThenElse(t.below, first, hn::IfThenElse(t.above, last, inner));
 }
 
-// One lane's walk over its intervals and segments.
-struct LaneWalk {
-    const std::vector<Interval>* intervals = nullptr;
-    std::size_t interval = 0;
-    std::int64_t k = 0, n = 0;
-    bool active = false;
-
-    void start(const std::vector<Interval>* ivs, double step) {
-        intervals = ivs;
-        interval = 0;
-        active = !ivs->empty();
-        if (active) {
-            k = 0;
-            n = segment_count((*ivs)[0], step);
-        }
-    }
-    Segment current(double step) const { return segment((*intervals)[interval], step, k, n); }
-    void advance(double step) {
-        if (++k < n) return;
-        if (++interval < intervals->size()) {
-            k = 0;
-            n = segment_count((*intervals)[interval], step);
-        } else {
-            active = false;
-        }
-    }
-};
-
 void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count) {
     const D d;
-    const DI di;
-    constexpr std::size_t kLanes = HWY_LANES(double);
-    const std::size_t L = hn::Lanes(d);
-    HWY_ALIGN double ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
-    HWY_ALIGN double tm[kLanes], len[kLanes], live[kLanes], buf[kLanes];
-    LaneWalk walk[kLanes];
-    for (std::size_t l = 0; l < L; ++l) {
-        const bool real = int(l) < count;
-        const Ray& r = rays[real ? l : 0];
-        ox[l] = r.origin.x;
-        oy[l] = r.origin.y;
-        oz[l] = r.origin.z;
-        dx[l] = r.direction.x;
-        dy[l] = r.direction.y;
-        dz[l] = r.direction.z;
-        walk[l] = LaneWalk{};
-        if (real) walk[l].start(&intervals[l], in.step);
-    }
-    const V Ox = hn::Load(d, ox), Oy = hn::Load(d, oy), Oz = hn::Load(d, oz);
-    const V Dx = hn::Load(d, dx), Dy = hn::Load(d, dy), Dz = hn::Load(d, dz);
+    RayPacket packet(rays, intervals, count, in.step);
+    const std::size_t L = packet.lanes;
+    HWY_ALIGN double buf[RayPacket::kLanes];
+    const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
+    const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
+    const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
 
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
-    const V org[3] = {hn::Set(d, in.origin[0]), hn::Set(d, in.origin[1]), hn::Set(d, in.origin[2])};
-    const V inv[3] = {hn::Set(d, in.inv_spacing[0]), hn::Set(d, in.inv_spacing[1]), hn::Set(d, in.inv_spacing[2])};
-    V maxi[3], top[3];
-    bool flat[3];
-    for (int a = 0; a < 3; ++a) {
-        maxi[a] = hn::Set(d, double(in.dims[a] - 1));
-        top[a] = hn::Set(d, double(in.dims[a] - 2));
-        flat[a] = in.dims[a] == 1;
-    }
-    const V nx = hn::Set(d, double(in.dims[0])), nxy = hn::Set(d, double(in.dims[0] * in.dims[1]));
-    const std::int64_t sx = flat[0] ? 0 : 1, sy = flat[1] ? 0 : in.dims[0], sz = flat[2] ? 0 : in.dims[0] * in.dims[1];
-    const auto offx = hn::Set(di, sx), offy = hn::Set(di, sy), offz = hn::Set(di, sz);
-
     V Cr = zero, Cg = zero, Cb = zero, tau_s = zero, tau_c = zero, opaque = zero;
     const V l_unit = hn::Set(d, in.unit_distance);
     const V threshold = hn::Set(d, in.threshold);
 
-    for (;;) {
-        bool any = false;
-        for (std::size_t l = 0; l < L; ++l) {
-            if (walk[l].active) {
-                const Segment s = walk[l].current(in.step);
-                tm[l] = s.midpoint();
-                len[l] = s.length();
-                live[l] = 1.0;
-                any = true;
-            } else {
-                tm[l] = 0.0;
-                len[l] = 0.0;
-                live[l] = 0.0;
-            }
-        }
-        if (!any) break;
-        const V t = hn::Load(d, tm), seg = hn::Load(d, len);
-        const M alive = hn::Gt(hn::Load(d, live), zero);
-
-        // Position, continuous index (clamped), cell and fraction.
-        const V X[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
-        V cell[3], frac[3];
-        for (int a = 0; a < 3; ++a) {
-            const V u = hn::Min(hn::Max(hn::Mul(hn::Sub(X[a], org[a]), inv[a]), zero), maxi[a]);
-            if (flat[a]) {
-                cell[a] = zero;
-                frac[a] = zero;
-            } else {
-                cell[a] = hn::Min(hn::Floor(u), top[a]);
-                frac[a] = hn::Sub(u, cell[a]);
-            }
-        }
-        const auto base = hn::ConvertTo(di, hn::Add(cell[0], hn::Mul(nx, cell[1])) /* i + nx j */);
-        const auto idx = hn::Add(base, hn::ConvertTo(di, hn::Mul(nxy, cell[2])));
-        const double* vox = in.voxels;
-        const V f1 = hn::GatherIndex(d, vox, idx);
-        const V f2 = hn::GatherIndex(d, vox, hn::Add(idx, offx));
-        const V f3 = hn::GatherIndex(d, vox, hn::Add(hn::Add(idx, offx), offy));
-        const V f4 = hn::GatherIndex(d, vox, hn::Add(idx, offy));
-        const auto idz = hn::Add(idx, offz);
-        const V f5 = hn::GatherIndex(d, vox, idz);
-        const V f6 = hn::GatherIndex(d, vox, hn::Add(idz, offx));
-        const V f7 = hn::GatherIndex(d, vox, hn::Add(hn::Add(idz, offx), offy));
-        const V f8 = hn::GatherIndex(d, vox, hn::Add(idz, offy));
-        const V p = frac[0], q = frac[1], r = frac[2];
-        const V P = hn::Sub(one, p), Q = hn::Sub(one, q), R = hn::Sub(one, r);
-        V v = zero;
-        v = hn::Add(v, hn::Mul(f1, hn::Mul(hn::Mul(P, Q), R)));
-        v = hn::Add(v, hn::Mul(f2, hn::Mul(hn::Mul(p, Q), R)));
-        v = hn::Add(v, hn::Mul(f3, hn::Mul(hn::Mul(p, q), R)));
-        v = hn::Add(v, hn::Mul(f4, hn::Mul(hn::Mul(P, q), R)));
-        v = hn::Add(v, hn::Mul(f5, hn::Mul(hn::Mul(P, Q), r)));
-        v = hn::Add(v, hn::Mul(f6, hn::Mul(hn::Mul(p, Q), r)));
-        v = hn::Add(v, hn::Mul(f7, hn::Mul(hn::Mul(p, q), r)));
-        v = hn::Add(v, hn::Mul(f8, hn::Mul(hn::Mul(P, q), r)));
-
+    while (packet.next(in.step)) {
+        const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
+        const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+        const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
         // Transfer function.
         const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, in.lo)), hn::Set(d, in.inv_width)) : v;
         const TableLookup ot = locate_rows(d, in.opacity_x, in.opacity_rows, x);
@@ -213,13 +103,12 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 stop = hn::Or(stop, hn::And(partial, hn::Gt(hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))), threshold)));
             hn::Store(hn::IfThenElseZero(stop, one), d, buf);
             for (std::size_t l = 0; l < L; ++l)
-                if (buf[l] != 0.0) walk[l].active = false;
+                if (buf[l] != 0.0) packet.walk[l].active = false;
         }
-        for (std::size_t l = 0; l < L; ++l)
-            if (walk[l].active) walk[l].advance(in.step);
+        packet.advance(in.step);
     }
     const V A = hn::IfThenElse(hn::Gt(opaque, zero), one, hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))));
-    HWY_ALIGN double r_[kLanes], g_[kLanes], b_[kLanes], a_[kLanes];
+    HWY_ALIGN double r_[RayPacket::kLanes], g_[RayPacket::kLanes], b_[RayPacket::kLanes], a_[RayPacket::kLanes];
     hn::Store(Cr, d, r_);
     hn::Store(Cg, d, g_);
     hn::Store(Cb, d, b_);

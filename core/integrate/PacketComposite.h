@@ -45,9 +45,6 @@ struct PacketCompositeInputs {
     double threshold = 1.0;
 };
 
-// The largest number of rays the renderer hands over at once.
-inline constexpr int kMaxPacketRays = 16;
-
 // Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count).
 void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                       PixelValue* out, int count);

@@ -124,3 +124,20 @@ TEST(Simd, BitwiseIdenticalAcrossInstructionSets) {
     }
     EXPECT_GE(compared, 2);
 }
+
+// mip and minip: only reconstruction and comparisons are vectorised, so the packet path is
+// bitwise the scalar one.
+TEST(Simd, MipAndMinipAreBitwiseTheScalarPath) {
+    for (auto proj : {Projection::Mip, Projection::Minip}) {
+        Scene s = ml_scene(37, 23);
+        s.render.projection = proj;
+        s.render.step = 0.37;
+        s.volume.transfer.opacity = {{0.0, 0.2}, {0.5, 0.1}, {1.0, 0.9}};
+        const Image a = render_scene(s, {.threads = 1, .simd = true});
+        const Image b = render_scene(s, {.threads = 1, .simd = false});
+        EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(double)), 0);
+        double max_alpha = 0.0;
+        for (std::size_t i = 3; i < a.pixels.size(); i += 4) max_alpha = std::max(max_alpha, a.pixels[i]);
+        EXPECT_GT(max_alpha, 0.1);
+    }
+}

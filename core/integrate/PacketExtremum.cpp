@@ -1,0 +1,67 @@
+// Highway's per-target compilation: this file is compiled once per instruction set.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/integrate/PacketExtremum.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include "core/integrate/PacketExtremum.h"
+#include "core/integrate/PacketKernels-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace volref {
+namespace HWY_NAMESPACE {
+namespace {
+using namespace packet;
+
+void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                    RayExtremum* out, int count) {
+    const D d;
+    RayPacket packet(rays, intervals, count, in.step);
+    const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
+    const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
+    const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
+    const V zero = hn::Zero(d);
+    V best = zero, t_best = zero, seen = zero;
+    while (packet.next(in.step)) {
+        const V t = hn::Load(d, packet.tm);
+        const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+        const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
+        // Scalar: if (!any || (maximum ? v > best : v < best)) take v.
+        const M better = in.maximum ? hn::Gt(v, best) : hn::Lt(v, best);
+        const M take = hn::And(alive, hn::Or(hn::Eq(seen, zero), better));
+        best = hn::IfThenElse(take, v, best);
+        t_best = hn::IfThenElse(take, t, t_best);
+        seen = hn::IfThenElse(alive, hn::Set(d, 1.0), seen);
+        packet.advance(in.step);
+    }
+    HWY_ALIGN double b[RayPacket::kLanes], tb[RayPacket::kLanes], s[RayPacket::kLanes];
+    hn::Store(best, d, b);
+    hn::Store(t_best, d, tb);
+    hn::Store(seen, d, s);
+    for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != 0.0, b[l], tb[l]};
+}
+
+}  // namespace
+
+void ExtremumPacket(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                    RayExtremum* out, int count) {
+    const int L = int(hn::Lanes(D()));
+    for (int first = 0; first < count; first += L)
+        extremum_lanes(in, rays + first, intervals + first, out + first, std::min(L, count - first));
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace volref
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace volref {
+HWY_EXPORT(ExtremumPacket);
+
+void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                     RayExtremum* out, int count) {
+    HWY_DYNAMIC_DISPATCH(ExtremumPacket)(in, rays, intervals, out, count);
+}
+}  // namespace volref
+#endif

@@ -1,0 +1,32 @@
+// The SIMD path of mip and minip (Google Highway, run-time dispatch): the extremum of the trilinear
+// value over each ray's segment midpoints, a packet of rays at a time, with the same comparisons
+// as ExtremumIntegrator (the first of equal extrema wins). Only reconstruction and comparison are
+// vectorised, with the scalar path's arithmetic (no transcendental), so the result is bitwise the
+// scalar one; the classification at the extremum stays scalar (one per ray).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/camera/Ray.h"
+#include "geometry/RayIntervals.h"
+
+namespace volref {
+
+struct PacketExtremumInputs {
+    const double* voxels = nullptr;
+    std::int64_t dims[3] = {1, 1, 1};
+    double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
+    double step = 1.0;
+    bool maximum = true;
+};
+
+struct RayExtremum {
+    bool any = false;      // the ray had at least one sample
+    double value = 0.0;    // the extremum
+    double t = 0.0;        // the midpoint where it was first reached
+};
+
+void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                     RayExtremum* out, int count);
+
+}  // namespace volref

@@ -40,6 +40,14 @@ inline constexpr double kZeroGradientRelative = 1e-9;
 // (1/512 of the cells) while skipping whole blocks of typical empty space.
 inline constexpr int kMacrocellSize = 8;
 
+// Gradient cache "auto" (opt-in): cache when the expected number of gradient evaluations per voxel,
+//   e = pixels * (domain diagonal / step) * (fraction of voxels with opacity > 0) / voxels,
+// exceeds this break-even: the cache's build time per voxel over the saving per evaluation, measured
+// on a 256^3 volume along rays (docs/performance.md, "Gradients on a 256^3 volume": 1.0 to 2.6 for
+// central differences with trilinear reconstruction). The estimate assumes every ray crosses the
+// domain's diagonal, an upper bound, so the rule leans to caching for large images.
+inline constexpr double kGradientCacheBreakEven = 2.0;
+
 // Pixel (x, y) is sampled through its centre (x + 0.5, y + 0.5); row 0 is the top row.
 inline constexpr double kPixelCentre = 0.5;
 

@@ -4,57 +4,14 @@
 #include <cmath>
 
 #include "core/integrate/CompensatedSum.h"
-#include "core/integrate/Segments.h"
-#include "core/sample/MacrocellGrid.h"
+#include "core/integrate/SegmentWalk.h"
 #include "transfer/OpacityCorrection.h"
 
 namespace volref {
 
 namespace {
 
-// The smallest k in [0, n] whose midpoint t0 + (k + 1/2) h is >= t, estimated (rounded); the walks
-// below check what they skip against macrocell_at.
-std::int64_t segment_at_or_after(const Interval& iv, double step, double t, std::int64_t n) {
-    const double k = std::ceil((t - iv.t0) / step - 0.5);
-    if (!(k > 0.0)) return 0;  // also -inf and NaN
-    if (k >= double(n)) return n;
-    return std::int64_t(k);
-}
-
-// The macrocell in which the pipeline samples segment k (at ray.at(midpoint)).
-MacrocellGrid::Index macrocell_of(const MacrocellGrid& grid, const Ray& ray, const Interval& iv, double step,
-                                  std::int64_t k, std::int64_t n) {
-    return grid.macrocell_at(ray.at(segment(iv, step, k, n).midpoint()));
-}
-
-// for_each_segment without the segments in empty macrocells (CompositeIntegrator.h).
-template <typename Fn>
-void for_each_segment_skipping(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals,
-                               double step, Fn&& fn) {
-    if (!grid) return for_each_segment(intervals, step, fn);
-    for (const Interval& iv : intervals) {
-        const std::int64_t n = segment_count(iv, step);
-        std::int64_t k = 0;
-        while (k < n) {
-            const MacrocellGrid::Index m = macrocell_of(*grid, ray, iv, step, k, n);
-            std::int64_t end = std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->exit_distance(ray, m), n), k + 1, n);
-            if (grid->empty(m)) {
-                if (end - 1 > k && macrocell_of(*grid, ray, iv, step, end - 1, n) != m) {
-                    std::int64_t in = k, out = end - 1;  // in m, not in m
-                    while (out - in > 1) {
-                        const std::int64_t mid = in + (out - in) / 2;
-                        (macrocell_of(*grid, ray, iv, step, mid, n) == m ? in : out) = mid;
-                    }
-                    end = in + 1;
-                }
-                k = end;  // segments k .. end - 1 lie in m: opacity 0
-                continue;
-            }
-            for (; k < end; ++k)
-                if (!fn(segment(iv, step, k, n))) return;
-        }
-    }
-}
+using namespace segment_walk;
 
 // for_each_segment_reversed without the segments in empty macrocells.
 template <typename Fn>
@@ -67,17 +24,26 @@ void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ra
         std::int64_t k = n - 1;
         while (k >= 0) {
             const MacrocellGrid::Index m = macrocell_of(*grid, ray, iv, step, k, n);
-            std::int64_t begin = std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->entry_distance(ray, m), n), 0, k);
+            // The estimate: segments begin .. k have their midpoints after the ray enters m.
+            const std::int64_t begin =
+                std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->entry_distance(ray, m), n), 0, k);
             if (grid->empty(m)) {
-                if (begin < k && macrocell_of(*grid, ray, iv, step, begin, n) != m) {
-                    std::int64_t out = begin, in = k;  // not in m, in m
-                    while (in - out > 1) {
-                        const std::int64_t mid = out + (in - out) / 2;
-                        (macrocell_of(*grid, ray, iv, step, mid, n) == m ? in : out) = mid;
+                // Indices mirrored (j -> k - j) so that the run again starts at 0 and grows.
+                auto in_m = [&](std::int64_t j) { return macrocell_of(*grid, ray, iv, step, k - j, n) == m; };
+                std::int64_t in = k - begin, out = k + 1;
+                if (in > 0 && !in_m(in)) {
+                    out = in;  // the estimate is too long
+                    in = 0;
+                } else {  // too short? gallop backward
+                    for (std::int64_t d = 1; in + d <= k; d *= 2) {
+                        if (!in_m(in + d)) {
+                            out = in + d;
+                            break;
+                        }
+                        in += d;
                     }
-                    begin = in;
                 }
-                k = begin - 1;  // segments begin .. k lie in m: opacity 0
+                k -= last_in_run(in, out, in_m) + 1;  // every segment down to there lies in m: opacity 0
                 continue;
             }
             for (; k >= begin; --k)
@@ -100,22 +66,24 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
     CompensatedSum tau;
     glm::dvec3 C(0.0);
     bool opaque = false;
-    for_each_segment_skipping(ctx_.macrocells, ray, intervals, ctx_.step, [&](const Segment& s) {
+    ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step);
+    Segment s;
+    while (walk.next(s)) {
         const PipelineSample p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
         const double a = p.opacity;
-        if (a <= 0.0) return true;
+        if (a <= 0.0) continue;
         const double T = std::exp(-tau.value());
         if (a >= 1.0) {  // opaque: alpha = 1, nothing behind is visible
             C += T * p.color;
             opaque = true;
-            return false;
+            break;
         }
         const double tau_k = optical_depth(a, s.length(), l);
         const double alpha = -std::expm1(-tau_k);
         C += (T * alpha) * p.color;
         tau.add(tau_k);
-        return !(terminate && -std::expm1(-tau.value()) > threshold);
-    });
+        if (terminate && -std::expm1(-tau.value()) > threshold) break;
+    }
     PixelValue out;
     out.rgba = glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value()));
     return out;

@@ -14,10 +14,11 @@
 // bitwise the one without skipping: the other segments are sampled at the same t, with the same length,
 // in the same order. The walk, per interval: the macrocell m of segment k's midpoint (macrocell_at, the
 // sampler's own placement); the segments up to where the ray leaves m (exit_distance, an estimate);
-// if m is empty, the last of them is checked to lie in m too (else the last one in m is found by
-// bisection) and the run is skipped: each axis' macrocell index is monotone in k (ray.at, the index
-// map, floor and the midpoints are monotone in floating point), so every segment between two in m is
-// in m. Otherwise the run is sampled. Back to front walks the same way from the far end (entry_distance).
+// if m is empty, the last of them is checked to lie in m too (if not, the last one in m is found by
+// bisection; if so, by galloping on and bisecting, as the estimate may also be short) and the run is
+// skipped: each axis' macrocell index is monotone in k (ray.at, the index map, floor and the midpoints
+// are monotone in floating point), so every segment between two in m is in m. Otherwise the run is
+// sampled. Back to front walks the same way from the far end (entry_distance).
 #pragma once
 #include <optional>
 

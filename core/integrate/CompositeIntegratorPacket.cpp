@@ -33,6 +33,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     in.step = ctx.step;
     in.terminate = ctx.render.early_termination.has_value();
     in.threshold = ctx.render.early_termination.value_or(1.0);
+    in.macrocells = ctx.macrocells;
     packet_ = in;
 }
 

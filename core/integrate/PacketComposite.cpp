@@ -55,7 +55,7 @@ HWY_INLINE V table_channel(D d, const TableLookup& t, const double* ys, int rows
 void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count) {
     const D d;
-    RayPacket packet(rays, intervals, count, in.step);
+    RayPacket packet(rays, intervals, count, in.step, in.macrocells);
     const std::size_t L = packet.lanes;
     HWY_ALIGN double buf[RayPacket::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
@@ -67,7 +67,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const V l_unit = hn::Set(d, in.unit_distance);
     const V threshold = hn::Set(d, in.threshold);
 
-    while (packet.next(in.step)) {
+    while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
         const M alive = hn::Gt(hn::Load(d, packet.live), zero);
         const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
@@ -103,9 +103,8 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 stop = hn::Or(stop, hn::And(partial, hn::Gt(hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))), threshold)));
             hn::Store(hn::IfThenElseZero(stop, one), d, buf);
             for (std::size_t l = 0; l < L; ++l)
-                if (buf[l] != 0.0) packet.walk[l].active = false;
+                if (buf[l] != 0.0) packet.active[l] = false;
         }
-        packet.advance(in.step);
     }
     const V A = hn::IfThenElse(hn::Gt(opaque, zero), one, hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))));
     HWY_ALIGN double r_[RayPacket::kLanes], g_[RayPacket::kLanes], b_[RayPacket::kLanes], a_[RayPacket::kLanes];

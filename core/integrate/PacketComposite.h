@@ -15,7 +15,9 @@
 // the same polynomials with the same fused operations inside them).
 //
 // It serves the common case: composite, front to back, trilinear, post-classification by a transfer
-// function without gradient opacity, unshaded. Everything else takes the scalar path.
+// function without gradient opacity, unshaded. Everything else takes the scalar path. Each lane
+// walks its segments with ForwardSegmentWalk (SegmentWalk.h), so empty-space skipping passes over
+// the same segments as in the scalar path.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -25,6 +27,8 @@
 #include "geometry/RayIntervals.h"
 
 namespace volref {
+
+class MacrocellGrid;
 
 // Everything the kernel reads, as plain arrays.
 struct PacketCompositeInputs {
@@ -43,6 +47,7 @@ struct PacketCompositeInputs {
     double step = 1.0;
     bool terminate = false;  // early termination at alpha > threshold
     double threshold = 1.0;
+    const MacrocellGrid* macrocells = nullptr;  // empty-space skipping (SegmentWalk.h), or none
 };
 
 // Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count).

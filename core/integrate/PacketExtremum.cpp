@@ -23,7 +23,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
     const V zero = hn::Zero(d);
     V best = zero, t_best = zero, seen = zero;
-    while (packet.next(in.step)) {
+    while (packet.next()) {
         const V t = hn::Load(d, packet.tm);
         const M alive = hn::Gt(hn::Load(d, packet.live), zero);
         const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
@@ -33,7 +33,6 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
         best = hn::IfThenElse(take, v, best);
         t_best = hn::IfThenElse(take, t, t_best);
         seen = hn::IfThenElse(alive, hn::Set(d, 1.0), seen);
-        packet.advance(in.step);
     }
     HWY_ALIGN double b[RayPacket::kLanes], tb[RayPacket::kLanes], s[RayPacket::kLanes];
     hn::Store(best, d, b);

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/camera/Ray.h"
-#include "core/integrate/Segments.h"
+#include "core/integrate/SegmentWalk.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace volref {
@@ -27,43 +27,19 @@ using DI = hn::RebindToSigned<D>;
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
-// One lane's walk over its intervals and segments.
-struct LaneWalk {
-    const std::vector<Interval>* intervals = nullptr;
-    std::size_t interval = 0;
-    std::int64_t k = 0, n = 0;
-    bool active = false;
-
-    void start(const std::vector<Interval>* ivs, double step) {
-        intervals = ivs;
-        interval = 0;
-        active = !ivs->empty();
-        if (active) {
-            k = 0;
-            n = segment_count((*ivs)[0], step);
-        }
-    }
-    Segment current(double step) const { return segment((*intervals)[interval], step, k, n); }
-    void advance(double step) {
-        if (++k < n) return;
-        if (++interval < intervals->size()) {
-            k = 0;
-            n = segment_count((*intervals)[interval], step);
-        } else {
-            active = false;
-        }
-    }
-};
-
-// The rays of a packet (SoA) and each lane's walk; lanes beyond `count` never become active.
+// The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
+// segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
+// never become active.
 struct RayPacket {
     static constexpr std::size_t kLanes = HWY_LANES(double);
     HWY_ALIGN double ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
     HWY_ALIGN double tm[kLanes], len[kLanes], live[kLanes];
-    LaneWalk walk[kLanes];
+    ForwardSegmentWalk walk[kLanes];
+    bool active[kLanes];
     std::size_t lanes = 0;
 
-    RayPacket(const Ray* rays, const std::vector<Interval>* intervals, int count, double step) {
+    RayPacket(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
+              const MacrocellGrid* grid = nullptr) {
         lanes = hn::Lanes(D());
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
@@ -74,17 +50,18 @@ struct RayPacket {
             dx[l] = r.direction.x;
             dy[l] = r.direction.y;
             dz[l] = r.direction.z;
-            walk[l] = LaneWalk{};
-            if (real) walk[l].start(&intervals[l], step);
+            active[l] = real;
+            if (real) walk[l] = ForwardSegmentWalk(grid, rays[l], intervals[l], step);
         }
     }
-    // Fills tm (midpoints), len (lengths) and live (1/0) for the active lanes' current segments;
-    // false when no lane is active.
-    bool next(double step) {
+    // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live
+    // (1/0); false when no lane is active any more.
+    bool next() {
         bool any = false;
         for (std::size_t l = 0; l < lanes; ++l) {
-            if (walk[l].active) {
-                const Segment s = walk[l].current(step);
+            Segment s;
+            if (active[l] && !walk[l].next(s)) active[l] = false;
+            if (active[l]) {
                 tm[l] = s.midpoint();
                 len[l] = s.length();
                 live[l] = 1.0;
@@ -96,10 +73,6 @@ struct RayPacket {
             }
         }
         return any;
-    }
-    void advance(double step) {
-        for (std::size_t l = 0; l < lanes; ++l)
-            if (walk[l].active) walk[l].advance(step);
     }
 };
 

@@ -50,6 +50,20 @@ double world_step(const RenderSpec& render, const Volume& volume) {
     return render.step * std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
 }
 
+GradientSpec resolve_gradient_cache(GradientSpec spec, const Volume& volume, const Classifier& classifier,
+                                    const ImageSpec& image, double step) {
+    if (!spec.cache_auto) return spec;
+    std::size_t visible = 0;
+    for (double v : volume.values)
+        if (classifier.classify(v, 1.0).opacity > 0.0) ++visible;
+    const double voxels = double(volume.values.size());
+    const double diagonal = glm::length(volume.domain_max() - volume.domain_min());
+    const double per_voxel = double(image.width) * double(image.height) * (diagonal / step) * (double(visible) / voxels) / voxels;
+    spec.cache = per_voxel > conventions::kGradientCacheBreakEven;
+    spec.cache_auto = false;
+    return spec;
+}
+
 namespace {
 
 // Prints "volref: rendering NN%" on stderr every quarter second once a render has run for a second.
@@ -128,7 +142,9 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
     const bool shades = vs.shading.has_value() &&
                         (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
     std::unique_ptr<GradientField> gradient;
-    if (shades || classifier->needs_gradient()) gradient = std::make_unique<GradientField>(sampler, vs.gradient);
+    if (shades || classifier->needs_gradient())
+        gradient = std::make_unique<GradientField>(sampler, resolve_gradient_cache(vs.gradient, volume, *classifier,
+                                                                                  scene.image, step));
     std::unique_ptr<PreClassifiedVolume> preclassified;
     if (vs.classify == VolumeSpec::Classify::Pre)
         preclassified = std::make_unique<PreClassifiedVolume>(sampler, *classifier, gradient.get());

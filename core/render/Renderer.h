@@ -7,6 +7,7 @@
 #include "core/film/Image.h"
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
+#include "transfer/Classifier.h"
 
 namespace volref {
 
@@ -27,5 +28,11 @@ Volume load_volume(const VolumeSpec& spec);
 double world_step(const RenderSpec& render, const Volume& volume);
 
 Image render_scene(const Scene& scene, const RenderOptions& options = {});
+
+// Resolves `"cache": "auto"` (core/Conventions.h, kGradientCacheBreakEven): the expected gradient
+// evaluations per voxel e = pixels (diagonal / step) (visible voxel fraction) / voxels, with a voxel
+// visible when the classifier gives it opacity > 0 at |grad f| = 1; cache iff e > break-even.
+GradientSpec resolve_gradient_cache(GradientSpec spec, const Volume& volume, const Classifier& classifier,
+                                    const ImageSpec& image, double step);
 
 }  // namespace volref

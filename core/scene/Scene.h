@@ -84,6 +84,10 @@ struct GradientSpec {
     enum class Scheme { Default, Central, Forward, Analytic };
     Scheme scheme = Scheme::Default;
     bool cache = false;  // precompute a per-voxel gradient volume and interpolate it
+    // "cache": "auto": cache when the render is expected to evaluate more gradients per voxel than
+    // the measured break-even (core/Conventions.h, kGradientCacheBreakEven). Opt-in only: cached
+    // gradients differ from on-the-fly ones by O(h^2), so the reference never switches silently.
+    bool cache_auto = false;
 };
 
 enum class Interpolation { Nearest, Trilinear, TricubicBSpline, TricubicCatmullRom };

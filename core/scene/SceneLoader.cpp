@@ -414,7 +414,7 @@ ShadingSpec read_shading(const Json& v, const std::string& path, const Context& 
     return s;
 }
 
-// {"scheme": "central" | "forward" | "analytic", "cache": bool} (an extension of the format).
+// {"scheme": "central" | "forward" | "analytic", "cache": bool | "auto"} (an extension of the format).
 GradientSpec read_gradient(const Json& v, const std::string& path, const Context& ctx, Interpolation interpolation) {
     using S = GradientSpec::Scheme;
     ObjectReader r(v, path, ctx);
@@ -428,7 +428,13 @@ GradientSpec read_gradient(const Json& v, const std::string& path, const Context
         r.fail("scheme", "analytic gradients need a tricubic interpolation (\"tricubic-bspline\" or "
                          "\"tricubic-catmull-rom\"); use \"central\" or \"forward\" with \"" +
                              std::string(interpolation == Interpolation::Nearest ? "nearest" : "trilinear") + "\"");
-    g.cache = r.boolean("cache", false);
+    if (const Json* c = r.find("cache"); c && c->is_string()) {
+        if (c->get<std::string>() != "auto")
+            r.fail("cache", "expected true, false or \"auto\", got \"" + c->get<std::string>() + "\"");
+        g.cache_auto = true;
+    } else {
+        g.cache = r.boolean("cache", false);
+    }
     return g;
 }
 

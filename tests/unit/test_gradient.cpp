@@ -4,7 +4,9 @@
 #include <random>
 
 #include "core/grid/ProceduralField.h"
+#include "core/render/Renderer.h"
 #include "core/sample/GradientField.h"
+#include "transfer/TransferFunction.h"
 
 using namespace volref;
 
@@ -78,4 +80,29 @@ TEST(Gradient, AnalyticTricubicInWorldUnits) {
     const GradientField g(s, {GradientSpec::Scheme::Default, false});
     EXPECT_EQ(g.scheme(), GradientSpec::Scheme::Analytic);
     for (double x : {0.3, 0.8, 1.1, 1.2}) EXPECT_NEAR(g.gradient({x, 0, 0}).x, 6.0 * x, 1e-12) << x;
+}
+
+// "cache": "auto": e = pixels (diagonal / step) (visible fraction) / voxels against the break-even 2.
+TEST(Gradient, AutoCacheRule) {
+    FieldSpec g;
+    g.kind = FieldSpec::Kind::Linear;
+    g.coefficients = {1, 0, 0, 0};
+    g.dims = {11, 11, 11};  // values 0..10 along x; diagonal 10 sqrt(3)
+    const Volume v = make_procedural_volume(g, glm::dvec3(0.0), glm::dvec3(1.0));
+    TransferSpec tf;
+    tf.opacity = {{0, 0}, {5, 0}, {5, 1}};  // visible where x >= 5: 6 of 11 columns
+    const TransferFunction t(tf, v);
+    GradientSpec spec;
+    spec.cache_auto = true;
+    ImageSpec image;
+    // 4 x 4 pixels, step 1: e = 16 * 17.32 * (6/11) / 1331 = 0.114 -> no cache.
+    image.width = image.height = 4;
+    EXPECT_FALSE(resolve_gradient_cache(spec, v, t, image, 1.0).cache);
+    // 64 x 64 pixels: e = 4096 * 17.32 * 0.545 / 1331 = 29 -> cache.
+    image.width = image.height = 64;
+    const GradientSpec r = resolve_gradient_cache(spec, v, t, image, 1.0);
+    EXPECT_TRUE(r.cache);
+    EXPECT_FALSE(r.cache_auto);
+    // Not asked: never cached.
+    EXPECT_FALSE(resolve_gradient_cache(GradientSpec{}, v, t, image, 1.0).cache);
 }

@@ -668,6 +668,9 @@ TEST(SceneLoaderGradient, DefaultsAndSchemes) {
         EXPECT_EQ(a.volume.gradient.scheme, GradientSpec::Scheme::Analytic) << interpolation;
         EXPECT_TRUE(a.volume.gradient.cache) << interpolation;
     }
+    const Scene au = parse(volume_with(R"("gradient": {"cache": "auto"})"));
+    EXPECT_TRUE(au.volume.gradient.cache_auto);
+    EXPECT_FALSE(au.volume.gradient.cache);
     // Default stays Default whatever the interpolation (the renderer resolves it).
     const Scene t = parse(volume_with(R"("interpolation": "tricubic-bspline", "gradient": {"cache": true})"));
     EXPECT_EQ(t.volume.gradient.scheme, GradientSpec::Scheme::Default);
@@ -682,7 +685,9 @@ TEST(SceneLoaderGradient, Errors) {
     EXPECT_TRUE(fails_with(volume_with(R"("interpolation": "nearest", "gradient": {"scheme": "analytic"})"),
                            "volume.gradient.scheme", "analytic gradients need a tricubic interpolation"));
     EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"cache": "yes"})"), "volume.gradient.cache",
-                           "expected true or false, got \"yes\""));
+                           "expected true, false or \"auto\", got \"yes\""));
+    EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"cache": 1})"), "volume.gradient.cache",
+                           "expected true or false, got 1"));
     EXPECT_TRUE(fails_with(volume_with(R"("gradient": {"step": 1})"), "volume.gradient.step",
                            "unknown key (expected one of: scheme, cache)"));
 }

@@ -141,3 +141,15 @@ TEST(Simd, MipAndMinipAreBitwiseTheScalarPath) {
         EXPECT_GT(max_alpha, 0.1);
     }
 }
+
+// Empty-space skipping in the packet path (each lane walks with ForwardSegmentWalk) leaves every
+// pixel bitwise as without skipping, as in the scalar path.
+TEST(Simd, SkippingDoesNotChangeThePacketPath) {
+    for (double step : {0.5, 0.37, 1.3}) {
+        Scene s = ml_scene(41, 19);
+        s.render.step = step;
+        const Image on = render_scene(s, {.threads = 1, .empty_space_skipping = true, .simd = true});
+        const Image off = render_scene(s, {.threads = 1, .empty_space_skipping = false, .simd = true});
+        EXPECT_EQ(std::memcmp(on.pixels.data(), off.pixels.data(), on.pixels.size() * sizeof(double)), 0) << step;
+    }
+}

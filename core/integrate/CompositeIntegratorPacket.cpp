@@ -8,10 +8,11 @@ namespace volref {
 CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
     const SamplePipeline& p = ctx.pipeline;
     const auto* tf = dynamic_cast<const TransferFunction*>(&p.classifier());
-    if (!tf || tf->needs_gradient() || p.shaded() || p.preclassified() ||
-        p.sampler().interpolation() != Interpolation::Trilinear || ctx.render.order != CompositeOrder::FrontToBack)
+    const VolumeSampler* sampler = p.cartesian_sampler();
+    if (!tf || !sampler || tf->needs_gradient() || p.shaded() || p.preclassified() ||
+        sampler->interpolation() != Interpolation::Trilinear || ctx.render.order != CompositeOrder::FrontToBack)
         return;
-    const Volume& v = p.sampler().volume();
+    const Volume& v = sampler->volume();
     PacketCompositeInputs in;
     in.voxels = v.values.data();
     for (int a = 0; a < 3; ++a) {

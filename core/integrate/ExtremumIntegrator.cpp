@@ -5,9 +5,9 @@
 namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
-    const VolumeSampler& sampler = ctx.pipeline.sampler();
-    if (sampler.interpolation() != Interpolation::Trilinear) return;
-    const Volume& v = sampler.volume();
+    const VolumeSampler* sampler = ctx.pipeline.cartesian_sampler();
+    if (!sampler || sampler->interpolation() != Interpolation::Trilinear) return;
+    const Volume& v = sampler->volume();
     PacketExtremumInputs in;
     in.voxels = v.values.data();
     for (int a = 0; a < 3; ++a) {

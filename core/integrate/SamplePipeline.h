@@ -24,7 +24,7 @@ struct PipelineSample {
 class SamplePipeline {
 public:
     // `gradient`, `preclassified` and `shader` may be null (not used by the scene).
-    SamplePipeline(const VolumeSampler& sampler, const Classifier& classifier, const GradientField* gradient,
+    SamplePipeline(const FieldSampler& sampler, const Classifier& classifier, const GradientSource* gradient,
                    const PreClassifiedVolume* preclassified, const Shader* shader)
         : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader) {}
 
@@ -56,14 +56,16 @@ public:
     }
 
     const Classifier& classifier() const { return classifier_; }
-    const VolumeSampler& sampler() const { return sampler_; }
+    const FieldSampler& sampler() const { return sampler_; }
+    // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
+    const VolumeSampler* cartesian_sampler() const { return dynamic_cast<const VolumeSampler*>(&sampler_); }
     bool shaded() const { return shader_ != nullptr; }
     bool preclassified() const { return pre_ != nullptr; }
 
 private:
-    const VolumeSampler& sampler_;
+    const FieldSampler& sampler_;
     const Classifier& classifier_;
-    const GradientField* gradient_;
+    const GradientSource* gradient_;
     const PreClassifiedVolume* pre_;
     const Shader* shader_;
 };

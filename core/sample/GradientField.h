@@ -17,17 +17,18 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/sample/FieldSampler.h"
 #include "core/sample/VolumeSampler.h"
 #include "core/scene/Scene.h"
 
 namespace volref {
 
-class GradientField {
+class GradientField final : public GradientSource {
 public:
     GradientField(const VolumeSampler& sampler, GradientSpec spec);
     ~GradientField();
 
-    glm::dvec3 gradient(const glm::dvec3& world) const;
+    glm::dvec3 gradient(const glm::dvec3& world) const override;
     // The scheme after resolving Default (analytic for tricubic kernels, central otherwise).
     GradientSpec::Scheme scheme() const { return scheme_; }
 

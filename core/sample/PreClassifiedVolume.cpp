@@ -9,7 +9,7 @@
 namespace volref {
 
 PreClassifiedVolume::PreClassifiedVolume(const VolumeSampler& sampler, const Classifier& classifier,
-                                         const GradientField* gradient) {
+                                         const GradientSource* gradient) {
     const Volume& v = sampler.volume();
     for (Volume& c : channels_) {
         c.dims = v.dims;

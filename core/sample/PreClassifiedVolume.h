@@ -20,7 +20,7 @@ namespace volref {
 class PreClassifiedVolume {
 public:
     // `gradient` may be null when the classifier does not need it.
-    PreClassifiedVolume(const VolumeSampler& sampler, const Classifier& classifier, const GradientField* gradient);
+    PreClassifiedVolume(const VolumeSampler& sampler, const Classifier& classifier, const GradientSource* gradient);
     ~PreClassifiedVolume();
     Classified sample(const glm::dvec3& world) const;
 

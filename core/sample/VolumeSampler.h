@@ -16,16 +16,17 @@
 #include <glm/vec3.hpp>
 
 #include "core/grid/Volume.h"
+#include "core/sample/FieldSampler.h"
 #include "core/sample/Trilinear.h"
 #include "core/scene/Scene.h"
 
 namespace volref {
 
-class VolumeSampler {
+class VolumeSampler final : public FieldSampler {
 public:
     VolumeSampler(const Volume& volume, Interpolation interpolation);
 
-    double value(const glm::dvec3& world) const {
+    double value(const glm::dvec3& world) const override {
         switch (interpolation_) {
             case Interpolation::Nearest: return nearest(world);
             case Interpolation::Trilinear: return trilinear(world);

@@ -113,6 +113,8 @@ private:
 // be tiny).
 bool skipping_applies(const Scene& scene, const Classifier& classifier, const Volume& volume) {
     const VolumeSpec& vs = scene.volume;
+    if (vs.bounds.type != BoundsSpec::Type::Box)
+        throw Error("volume.bounds.type: mesh and shell bounds are not rendered yet (the renderer side of issue 5)");
     if (scene.render.projection != Projection::Composite) return false;
     if (vs.classification && vs.classification->type == ClassificationSpec::Type::Isovalue) return false;
     if (!classifier.needs_gradient()) return true;

@@ -12,6 +12,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "geometry/ShellSpec.h"
+
 namespace volref {
 
 // A procedural field sampled at the grid's vertices (scene-format.md, volume.source.field).
@@ -93,9 +95,13 @@ struct GradientSpec {
 enum class Interpolation { Nearest, Trilinear, TricubicBSpline, TricubicCatmullRom };
 
 struct BoundsSpec {
-    enum class Type { Box };
+    enum class Type { Box, Mesh, Cylindrical, Spherical };
     Type type = Type::Box;
     std::optional<glm::dvec3> min, max;  // box: absent = the volume's domain
+    std::filesystem::path mesh;          // mesh: a closed triangle mesh (.obj, .ply), absolute
+    CylindricalShell cylinder;           // cylindrical shell (the grid is in beam space)
+    SphericalShell sphere;               // spherical shell (the grid is in beam space)
+    int tessellate = 0;                  // shells: > 0 = use a triangle mesh of about this many segments per turn
 };
 
 struct VolumeSpec {

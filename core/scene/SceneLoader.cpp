@@ -293,11 +293,86 @@ VolumeSourceSpec read_source(const Json& v, const std::string& path, const Conte
 }
 
 // {"type": "box", "min": [3], "max": [3]}: min < max on every axis when both are given.
-BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ctx) {
+// [lo, hi] with lo < hi, each in `range`.
+std::array<double, 2> read_range(ObjectReader& r, std::string_view key, std::array<double, 2> fallback,
+                                 const Range& range = {}) {
+    const Json* j = r.find(key);
+    if (!j) return fallback;
+    const std::vector<double> x = read_numbers(*j, r.path(key), r.context(), 2, range);
+    if (!(x[0] < x[1])) r.fail(key, "expected [lo, hi] with lo < hi, got " + describe(*j));
+    return {x[0], x[1]};
+}
+
+// Angles [a0, a1] in degrees with a0 < a1 <= a0 + 360 (a full turn when a1 - a0 = 360).
+std::array<double, 2> read_angle_range(ObjectReader& r, std::string_view key) {
+    const std::array<double, 2> a = read_range(r, key, {0.0, 360.0});
+    if (a[1] - a[0] > 360.0) r.fail(key, "expected a range of at most 360 degrees");
+    return a;
+}
+
+BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     using T = BoundsSpec::Type;
     ObjectReader r(v, path, ctx);
     BoundsSpec b;
-    b.type = r.choice<T>("type", T::Box, {{"box", T::Box}}, {"mesh", "cylindrical", "spherical"});
+    b.type = r.choice<T>("type", T::Box,
+                         {{"box", T::Box}, {"mesh", T::Mesh}, {"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
+    const Range radius = Range::non_negative();
+    switch (b.type) {
+        case T::Box: break;
+        case T::Mesh:
+            r.allow({"type", "file"}, "for bounds type \"mesh\"");
+            b.mesh = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
+            return b;
+        case T::Cylindrical: {
+            r.allow({"type", "center", "radius", "angle", "height", "tessellate"}, "for bounds type \"cylindrical\"");
+            CylindricalShell& c = b.cylinder;
+            c.center = r.vec3("center", glm::dvec3(0.0));
+            const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
+            const auto a = read_angle_range(r, "angle");
+            const auto h = read_range(r, "height", {0.0, 1.0});
+            c.r0 = rr[0];
+            c.r1 = rr[1];
+            c.a0 = a[0];
+            c.a1 = a[1];
+            c.h0 = h[0];
+            c.h1 = h[1];
+            b.tessellate = int(r.integer("tessellate", 0, Range::at_least(3)));
+            return b;
+        }
+        case T::Spherical: {
+            r.allow({"type", "center", "radius", "longitude", "latitude", "axes", "tessellate"},
+                    "for bounds type \"spherical\"");
+            SphericalShell& s = b.sphere;
+            s.center = r.vec3("center", glm::dvec3(0.0));
+            const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
+            const auto lon = read_angle_range(r, "longitude");
+            const auto lat = read_range(r, "latitude", {-90.0, 90.0}, Range::closed(-90.0, 90.0));
+            s.r0 = rr[0];
+            s.r1 = rr[1];
+            s.lon0 = lon[0];
+            s.lon1 = lon[1];
+            s.lat0 = lat[0];
+            s.lat1 = lat[1];
+            if (const Json* ax = r.find("axes")) {
+                const std::string p = r.path("axes");
+                if (!ax->is_array() || ax->size() != 3)
+                    ctx.fail(p, "expected 3 names, a permutation of \"longitude\", \"latitude\", \"radius\"");
+                std::array<bool, 3> used{false, false, false};
+                for (std::size_t i = 0; i < 3; ++i) {
+                    const Json& e = (*ax)[i];
+                    const std::string ep = p + "[" + std::to_string(i) + "]";
+                    const std::string name = e.is_string() ? e.get<std::string>() : "";
+                    const int k = name == "longitude" ? 0 : name == "latitude" ? 1 : name == "radius" ? 2 : -1;
+                    if (k < 0) ctx.fail(ep, "expected \"longitude\", \"latitude\" or \"radius\", got " + describe(e));
+                    if (used[std::size_t(k)]) ctx.fail(ep, "\"" + name + "\" is given twice");
+                    used[std::size_t(k)] = true;
+                    s.axes[i] = k;
+                }
+            }
+            b.tessellate = int(r.integer("tessellate", 0, Range::at_least(3)));
+            return b;
+        }
+    }
     r.allow({"type", "min", "max"}, "for bounds type \"box\"");
     b.min = r.optional_vec3("min");
     b.max = r.optional_vec3("max");
@@ -458,7 +533,7 @@ VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ct
                                                   {"tricubic-catmull-rom", Interpolation::TricubicCatmullRom}});
     using C = VolumeSpec::Classify;
     spec.classify = r.choice<C>("classify", C::Post, {{"post", C::Post}, {"pre", C::Pre}});
-    if (const Json* b = r.find("bounds")) spec.bounds = read_bounds(*b, r.path("bounds"), ctx);
+    if (const Json* b = r.find("bounds")) spec.bounds = read_bounds(*b, r.path("bounds"), ctx, base_dir);
     const Json* transfer = r.find("transfer");
     const Json* classification = r.find("classification");
     if (transfer && classification)

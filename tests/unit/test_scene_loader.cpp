@@ -877,10 +877,6 @@ TEST(SceneLoaderErrors, Sources) {
 }
 
 TEST(SceneLoaderErrors, NotImplementedYet) {
-    for (const char* type : {"mesh", "cylindrical", "spherical"})
-        EXPECT_TRUE(fails_with(volume_with(std::string(R"("bounds": {"type": ")") + type + "\"}"), "volume.bounds.type",
-                               "is not implemented yet"))
-            << type;
     EXPECT_TRUE(fails_with(volume_with(R"("transform": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1])"), "volume.transform",
                            "not implemented yet"));
     EXPECT_TRUE(fails_with(volume_with(R"("clip_planes": [])"), "volume.clip_planes", "not implemented yet"));
@@ -1137,5 +1133,50 @@ TEST(SceneLoaderFiles, ValidationErrorNamesFile) {
     EXPECT_EQ(error_of([&] { load_scene(file); }), file.string() + ": render.step: expected a number > 0, got 0");
 }
 
+
+TEST(SceneLoaderBounds, ShellsAndMeshes) {
+    const Scene c = parse(volume_with(
+        R"("bounds": {"type": "cylindrical", "center": [1, 2, 3], "radius": [0.5, 2], "angle": [300, 420], "height": [-1, 1], "tessellate": 64})"));
+    EXPECT_EQ(c.volume.bounds.type, BoundsSpec::Type::Cylindrical);
+    EXPECT_EQ(c.volume.bounds.cylinder.center, glm::dvec3(1, 2, 3));
+    EXPECT_EQ(c.volume.bounds.cylinder.r0, 0.5);
+    EXPECT_EQ(c.volume.bounds.cylinder.a1, 420.0);
+    EXPECT_EQ(c.volume.bounds.cylinder.h0, -1.0);
+    EXPECT_EQ(c.volume.bounds.tessellate, 64);
+    const Scene d = parse(volume_with(R"("bounds": {"type": "cylindrical"})"));
+    EXPECT_EQ(d.volume.bounds.cylinder.r1, 1.0);
+    EXPECT_EQ(d.volume.bounds.cylinder.a1, 360.0);
+    EXPECT_EQ(d.volume.bounds.tessellate, 0);
+    const Scene s = parse(volume_with(
+        R"("bounds": {"type": "spherical", "radius": [1, 2], "longitude": [0, 90], "latitude": [-30, 60], "axes": ["radius", "longitude", "latitude"]})"));
+    EXPECT_EQ(s.volume.bounds.type, BoundsSpec::Type::Spherical);
+    EXPECT_EQ(s.volume.bounds.sphere.lat0, -30.0);
+    EXPECT_EQ(s.volume.bounds.sphere.lon1, 90.0);
+    EXPECT_EQ(s.volume.bounds.sphere.axes, (std::array<int, 3>{2, 0, 1}));
+    const Scene m = parse(volume_with(R"("bounds": {"type": "mesh", "file": "shape.obj"})"));
+    EXPECT_EQ(m.volume.bounds.type, BoundsSpec::Type::Mesh);
+    EXPECT_EQ(m.volume.bounds.mesh.filename(), "shape.obj");
+    EXPECT_TRUE(m.volume.bounds.mesh.is_absolute());
+}
+
+TEST(SceneLoaderBounds, Errors) {
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [2, 1]})"), "volume.bounds.radius",
+                           "lo < hi"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [-1, 1]})"),
+                           "volume.bounds.radius[0]", ">= 0"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "angle": [0, 400]})"), "volume.bounds.angle",
+                           "at most 360"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "latitude": [-100, 0]})"),
+                           "volume.bounds.latitude[0]", ""));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "axes": ["radius", "radius", "latitude"]})"),
+                           "volume.bounds.axes[1]", "given twice"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "height": [0, 1]})"), "volume.bounds.height",
+                           "unknown key"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "mesh"})"), "volume.bounds.file", "required"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "box", "tessellate": 8})"), "volume.bounds.tessellate",
+                           "unknown key"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "tessellate": 2})"),
+                           "volume.bounds.tessellate", ""));
+}
 }  // namespace
 }  // namespace volref

@@ -5,6 +5,7 @@
 #   bench/scaling.sh                 # about 6 min on 2 idle cores
 #   RUNS=1 bench/scaling.sh          # one run per case instead of 3 (a quick look)
 #   VOLREF=/path/to/volref bench/scaling.sh
+#   WAIT_IDLE=0 bench/scaling.sh     # do not wait for an idle machine before each render (default: up to 30 s)
 #
 # The scene: a procedural Marschner-Lobb volume (fm 6, alpha 0.25; doubles, 8 B per voxel), the 5-row
 # transfer function of reference_scenes/default.json, trilinear, composite front to back, step 0.5 voxel,
@@ -20,12 +21,18 @@
 # "cast" is render minus the median setup time of the same volume and thread count (the ray casting);
 # "process" is the wall-clock time of the whole command; peak RSS is /usr/bin/time's %M (the maximum over
 # the runs of a case). Medians of RUNS. The raw results are kept in $OUT (default: a temporary file,
-# named at the end).
+# named at the end), with the CPU time of each run and the idle fraction of the machine just before it.
+#
+# On a shared machine: before each render the script waits (at most WAIT_IDLE seconds, default 30) until
+# the CPUs were at least 90% idle over one second (from /proc/stat), so that a render does not start in
+# the middle of someone else's build. It cannot stop load that starts during a render: compare the
+# runs' spread, and the CPU time with the render time of the 1-thread runs, in the raw results.
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VOLREF=${VOLREF:-$here/build/cli/volref}
 RUNS=${RUNS:-3}
+WAIT_IDLE=${WAIT_IDLE:-30}
 TIME=/usr/bin/time
 if [[ ! -x $VOLREF ]]; then
     echo "scaling.sh: $VOLREF not found: build it first (cmake --build build --target volref_cli)" >&2
@@ -55,18 +62,40 @@ cat > "$work/ml.json" <<'EOF'
 }
 EOF
 
-# One render: appends "dims size threads run render_s process_s rss_kib" to $OUT.
+# The fraction of the CPUs' time spent idle over the next second.
+idle_fraction() {
+    local a b
+    a=$(awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat)
+    sleep 1
+    b=$(awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat)
+    awk -v a="$a" -v b="$b" 'BEGIN { split(a, x, " "); split(b, y, " "); d = y[2] - x[2]; printf "%.2f", d > 0 ? (y[1] - x[1]) / d : 1 }'
+}
+
+# Waits until the machine is idle (>= 90% over a second), at most WAIT_IDLE seconds; prints the last
+# idle fraction.
+wait_idle() {
+    local deadline=$((SECONDS + WAIT_IDLE)) f=1
+    while ((WAIT_IDLE > 0)); do
+        f=$(idle_fraction)
+        if awk -v f="$f" 'BEGIN { exit !(f >= 0.9) }' || ((SECONDS >= deadline)); then break; fi
+    done
+    echo "$f"
+}
+
+# One render: appends "dims size threads run render_s process_s rss_kib cpu_s idle_before" to $OUT.
 run() {
-    local dims=$1 size=$2 threads=$3 rep=$4 seconds wall rss
-    "$TIME" -f '%e %M' -o "$work/time.txt" "$VOLREF" render "$work/ml.json" -o "$work/out.exr" --threads "$threads" \
+    local dims=$1 size=$2 threads=$3 rep=$4 seconds wall rss cpu idle
+    idle=$(wait_idle)
+    "$TIME" -f '%e %M %U %S' -o "$work/time.txt" "$VOLREF" render "$work/ml.json" -o "$work/out.exr" --threads "$threads" \
         --set "volume.source.dims=[$dims,$dims,$dims]" --set "image.width=$size" --set "image.height=$size" \
         > /dev/null 2> "$work/err.txt" || { cat "$work/err.txt" "$work/time.txt" >&2; exit 1; }
     seconds=$(sed -n 's/^volref: rendered [0-9]*x[0-9]* in \([0-9.]*\) s$/\1/p' "$work/err.txt")
     if [[ -z $seconds ]]; then cat "$work/err.txt" >&2; exit 1; fi
-    read -r wall rss < "$work/time.txt"
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$dims" "$size" "$threads" "$rep" "$seconds" "$wall" "$rss" >> "$OUT"
-    printf '  %4s^3 %4s^2 %s thread(s): %7.3f s render, %7.2f s process, %6d MiB peak RSS\n' \
-        "$dims" "$size" "$threads" "$seconds" "$wall" "$((rss / 1024))" >&2
+    read -r wall rss user sys < "$work/time.txt"
+    cpu=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$dims" "$size" "$threads" "$rep" "$seconds" "$wall" "$rss" "$cpu" "$idle" >> "$OUT"
+    printf '  %4s^3 %4s^2 %s thread(s): %7.3f s render, %7.2f s process, %6.2f s CPU, %6d MiB peak RSS (idle before: %s)\n' \
+        "$dims" "$size" "$threads" "$seconds" "$wall" "$cpu" "$((rss / 1024))" "$idle" >&2
 }
 
 # The resident memory of the program and its libraries alone (no scene).
@@ -139,4 +168,4 @@ END {
     }
 }' "$OUT"
 echo
-echo "raw results (dims size threads run render_s process_s rss_kib): $OUT"
+echo "raw results (dims size threads run render_s process_s rss_kib cpu_s idle_before): $OUT"

@@ -23,6 +23,24 @@ int main(int argc, char** argv) {
     rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
         ->take_all();
 
+    volref::cli::ResampleArgs resample;
+    CLI::App* rs = app.add_subcommand(
+        "resample", "Resample a volume between Cartesian and beam-space (cylindrical, spherical) grids; writes NRRD");
+    rs->add_option("input", resample.input, "Input volume (.nrrd, .nhdr, .raw)")->required();
+    rs->add_option("output", resample.output, "Output volume (.nrrd)")->required();
+    rs->add_option("--to", resample.to, "Output grid: cylindrical, spherical or cartesian")->required();
+    rs->add_option("--dims", resample.dims, "Output grid size NX,NY,NZ (a shell's in its grid-axis order)")->required();
+    rs->add_option("--shell", resample.shell,
+                   "The shell as JSON text or a JSON file (scene volume.bounds); --to cartesian: default IN's volref_bounds");
+    rs->add_option("--interpolation", resample.interpolation,
+                   "nearest, trilinear (default), tricubic-bspline, tricubic-catmull-rom");
+    rs->add_option("--origin", resample.origin, "--to cartesian: X,Y,Z of voxel (0,0,0) (with --spacing)");
+    rs->add_option("--spacing", resample.spacing, "--to cartesian: SX,SY,SZ (default: the shell's bounding box)");
+    rs->add_option("--fill", resample.fill, "Value of samples outside the source (default 0)");
+    rs->add_option("--type", resample.type, "Output type: f64 (default) or f32");
+    rs->add_option("--encoding", resample.encoding, "Output encoding: raw (default) or gzip");
+    rs->add_option("--format", resample.format, "Input format: nrrd or raw (default: from the extension)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -31,6 +49,7 @@ int main(int argc, char** argv) {
     }
     try {
         if (rc->parsed()) return volref::cli::run_render(render);
+        if (rs->parsed()) return volref::cli::run_resample(resample);
     } catch (const volref::Error& e) {
         std::fprintf(stderr, "volref: error: %s\n", e.what());
         return 1;

@@ -6,6 +6,8 @@ packages=(
   libembree-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev zlib1g-dev
   # openimageio-tools: OpenImageIO's CMake package lists its command-line tools and fails without them
   libhwy-dev libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # bounding meshes: OBJ (tinyobjloader, its double-precision build) and PLY (assimp)
+  libtinyobjloader-dev libassimp-dev
 )
 missing=()
 for p in "${packages[@]}"; do

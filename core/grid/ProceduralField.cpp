@@ -15,8 +15,8 @@ double marschner_lobb_coordinate(std::int64_t i, std::int64_t n) {
     return n == 1 ? 0.0 : -1.0 + 2.0 * double(i) / double(n - 1);
 }
 
-double field_value(const FieldSpec& f, const Volume& v, std::int64_t i, std::int64_t j, std::int64_t k) {
-    const glm::dvec3 p = v.voxel_position(i, j, k);
+double field_value(const FieldSpec& f, const Volume& v, const glm::dvec3& p, std::int64_t i, std::int64_t j,
+                   std::int64_t k) {
     switch (f.kind) {
         case FieldSpec::Kind::Constant: return f.value;
         case FieldSpec::Kind::Linear:
@@ -43,10 +43,18 @@ double field_value(const FieldSpec& f, const Volume& v, std::int64_t i, std::int
 }  // namespace
 
 Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing) {
-    Volume v;
-    v.dims = field.dims;
+    Volume v = make_procedural_volume(field, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+        return origin + glm::dvec3(double(i), double(j), double(k)) * spacing;
+    });
     v.origin = origin;
     v.spacing = spacing;
+    return v;
+}
+
+Volume make_procedural_volume(const FieldSpec& field,
+                              const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position) {
+    Volume v;
+    v.dims = field.dims;
     v.type = ScalarType::F64;
     const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims");
     if (field.kind == FieldSpec::Kind::Cells && field.values.size() != count)
@@ -55,7 +63,7 @@ Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, 
     v.values.resize(count);
     for (std::int64_t k = 0; k < v.dims[2]; ++k)
         for (std::int64_t j = 0; j < v.dims[1]; ++j)
-            for (std::int64_t i = 0; i < v.dims[0]; ++i) v.values[v.index(i, j, k)] = field_value(field, v, i, j, k);
+            for (std::int64_t i = 0; i < v.dims[0]; ++i) v.values[v.index(i, j, k)] = field_value(field, v, position(i, j, k), i, j, k);
     return v;
 }
 

@@ -1,5 +1,6 @@
 // Procedural fields sampled at a grid's vertices (scene-format.md, volume.source.field).
 #pragma once
+#include <functional>
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
 
@@ -15,5 +16,10 @@ namespace volref {
 //   gaussian        f = amplitude exp(-|p - center|^2 / (2 sigma^2))
 //   cells           f = values[i + nx (j + ny k)]
 Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing);
+
+// The same with the world position of sample (i, j, k) given by `position` (beam-space grids:
+// ShellGrid::sample_position); origin and spacing are left at 0 and 1.
+Volume make_procedural_volume(const FieldSpec& field,
+                              const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position);
 
 }  // namespace volref

@@ -310,10 +310,8 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
                 for (int y = y0; y < std::min(y0 + T, H); ++y)
                     for (int xs = x0; xs < x_end; xs += kMaxPacketRays) {
                         const int count = std::min(kMaxPacketRays, x_end - xs);
-                        for (int i = 0; i < count; ++i) {
-                            rays[i] = camera.pixel_ray(xs + i, y);
-                            geometry.intervals(rays[i], volume_id, intervals[i]);
-                        }
+                        for (int i = 0; i < count; ++i) rays[i] = camera.pixel_ray(xs + i, y);
+                        geometry.intervals(rays, count, volume_id, intervals);  // Embree packets
                         if (options.simd)
                             integrator->integrate_packet(rays, intervals, values, count);
                         else

@@ -10,6 +10,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/Error.h"
+#include "core/io/OutputFile.h"
 
 namespace volref {
 
@@ -52,24 +53,13 @@ std::vector<T> quantised_over_background(const Image& image, const glm::dvec4& b
 
 void check_output_path(const fs::path& path) {
     format_of(path);
-    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec))
-        throw Error(path.string() + ": the output folder " + dir.string() + " does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-        throw Error(path.string() + ": the output folder " + dir.string() + " is not writable");
-    if (fs::is_directory(path, ec)) throw Error(path.string() + ": is a folder");
+    check_output_folder(path);
 }
 
 void write_image(const Image& image, const fs::path& path, const glm::dvec4& background) {
     check_output_path(path);
     const Format format = format_of(path);
-    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-    // ".NAME.volref-tmp-PID.EXT": hidden, unique per process, same extension (OIIO picks the format by it).
-    std::string tmp_name(".");
-    tmp_name.append(path.stem().string()).append(".volref-tmp-").append(std::to_string(::getpid()));
-    tmp_name.append(path.extension().string());
-    const fs::path tmp = dir / tmp_name;
+    const fs::path tmp = temporary_output_path(path);
 
     auto out = OIIO::ImageOutput::create(tmp.string());
     if (!out) throw Error(path.string() + ": cannot create an image writer: " + OIIO::geterror());

@@ -47,6 +47,15 @@ struct Volume {
     }
     // [min, max] of the stored values.
     std::array<double, 2> value_range() const;
+    // A volume on the same grid (dims, origin, spacing), type f64, every value 0.
+    Volume same_grid() const {
+        Volume v;
+        v.dims = dims;
+        v.origin = origin;
+        v.spacing = spacing;
+        v.values.assign(values.size(), 0.0);
+        return v;
+    }
 };
 
 // Checks that every dim is >= 1 and that their product (and its size in bytes as double) does not

@@ -17,6 +17,7 @@
 #include <zlib.h>
 
 #include "core/Error.h"
+#include "core/io/OutputFile.h"
 
 namespace fs = std::filesystem;
 
@@ -168,13 +169,7 @@ void check_nrrd_output_path(const fs::path& path) {
         throw Error(path.string() + ": the output must be a .nrrd file (got " +
                     (path.extension().empty() ? std::string("no extension") : "'" + path.extension().string() + "'") +
                     ")");
-    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec))
-        throw Error(path.string() + ": the output folder " + dir.string() + " does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-        throw Error(path.string() + ": the output folder " + dir.string() + " is not writable");
-    if (fs::is_directory(path, ec)) throw Error(path.string() + ": is a folder");
+    check_output_folder(path);
 }
 
 void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptions& options) {
@@ -202,11 +197,7 @@ void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptio
         }
     }
 
-    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-    // ".NAME.volref-tmp-PID.nrrd" (built by appending: GCC 12 warns falsely on "." + std::string).
-    std::string tmp_name(".");
-    tmp_name.append(path.stem().string()).append(".volref-tmp-").append(std::to_string(::getpid())).append(".nrrd");
-    const fs::path tmp = dir / tmp_name;
+    const fs::path tmp = temporary_output_path(path);
     std::error_code ec;
     try {
         std::unique_ptr<std::FILE, FileCloser> file(std::fopen(tmp.c_str(), "wb"));

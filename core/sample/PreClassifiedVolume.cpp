@@ -11,13 +11,7 @@ namespace volref {
 PreClassifiedVolume::PreClassifiedVolume(const VolumeSampler& sampler, const Classifier& classifier,
                                          const GradientSource* gradient) {
     const Volume& v = sampler.volume();
-    for (Volume& c : channels_) {
-        c.dims = v.dims;
-        c.origin = v.origin;
-        c.spacing = v.spacing;
-        c.type = ScalarType::F64;
-        c.values.resize(v.values.size());
-    }
+    for (Volume& c : channels_) c = v.same_grid();
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
         for (std::int64_t k = r.begin(); k != r.end(); ++k)
             for (std::int64_t j = 0; j < v.dims[1]; ++j)

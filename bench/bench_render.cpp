@@ -1,14 +1,21 @@
 // bench_render: whole renders through render_scene at 1 and 2 threads (docs/performance.md, "Whole
 // renders").
 //
-// Scenes (render/<scene>/threads:<n>, wall-clock time, RenderOptions{threads = n}):
+// Benchmarks render/<scene>/<path>/threads:<n>, wall-clock time, RenderOptions{threads = n} and
+//   full         the defaults: SIMD packets of 16 rays and empty-space skipping (1 and 2 threads)
+//   no_skipping  SIMD packets, every segment sampled (empty_space_skipping = false; 1 thread)
+//   scalar       one ray at a time, every segment sampled (simd = false, empty_space_skipping = false;
+//                1 thread): the reference path as it was before packets and skipping
+// The image is the same bits on every path (tested elsewhere), so only the time differs.
+//
+// Scenes:
 //   default      reference_scenes/default.json as the loader reads it: Marschner-Lobb 64^3, trilinear,
 //                5-row transfer function, perspective camera, 512 x 512, composite, step 0.5 voxel
 //   ml256        the same scene with a 256^3 Marschner-Lobb volume (128 MiB of doubles) and the default
 //                camera (bounding sphere in view): the scene bench/scaling.sh renders at 512 x 512
 //   ml256_setup  ml256 at 1 x 1 pixel: the fixed cost inside render_scene (generating the procedural
-//                volume on one thread, Embree scene, camera, thread arena); ml256 minus this is the
-//                ray casting itself
+//                volume on one thread, the macrocell grid when skipping, Embree scene, camera, thread
+//                arena); ml256 minus this (on the same path) is the ray casting itself
 //   shaded       reference_scenes/shaded-composite.json: 64^3, tricubic Catmull-Rom with the analytic
 //                gradient, gradient opacity, Blinn-Phong under two lights, 512 x 512
 // The scene files are read from VOLREF_SOURCE_DIR (a compile definition: the source tree).
@@ -18,9 +25,11 @@
 //
 // Samples: the number of ray samples of a render is the sum over pixels of the segment counts of the
 // pixel's intervals (Segments.h: max(1, ceil(L / h - slack)) per interval), which is what the composite
-// integrator samples when early termination is off (it is, in these scenes). It is counted once per scene
-// in a separate pass, outside timing, with the renderer's own pieces: the same Camera, the same
-// BoundingGeometry (box = the volume's domain) and the same world step. Counters:
+// integrator samples when early termination is off (it is, in these scenes) and nothing is skipped. It is
+// counted once per scene in a separate pass, outside timing, with the renderer's own pieces: the same
+// Camera, the same BoundingGeometry (box = the volume's domain) and the same world step. With empty-space
+// skipping ("full") fewer segments are actually sampled; samples/s still counts all of them (the work a
+// render without skipping would do per second), so it compares the paths on the same scale. Counters:
 //   items_per_second               pixels per second (wall clock)
 //   samples_per_second             ray samples per second (wall clock)
 //   samples_per_second_per_thread  the same divided by the thread count (per core, on 2 cores)
@@ -111,38 +120,46 @@ const SampleCount& samples(const std::string& name) {
     return it->second;
 }
 
-void register_render(const std::string& name) {
-    for (const int threads : {1, 2}) {
-        const std::string bench = "render/" + name + "/threads:" + std::to_string(threads);
-        benchmark::RegisterBenchmark(bench.c_str(), [name, threads](benchmark::State& state) {
-            const Scene& s = scene(name);
-            const SampleCount& count = samples(name);  // counted before timing
-            volref::RenderOptions options;
-            options.threads = threads;
-            for (auto _ : state) {
-                const volref::Image image = volref::render_scene(s, options);
-                benchmark::DoNotOptimize(image.pixels.data());
-                benchmark::ClobberMemory();
-            }
-            const double iterations = double(state.iterations());
-            const auto pixels = std::int64_t(s.image.width) * std::int64_t(s.image.height);
-            state.SetItemsProcessed(std::int64_t(state.iterations()) * pixels);
-            state.counters["samples_per_second"] =
-                benchmark::Counter(iterations * double(count.samples), benchmark::Counter::kIsRate);
-            state.counters["samples_per_second_per_thread"] =
-                benchmark::Counter(iterations * double(count.samples) / threads, benchmark::Counter::kIsRate);
-            state.counters["samples"] = double(count.samples);
-            state.counters["hit_pixels"] = double(count.hit_pixels);
-        })
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
-    }
+enum class Path { Full, NoSkipping, Scalar };
+
+void register_render(const std::string& name, Path path, int threads) {
+    const char* path_name = path == Path::Full ? "full" : path == Path::NoSkipping ? "no_skipping" : "scalar";
+    const std::string bench = "render/" + name + "/" + path_name + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(bench.c_str(), [name, path, threads](benchmark::State& state) {
+        const Scene& s = scene(name);
+        const SampleCount& count = samples(name);  // counted before timing
+        volref::RenderOptions options;
+        options.threads = threads;
+        options.simd = path != Path::Scalar;
+        options.empty_space_skipping = path == Path::Full;
+        for (auto _ : state) {
+            const volref::Image image = volref::render_scene(s, options);
+            benchmark::DoNotOptimize(image.pixels.data());
+            benchmark::ClobberMemory();
+        }
+        const double iterations = double(state.iterations());
+        const auto pixels = std::int64_t(s.image.width) * std::int64_t(s.image.height);
+        state.SetItemsProcessed(std::int64_t(state.iterations()) * pixels);
+        state.counters["samples_per_second"] =
+            benchmark::Counter(iterations * double(count.samples), benchmark::Counter::kIsRate);
+        state.counters["samples_per_second_per_thread"] =
+            benchmark::Counter(iterations * double(count.samples) / threads, benchmark::Counter::kIsRate);
+        state.counters["samples"] = double(count.samples);
+        state.counters["hit_pixels"] = double(count.hit_pixels);
+    })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    for (const char* name : {"default", "ml256", "ml256_setup", "shaded"}) register_render(name);
+    for (const char* name : {"default", "ml256", "ml256_setup", "shaded"}) {
+        register_render(name, Path::Full, 1);
+        register_render(name, Path::Full, 2);
+        register_render(name, Path::NoSkipping, 1);  // for ml256_setup: without building the macrocell grid
+        if (std::string(name) != "ml256_setup") register_render(name, Path::Scalar, 1);
+    }
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();

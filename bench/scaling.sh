@@ -68,7 +68,7 @@ idle_fraction() {
     a=$(awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat)
     sleep 1
     b=$(awk '/^cpu /{print $5 + $6, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat)
-    awk -v a="$a" -v b="$b" 'BEGIN { split(a, x, " "); split(b, y, " "); d = y[2] - x[2]; printf "%.2f", d > 0 ? (y[1] - x[1]) / d : 1 }'
+    awk -v a="$a" -v b="$b" 'BEGIN { split(a, x, " "); split(b, y, " "); d = y[2] - x[2]; f = 1; if (d > 0) f = (y[1] - x[1]) / d; printf "%.2f", f }'
 }
 
 # Waits until the machine is idle (>= 90% over a second), at most WAIT_IDLE seconds; prints the last

@@ -2,7 +2,7 @@
 # bench/scaling.sh: how `volref render` scales with the image size, the volume size and the thread count,
 # and its peak memory against the volume size (docs/performance.md, "Scaling and memory").
 #
-#   bench/scaling.sh                 # about 6 min on 2 idle cores
+#   bench/scaling.sh                 # about 4.5 min on 2 idle cores
 #   RUNS=1 bench/scaling.sh          # one run per case instead of 3 (a quick look)
 #   VOLREF=/path/to/volref bench/scaling.sh
 #   WAIT_IDLE=0 bench/scaling.sh     # do not wait for an idle machine before each render (default: up to 30 s)
@@ -14,7 +14,13 @@
 #   image size   256^2, 512^2, 1024^2, 2048^2 with a 256^3 volume
 #   volume size  128^3, 256^3, 512^3 at 512^2
 #   setup        each volume at 1 x 1 pixel: the fixed part of the render time (generating the
-#                procedural volume, on one thread; Embree scene; camera) and the memory without an image
+#                procedural volume, on one thread; the macrocell grid; Embree scene; camera) and the
+#                memory without an image
+#   f32 file     for memory only: the same scene reading a float32 raw file (with its JSON sidecar) of
+#                128^3, 256^3 and 512^3 voxels at 512^2, 1 thread. The file is all zeros, made sparse by
+#                truncate (no disk space; its size is what matters: volref reads the whole file into
+#                memory, then converts it to doubles); its render times are not comparable (nothing to
+#                see, everything skipped) and are not reported.
 # Each case runs at 1 and 2 threads, the two interleaved, and the whole list is repeated RUNS times (3),
 # so every case sees the machine's load at several moments. "render" is what volref prints on stderr
 # ("volref: rendered WxH in S s": render_scene, volume generation included, file writing excluded);
@@ -82,19 +88,25 @@ wait_idle() {
     echo "$f"
 }
 
-# One render: appends "dims size threads run render_s process_s rss_kib cpu_s idle_before" to $OUT.
+# One render: appends "dims size threads run render_s process_s rss_kib cpu_s idle_before" to $OUT
+# (dims "f32:N" for the float32 file of N^3 voxels).
 run() {
-    local dims=$1 size=$2 threads=$3 rep=$4 seconds wall rss cpu idle
+    local dims=$1 size=$2 threads=$3 rep=$4 seconds wall rss cpu idle volume_args
+    if [[ $dims == f32:* ]]; then
+        volume_args=(--set "volume.source=$work/zeros${dims#f32:}.raw")
+    else
+        volume_args=(--set "volume.source.dims=[$dims,$dims,$dims]")
+    fi
     idle=$(wait_idle)
     "$TIME" -f '%e %M %U %S' -o "$work/time.txt" "$VOLREF" render "$work/ml.json" -o "$work/out.exr" --threads "$threads" \
-        --set "volume.source.dims=[$dims,$dims,$dims]" --set "image.width=$size" --set "image.height=$size" \
+        "${volume_args[@]}" --set "image.width=$size" --set "image.height=$size" \
         > /dev/null 2> "$work/err.txt" || { cat "$work/err.txt" "$work/time.txt" >&2; exit 1; }
     seconds=$(sed -n 's/^volref: rendered [0-9]*x[0-9]* in \([0-9.]*\) s$/\1/p' "$work/err.txt")
     if [[ -z $seconds ]]; then cat "$work/err.txt" >&2; exit 1; fi
     read -r wall rss user sys < "$work/time.txt"
     cpu=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$dims" "$size" "$threads" "$rep" "$seconds" "$wall" "$rss" "$cpu" "$idle" >> "$OUT"
-    printf '  %4s^3 %4s^2 %s thread(s): %7.3f s render, %7.2f s process, %6.2f s CPU, %6d MiB peak RSS (idle before: %s)\n' \
+    printf '  %8s^3 %4s^2 %s thread(s): %7.3f s render, %7.2f s process, %6.2f s CPU, %6d MiB peak RSS (idle before: %s)\n' \
         "$dims" "$size" "$threads" "$seconds" "$wall" "$cpu" "$((rss / 1024))" "$idle" >&2
 }
 
@@ -103,6 +115,10 @@ run() {
 base_rss=$(tail -n 1 "$work/time.txt")
 
 cases=("256 256" "256 512" "256 1024" "256 2048" "128 512" "512 512" "128 1" "256 1" "512 1")
+for d in 128 256 512; do
+    truncate -s $((4 * d * d * d)) "$work/zeros$d.raw"
+    printf '{"dims": [%d, %d, %d], "type": "f32", "endian": "little"}\n' "$d" "$d" "$d" > "$work/zeros$d.raw.json"
+done
 start=$(date +%s)
 echo "volref: $VOLREF" >&2
 echo "start: $(date -u '+%Y-%m-%d %H:%M UTC'), load average $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores" >&2
@@ -113,6 +129,7 @@ for rep in $(seq 1 "$RUNS"); do
         read -r dims size <<< "$c"
         for threads in 1 2; do run "$dims" "$size" "$threads" "$rep"; done
     done
+    for d in 128 256 512; do run "f32:$d" 512 1 "$rep"; done
 done
 echo "end: $(date -u '+%Y-%m-%d %H:%M UTC'), load average $(cut -d' ' -f1-3 /proc/loadavg), $(( $(date +%s) - start )) s" >&2
 
@@ -124,6 +141,7 @@ function med(list,    n, i, j, v, t) {  # the median of space-separated numbers
 }
 function median(key) { return med(times[key]) }
 function medianp(key) { return med(procs[key]) }
+$1 ~ /^f32:/ { d = substr($1, 5) + 0; if ($7 > frss[d]) frss[d] = $7; next }
 {
     key = $1 " " $2 " " $3
     times[key] = times[key] (key in times ? " " : "") $5
@@ -153,19 +171,23 @@ END {
         printf "| %d^3 | %.3f / %.3f s | %.3f s | %.3f s | %.2fx | %.3f s | %.3f s | %.2fx |\n", d, s1, s2, r1, r2, r1 / r2,
             r1 - s1, r2 - s2, (r1 - s1) / (r2 - s2)
     }
-    printf "\nPeak RSS against volume size (maximum over the runs; the program and its libraries alone, `volref --help`: %.0f MiB).\n", base_rss / 1024
-    printf "volume bytes: as held (double, 8 B/voxel; also the procedural field'"'"'s type, f64) and as a float32 file (4 B/voxel);\n"
-    printf "image bytes: volref'"'"'s Image, RGBA double (32 B/pixel).\n\n"
-    printf "| volume | image | peak RSS | volume (f64) + image | RSS / (f64 + image) | volume (f32) + image | RSS / (f32 + image) | (RSS - program) / (f64 + image) |\n"
+    printf "\nPeak RSS against volume size (maximum over the runs). program: `volref --help` alone, %.0f MiB (the\n", base_rss / 1024
+    printf "executable and its libraries). file bytes: the volume'"'"'s own type, f64 for the procedural field (8 B/voxel),\n"
+    printf "f32 for the float32 file (4 B/voxel); volref holds every volume as doubles (8 B/voxel). image: volref'"'"'s\n"
+    printf "Image, RGBA double (32 B/pixel).\n\n"
+    printf "| volume | image | peak RSS | file bytes + image | RSS / (file + image) | (RSS - program) / (file + image) | doubles + image | RSS / (doubles + image) |\n"
     printf "|---|---|---|---|---|---|---|---|\n"
-    for (i = 1; i <= 3; ++i) {
-        d = dims[i]
-        for (k = 0; k < 2; ++k) {
-            n = k ? 512 : 1; r = rss[d " " n] * 1024; img = 32 * n * n; v8 = 8 * d * d * d; v4 = 4 * d * d * d
-            printf "| %d^3 | %d^2 | %.0f MiB | %.1f MiB | %.2f | %.1f MiB | %.2f | %.2f |\n", d, n, r / mib, (v8 + img) / mib,
-                r / (v8 + img), (v4 + img) / mib, r / (v4 + img), (r - base_rss * 1024) / (v8 + img)
+    for (f = 0; f < 2; ++f)
+        for (i = 1; i <= 3; ++i) {
+            d = dims[i]
+            for (k = 0; k < 2; ++k) {
+                if (f && !k) continue
+                n = k ? 512 : 1; r = (f ? frss[d] : rss[d " " n]) * 1024; img = 32 * n * n
+                v8 = 8 * d * d * d; vf = (f ? 4 : 8) * d * d * d
+                printf "| %d^3 %s | %d^2 | %.0f MiB | %.1f MiB | %.2f | %.2f | %.1f MiB | %.2f |\n", d, f ? "f32 file" : "procedural f64",
+                    n, r / mib, (vf + img) / mib, r / (vf + img), (r - base_rss * 1024) / (vf + img), (v8 + img) / mib, r / (v8 + img)
+            }
         }
-    }
 }' "$OUT"
 echo
 echo "raw results (dims size threads run render_s process_s rss_kib cpu_s idle_before): $OUT"

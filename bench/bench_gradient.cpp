@@ -37,6 +37,7 @@
 #include <glm/vec3.hpp>
 #include <tbb/global_control.h>
 
+#include "bench/BenchData.h"
 #include "core/grid/ProceduralField.h"
 #include "core/grid/Volume.h"
 #include "core/sample/GradientField.h"
@@ -51,35 +52,7 @@ using volref::Interpolation;
 using volref::Volume;
 using volref::VolumeSampler;
 
-constexpr std::int64_t kDim = 256;
-constexpr std::size_t kPoints = std::size_t(1) << 16;
-constexpr std::size_t kRays = 256;
-constexpr std::size_t kSamplesPerRay = kPoints / kRays;
-constexpr std::uint64_t kSeed = 20261122;
-
-const Volume& volume() {
-    static const Volume v = [] {
-        volref::FieldSpec f;
-        f.kind = volref::FieldSpec::Kind::MarschnerLobb;
-        f.dims = {kDim, kDim, kDim};
-        return volref::make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
-    }();
-    return v;
-}
-
-const VolumeSampler& sampler(Interpolation interpolation) {
-    static const VolumeSampler nearest(volume(), Interpolation::Nearest);
-    static const VolumeSampler trilinear(volume(), Interpolation::Trilinear);
-    static const VolumeSampler bspline(volume(), Interpolation::TricubicBSpline);
-    static const VolumeSampler catmull_rom(volume(), Interpolation::TricubicCatmullRom);
-    switch (interpolation) {
-        case Interpolation::Nearest: return nearest;
-        case Interpolation::Trilinear: return trilinear;
-        case Interpolation::TricubicBSpline: return bspline;
-        case Interpolation::TricubicCatmullRom: return catmull_rom;
-    }
-    return trilinear;
-}
+using namespace bench;
 
 // On-the-fly gradient fields, built on first use (cheap: no cache).
 const GradientField& on_the_fly(Interpolation interpolation, GradientSpec::Scheme scheme) {
@@ -98,32 +71,14 @@ const GradientField& cached() {
 enum class PointSet { Random, Rays };
 
 const std::vector<glm::dvec3>& points(PointSet set) {
-    static const auto make = [](PointSet s) {
-        const Volume& v = volume();
-        const glm::dvec3 lo = v.domain_min(), hi = v.domain_max();
-        std::mt19937_64 rng(kSeed);
-        std::uniform_real_distribution<double> unit(0.0, 1.0);
-        const auto random_point = [&] {
-            glm::dvec3 p;
-            for (int a = 0; a < 3; ++a) p[a] = lo[a] + unit(rng) * (hi[a] - lo[a]);
-            return p;
-        };
+    static const std::vector<glm::dvec3> random = [] {
+        DomainPoints generator;
         std::vector<glm::dvec3> pts;
         pts.reserve(kPoints);
-        if (s == PointSet::Random) {
-            for (std::size_t i = 0; i < kPoints; ++i) pts.push_back(random_point());
-        } else {
-            for (std::size_t r = 0; r < kRays; ++r) {
-                const glm::dvec3 a = random_point(), b = random_point();
-                for (std::size_t i = 0; i < kSamplesPerRay; ++i)
-                    pts.push_back(a + (b - a) * (double(i) / double(kSamplesPerRay - 1)));
-            }
-        }
+        for (std::size_t i = 0; i < kPoints; ++i) pts.push_back(generator.next());
         return pts;
-    };
-    static const std::vector<glm::dvec3> random = make(PointSet::Random);
-    static const std::vector<glm::dvec3> rays = make(PointSet::Rays);
-    return set == PointSet::Random ? random : rays;
+    }();
+    return set == PointSet::Random ? random : ray_points();
 }
 
 template <class F>

@@ -52,6 +52,7 @@
 #include "core/integrate/SamplePipeline.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/VolumeSampler.h"
+#include "bench/BenchData.h"
 #include "core/scene/Scene.h"
 #include "transfer/BoundaryClassifier.h"
 #include "transfer/IsovalueClassifier.h"
@@ -65,32 +66,7 @@ using volref::Interpolation;
 using volref::Volume;
 using volref::VolumeSampler;
 
-constexpr std::int64_t kDim = 256;
-constexpr std::size_t kPoints = std::size_t(1) << 16;
-constexpr std::size_t kRays = 256;
-constexpr std::size_t kSamplesPerRay = kPoints / kRays;
-constexpr std::uint64_t kSeed = 20261122;
-
-const Volume& volume() {
-    static const Volume v = [] {
-        volref::FieldSpec f;
-        f.kind = volref::FieldSpec::Kind::MarschnerLobb;
-        f.dims = {kDim, kDim, kDim};
-        return volref::make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
-    }();
-    return v;
-}
-
-const VolumeSampler& sampler(Interpolation interpolation) {
-    static const VolumeSampler nearest(volume(), Interpolation::Nearest);
-    static const VolumeSampler trilinear(volume(), Interpolation::Trilinear);
-    static const VolumeSampler bspline(volume(), Interpolation::TricubicBSpline);
-    switch (interpolation) {
-        case Interpolation::Nearest: return nearest;
-        case Interpolation::TricubicBSpline: return bspline;
-        default: return trilinear;
-    }
-}
+using namespace bench;
 
 // The rays point set of bench_gradient (same seed, same arithmetic, so the same points), and for each
 // ray its origin, unit direction and sample spacing, for the stages that need a ray.
@@ -102,21 +78,9 @@ struct RaySet {
 
 const RaySet& ray_set() {
     static const RaySet set = [] {
-        const Volume& v = volume();
-        const glm::dvec3 lo = v.domain_min(), hi = v.domain_max();
-        std::mt19937_64 rng(kSeed);
-        std::uniform_real_distribution<double> unit(0.0, 1.0);
-        const auto random_point = [&] {
-            glm::dvec3 p;
-            for (int a = 0; a < 3; ++a) p[a] = lo[a] + unit(rng) * (hi[a] - lo[a]);
-            return p;
-        };
         RaySet s;
-        s.points.reserve(kPoints);
-        for (std::size_t r = 0; r < kRays; ++r) {
-            const glm::dvec3 a = random_point(), b = random_point();
-            for (std::size_t i = 0; i < kSamplesPerRay; ++i)
-                s.points.push_back(a + (b - a) * (double(i) / double(kSamplesPerRay - 1)));
+        s.points = ray_points();
+        for (const auto& [a, b] : ray_endpoints()) {
             volref::Ray ray;
             ray.origin = a;
             ray.direction = glm::normalize(b - a);

@@ -24,8 +24,8 @@ import numpy as np
 _HEADER = re.compile(r":\s+(\d+) x\s+(\d+), (\d+) channel, (\w+)")
 
 
-def read_rgb(path):
-    """Returns an (H, W, 3) float64 array of the image's RGB in [0, 1] (rows top to bottom)."""
+def read_image(path):
+    """Returns an (H, W, channels) float64 array of the image in [0, 1] (rows top to bottom)."""
     text = subprocess.run(["oiiotool", "--dumpdata", path], check=True, capture_output=True, text=True).stdout
     lines = text.splitlines()
     m = _HEADER.search(lines[0])
@@ -40,8 +40,12 @@ def read_rgb(path):
         raise SystemExit(f"compare.py: {path}: expected {w * h} pixels, read {len(body)}")
     # "r g b a (r' g' b' a')" for integer types: keep the raw values before the bracket.
     values = np.array(" ".join(b.split("(", 1)[0] for b in body).split(), dtype=np.float64)
-    values = values.reshape(h, w, nch) / scale
-    return values[..., :3]
+    return values.reshape(h, w, nch) / scale
+
+
+def read_rgb(path):
+    """Returns an (H, W, 3) float64 array of the image's RGB in [0, 1] (rows top to bottom)."""
+    return read_image(path)[..., :3]
 
 
 def errors(reference, image):

@@ -37,7 +37,7 @@ build=${VOLREF_BUILD:-$root/build}
 py=/usr/bin/python3          # Debian's Python: python3-vtk9 and python3-numpy live there
 ref_threads=$(nproc)
 
-rm -rf "$out/bin" "$out/runs" "$out/images" "$out/ref" "$out/samples"
+rm -rf "${out:?}/bin" "${out:?}/runs" "${out:?}/images" "${out:?}/ref" "${out:?}/samples"
 mkdir -p "$out/bin" "$out/runs" "$out/images" "$out/ref" "$out/samples"
 
 log() { printf '%s [%s] %s\n' "$(date +%H:%M:%S)" "vtk-comparison" "$*" >&2; }
@@ -77,6 +77,8 @@ timed_vtk() {
     fi
 }
 
+load_start=$(cut -d' ' -f1-3 /proc/loadavg)
+
 # 2. Samples per scene.
 for c in $cases; do
     "$py" "$here/count_samples.py" "$here/scenes/$c.json" >"$out/samples/$c.json"
@@ -108,6 +110,19 @@ while [ "$rep" -le "$reps" ]; do
     rep=$((rep + 1))
 done
 rm -f "$out/runs/setup.png"
-printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s}\n' \
-    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" >"$out/settings.json"
+
+# 5. The shaded case once more with the light VTK creates by itself (ambient colour (0, 0, 0)), to
+#    show what the explicit white headlight changes (image only, not timed).
+case " $cases " in *" shaded "*)
+    t=$(echo "$threads_list" | tr ' ' '\n' | sort -n | tail -n 1)
+    for m in fixed gpu; do
+        log "shaded, VTK $m with VTK's default light"
+        LP_NUM_THREADS=$t "$py" "$here/vtk_render.py" "$here/scenes/shaded.json" --mapper "$m" --threads "$t" \
+            --frames 0 --warmup 1 --light default -o "$out/images/shaded-$m-defaultlight.png" >/dev/null \
+            2>"$out/runs/shaded-$m-defaultlight.err" || log "VTK $m with the default light failed"
+        [ -s "$out/runs/shaded-$m-defaultlight.err" ] || rm -f "$out/runs/shaded-$m-defaultlight.err"
+    done ;;
+esac
+printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s, "loadavg_start": "%s", "loadavg_end": "%s"}\n' \
+    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" "$load_start" "$(cut -d' ' -f1-3 /proc/loadavg)" >"$out/settings.json"
 log "done: results in $out"

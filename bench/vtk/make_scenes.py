@@ -15,6 +15,7 @@ trilinear interpolation, one sample per voxel of ray length.
 import json
 import math
 import os
+import re
 
 N = 256
 HALF = (N - 1) / 2.0            # 127.5: the domain is [-HALF, HALF]^3
@@ -47,7 +48,13 @@ COLOR = [[0.0, 0.1, 0.2, 0.6],
 BAND_OPACITY = [[0.0, 0.0], [0.44, 0.0], [0.5, 0.5], [0.56, 0.0], [1.0, 0.0]]
 BAND_UNIT_DISTANCE = 4.0
 
-# MIP: the value at the maximum through a ramp (the maximum is > 0.5 on nearly every ray).
+# MIP: the maximum along a ray is above 0.6 on nearly every ray, so the MIP gets its own colour
+# map, stretched over [0.6, 1], and an opacity ramp from 0 at 0.5 to 1 at 1.
+MIP_COLOR = [[0.6, 0.1, 0.2, 0.6],
+             [0.75, 0.25, 0.5, 0.95],
+             [0.85, 1.0, 0.85, 0.4],
+             [0.93, 1.0, 0.45, 0.15],
+             [1.0, 0.9, 0.1, 0.05]]
 MIP_OPACITY = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
 
 # Dense: every sample contributes (0.002 per unit at the low end to 0.02 at the high end).
@@ -56,13 +63,13 @@ DENSE_OPACITY = [[0.0, 0.002], [1.0, 0.02]]
 SHADING = {"ka": 0.2, "kd": 0.7, "ks": 0.3, "n": 10, "two_sided": True}
 
 
-def scene(description, opacity, unit_distance, projection="composite", shading=None):
+def scene(description, opacity, unit_distance, projection="composite", shading=None, color=COLOR):
     volume = {
         "source": {"field": "marschner-lobb", "dims": [N, N, N], "fm": 6, "alpha": 0.25},
         "origin": [-HALF, -HALF, -HALF],
         "spacing": [1, 1, 1],
         "interpolation": "trilinear",
-        "transfer": {"domain": "data", "color": COLOR, "opacity": opacity,
+        "transfer": {"domain": "data", "color": color, "opacity": opacity,
                      "opacity_unit_distance": unit_distance},
     }
     if shading is not None:
@@ -89,8 +96,8 @@ SCENES = {
     "shaded": scene(COMMON + "Composite, Blinn-Phong shaded (ka 0.2, kd 0.7, ks 0.3, n 10, two-sided "
                     "as VTK's renderers light by default), the same band as the unshaded case.",
                     BAND_OPACITY, BAND_UNIT_DISTANCE, shading=SHADING),
-    "mip": scene(COMMON + "Maximum intensity projection through an opacity ramp from 0.5 to 1.",
-                 MIP_OPACITY, 1.0, projection="mip"),
+    "mip": scene(COMMON + "Maximum intensity projection: colours stretched over [0.6, 1], opacity "
+                 "a ramp from 0 at 0.5 to 1 at 1.", MIP_OPACITY, 1.0, projection="mip", color=MIP_COLOR),
     "dense": scene(COMMON + "Composite with a dense transfer function: opacity 0.002 per unit at "
                    "f = 0 to 0.02 at f = 1, so every sample contributes (no empty space).",
                    DENSE_OPACITY, 1.0),
@@ -101,6 +108,9 @@ if __name__ == "__main__":
     os.makedirs(out, exist_ok=True)
     for name, s in SCENES.items():
         with open(os.path.join(out, name + ".json"), "w") as f:
-            json.dump(s, f, indent=1)
-            f.write("\n")
+            text = json.dumps(s, indent=2)
+            # Innermost arrays (numbers, vectors, table rows) on one line.
+            text = re.sub(r"\[\s+([^\[\]{}]*?)\s+\]",
+                          lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text)
+            f.write(text + "\n")
         print(os.path.join(out, name + ".json"))

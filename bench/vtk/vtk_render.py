@@ -21,6 +21,13 @@ Timing: the volume is built (numpy, float32) and the pipeline set up first (not 
 compilation and 3-D texture upload), then --frames timed frames, each rw.Render() followed by
 rw.WaitForCompletion() (glFinish). The image of the last frame is written as an 8-bit RGB PNG.
 Prints one JSON object on stdout.
+
+Lighting of shaded scenes: by default (--light white) an explicit headlight with ambient, diffuse
+and specular colour (1, 1, 1) and intensity 1, which is the scene's light (volref: I ka m + ...).
+The light VTK creates when there is none has ambient colour (0, 0, 0), and the fixed-point mapper
+multiplies ka by it, dropping the ambient term (vtkEncodedGradientShader); --light default uses that
+light. The renderer's TwoSidedLighting stays on (VTK's default): the scenes ask for two-sided
+shading to match.
 """
 import argparse
 import json
@@ -34,10 +41,10 @@ import numpy as np
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (registers the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the GPU mapper and the ray-cast display helper)
 from vtkmodules.util import numpy_support
-from vtkmodules.vtkCommonCore import vtkMultiThreader
+from vtkmodules.vtkCommonCore import vtkMultiThreader, vtkVersion
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction
 from vtkmodules.vtkIOImage import vtkPNGWriter
-from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow,
+from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkLight, vtkRenderer, vtkRenderWindow,
                                          vtkVolume, vtkVolumeProperty, vtkWindowToImageFilter)
 from vtkmodules.vtkRenderingVolume import vtkFixedPointVolumeRayCastMapper, vtkGPUVolumeRayCastMapper
 
@@ -118,6 +125,10 @@ def main():
     ap.add_argument("--frames", type=int, default=3)
     ap.add_argument("--warmup", type=int, default=1)
     ap.add_argument("-o", "--output", help="PNG of the last frame")
+    ap.add_argument("--light", choices=["white", "default"], default="white",
+                    help="white (the default): one headlight of colour (1, 1, 1) for ambient, diffuse "
+                         "and specular, the scene's light; default: the light VTK creates itself, whose "
+                         "ambient colour is (0, 0, 0), so the fixed-point mapper drops the ambient term")
     args = ap.parse_args()
 
     with open(args.scene) as f:
@@ -167,6 +178,14 @@ def main():
     ren = vtkRenderer()
     ren.SetBackground(bg[0] * bg[3], bg[1] * bg[3], bg[2] * bg[3])
     ren.AddVolume(volume)
+    if shading is not None and args.light == "white":
+        light = vtkLight()
+        light.SetLightTypeToHeadlight()
+        light.SetIntensity(1.0)
+        light.SetAmbientColor(1.0, 1.0, 1.0)
+        light.SetDiffuseColor(1.0, 1.0, 1.0)
+        light.SetSpecularColor(1.0, 1.0, 1.0)
+        ren.AddLight(light)
     rw = vtkRenderWindow()
     rw.SetOffScreenRendering(1)
     rw.SetMultiSamples(0)
@@ -210,13 +229,14 @@ def main():
         writer.Write()
 
     caps = rw.ReportCapabilities() or ""
-    renderer_string = next((line.split(":", 1)[1].strip() for line in caps.splitlines()
-                            if line.startswith("OpenGL renderer string")), "")
+    def capability(name):
+        return next((line.split(":", 1)[1].strip() for line in caps.splitlines() if line.startswith(name)), "")
     threads = mapper.GetNumberOfThreads() if args.mapper == "fixed" else int(os.environ.get("LP_NUM_THREADS", "0"))
     print(json.dumps({
         "mapper": args.mapper, "threads": threads, "setup_s": setup, "warmup_s": warm,
         "frames_s": frames, "data_range": [vmin, vmax], "sample_distance": mapper.GetSampleDistance(),
-        "gl_renderer": renderer_string,
+        "gl_renderer": capability("OpenGL renderer string"), "gl_version": capability("OpenGL version string"),
+        "vtk_version": vtkVersion.GetVTKVersion(), "light": args.light if shading is not None else "unused",
     }))
 
 

@@ -5,10 +5,13 @@
 #
 #   xvfb-run -a -s "-screen 0 1024x768x24" bench/vtk/driver.sh OUT_DIR
 #
-# Settings (environment): VTK_CMP_REPS (3) runs of each renderer per case and thread count,
+# Settings (environment): VTK_CMP_REPS (5) runs of each renderer per case and thread count,
 # VTK_CMP_FRAMES (3) timed frames per VTK run (after 1 warm-up frame), VTK_CMP_THREADS ("1 2"),
 # VTK_CMP_CASES ("composite shaded mip dense"), VTK_CMP_REF_STEP (0.0625) the reference's step in
-# voxels, VOLREF_BUILD (build) the build folder holding cli/volref.
+# voxels, VTK_CMP_IDLE (0.9) and VTK_CMP_WAIT_BUDGET (240): before each timed run, wait until the
+# CPUs were at least this idle over half a second, spending at most this many seconds waiting in the
+# whole run (the machine is shared; the idle fraction of every run goes to OUT_DIR/runs/idle.tsv),
+# VOLREF_BUILD (build) the build folder holding cli/volref.
 #
 # Steps:
 #  1. freeze the volref binary: cli/volref and libvolref.so.0 are copied to OUT_DIR/bin and run from
@@ -28,11 +31,13 @@ root=$(cd "$here/../.." && pwd)
 out=$1
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-reps=${VTK_CMP_REPS:-3}
+reps=${VTK_CMP_REPS:-5}
 frames=${VTK_CMP_FRAMES:-3}
 threads_list=${VTK_CMP_THREADS:-"1 2"}
 cases=${VTK_CMP_CASES:-"composite shaded mip dense"}
 ref_step=${VTK_CMP_REF_STEP:-0.0625}
+idle_min=${VTK_CMP_IDLE:-0.9}
+wait_left=$(( ${VTK_CMP_WAIT_BUDGET:-240} * 2 ))   # in half seconds
 build=${VOLREF_BUILD:-$root/build}
 py=/usr/bin/python3          # Debian's Python: python3-vtk9 and python3-numpy live there
 ref_threads=$(nproc)
@@ -43,6 +48,26 @@ mkdir -p "$out/bin" "$out/runs" "$out/images" "$out/ref" "$out/samples"
 log() { printf '%s [%s] %s\n' "$(date +%H:%M:%S)" "vtk-comparison" "$*" >&2; }
 now() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.4f", b - a }'; }
+
+# The fraction of CPU time spent idle (idle + iowait, all CPUs) over the next half second.
+idle_fraction() {
+    a=$(head -n 1 /proc/stat); sleep 0.5; b=$(head -n 1 /proc/stat)
+    printf '%s\n%s\n' "$a" "$b" | awk '{ t = 0; for (i = 2; i <= NF; i++) t += $i; idle = $5 + $6 }
+        NR == 1 { t0 = t; i0 = idle } NR == 2 { printf "%.3f", (t > t0) ? (idle - i0) / (t - t0) : 1 }'
+}
+
+# Waits (within the budget) until the CPUs are idle; records the run's name, the idle fraction just
+# before it and the half seconds waited in runs/idle.tsv.
+wait_idle() {
+    waited=0
+    frac=$(idle_fraction)
+    while [ "$wait_left" -gt 0 ] && awk -v f="$frac" -v m="$idle_min" 'BEGIN { exit !(f < m) }'; do
+        frac=$(idle_fraction)
+        wait_left=$((wait_left - 1))
+        waited=$((waited + 1))
+    done
+    printf '%s\t%s\t%s\n' "$1" "$frac" "$waited" >>"$out/runs/idle.tsv"
+}
 
 # 1. Freeze the binary.
 cp "$build/cli/volref" "$out/bin/volref"
@@ -99,11 +124,15 @@ while [ "$rep" -le "$reps" ]; do
         for c in $cases; do
             scene="$here/scenes/$c.json"
             log "rep $rep/$reps, $t thread(s), $c: volref, set-up, VTK fixed-point, VTK GPU"
+            wait_idle "$c-t$t-volref-$rep"
             timed_volref "$out/runs/$c-t$t-volref-$rep.json" render "$scene" \
                 -o "$out/images/$c-volref-t$t.png" --threads "$t"
+            wait_idle "$c-t$t-setup-$rep"
             timed_volref "$out/runs/$c-t$t-setup-$rep.json" render "$scene" \
                 -o "$out/runs/setup.png" --threads "$t" --set image.width=1 --set image.height=1
+            wait_idle "$c-t$t-fixed-$rep"
             timed_vtk "$out/runs/$c-t$t-fixed-$rep.json" fixed "$t" "$scene" "$out/images/$c-fixed-t$t.png"
+            wait_idle "$c-t$t-gpu-$rep"
             timed_vtk "$out/runs/$c-t$t-gpu-$rep.json" gpu "$t" "$scene" "$out/images/$c-gpu-t$t.png"
         done
     done
@@ -123,6 +152,7 @@ case " $cases " in *" shaded "*)
         [ -s "$out/runs/shaded-$m-defaultlight.err" ] || rm -f "$out/runs/shaded-$m-defaultlight.err"
     done ;;
 esac
-printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s, "loadavg_start": "%s", "loadavg_end": "%s"}\n' \
-    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" "$load_start" "$(cut -d' ' -f1-3 /proc/loadavg)" >"$out/settings.json"
+printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s, "idle_min": %s, "wait_budget_s": %s, "loadavg_start": "%s", "loadavg_end": "%s"}\n' \
+    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" "$idle_min" "${VTK_CMP_WAIT_BUDGET:-240}" \
+    "$load_start" "$(cut -d' ' -f1-3 /proc/loadavg)" >"$out/settings.json"
 log "done: results in $out"

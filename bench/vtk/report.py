@@ -22,6 +22,7 @@ import platform
 import statistics
 import subprocess
 import sys
+import textwrap
 import time
 
 import numpy as np
@@ -146,8 +147,44 @@ def default_light_note(errs):
     text = (f" With VTK's own light (`vtk_render.py --light default`, rendered once by this run) the shaded "
             f"fixed-point image's RMSE is {fd['rmse']:.4f} instead of {f['rmse']:.4f}")
     if g and gd:
-        text += f" (GPU: {gd['rmse']:.4f} instead of {g['rmse']:.4f})"
+        text += (f" (GPU: {gd['rmse']:.4f} either way)" if abs(gd["rmse"] - g["rmse"]) < 5e-5
+                 else f" (GPU: {gd['rmse']:.4f} instead of {g['rmse']:.4f})")
     return text + "."
+
+
+def closest_note(ratios):
+    if not ratios:
+        return ""
+    by_case = {}
+    for r, c, t in ratios:
+        by_case.setdefault(c, []).append(r)
+    best = max(by_case, key=lambda c: max(by_case[c]))
+    worst = min(by_case, key=lambda c: min(by_case[c]))
+    return (f" Measured here, volref comes closest to the fixed-point mapper in the {best} case "
+            f"({'x, '.join(f'{r:.2f}' for r in by_case[best])}x at {', '.join(str(t) for _, c, t in ratios if c == best)} "
+            f"thread(s)) and is furthest behind in the {worst} case "
+            f"({'x, '.join(f'{r:.2f}' for r in by_case[worst])}x).")
+
+
+def idle_note(out, settings):
+    path = f"{out}/runs/idle.tsv"
+    if not os.path.exists(path):
+        return ""
+    rows = []
+    with open(path) as f:
+        for ln in f:
+            parts = ln.split("\t")
+            if len(parts) == 3:
+                rows.append((parts[0], float(parts[1]), int(parts[2])))
+    if not rows:
+        return ""
+    m = settings.get("idle_min", 0.9)
+    ok = sum(1 for _, frac, _ in rows if frac >= m)
+    waited = sum(w for _, _, w in rows) / 2.0
+    text = (f" Before each of the {len(rows)} timed runs the script waited until the CPUs had been at least "
+            f"{m * 100:.0f}% idle over half a second (at most {settings.get('wait_budget_s', '?')} s of waiting "
+            f"in all): {ok} of {len(rows)} runs started that way, after {waited:.0f} s of waiting in total")
+    return text + ("." if ok == len(rows) else "; the others started when the budget was spent.")
 
 
 def section(out, args):
@@ -202,7 +239,7 @@ def section(out, args):
     w("")
     w("| case | threads | volref render | set-up | frame | process | volref FPS | fixed-point FPS | GPU (llvmpipe) FPS | volref / fixed-point | volref / GPU |")
     w("|---|---|---|---|---|---|---|---|---|---|---|")
-    ratios_fixed = []
+    ratios_fixed, ratios_render = [], []
     for c in cases:
         for t in threads:
             r = res[(c, t)]
@@ -214,20 +251,27 @@ def section(out, args):
             rg = v_fps / g_fps if v_fps and g_fps else None
             if rf:
                 ratios_fixed.append((rf, c, t))
+                if r["volref_render"]:
+                    ratios_render.append((1.0 / r["volref_render"]) / f_fps)
             w(f"| {CASE_TITLES.get(c, c)} | {t} | {fixed(r['volref_render'], 2)} s | {fixed(r['setup_render'], 2)} s | "
               f"{fixed(vf, 2)} s | {fixed(r['volref_process'], 2)} s | {fixed(v_fps, 2)} | "
               f"{fixed(f_fps, 2) if f_fps else 'failed'} | {fixed(g_fps, 2) if g_fps else 'failed'} | "
               f"{fixed(rf, 3)} | {fixed(rg, 2)} |")
     w("")
+    if ratios_render:
+        w(f"volref FPS = 1 / frame. Counted on volref's whole render time instead (volume generation included), "
+          f"volref / fixed-point would be {min(ratios_render):.2f}x to {max(ratios_render):.2f}x.")
+        w("")
 
     # Samples per second.
     w("**Samples per second.** Samples per frame = volref's exact count at step 1 voxel "
       "(bench/vtk/count_samples.py: volref's pixel rays rebuilt in numpy, the slab test against the domain, "
       "max(1, ceil(L / h - 1e-9)) samples per ray of chord L; rays hitting x mean chord / step differs from it "
       f"by at most {max(abs(s['samples'] - s['estimate']) / s['samples'] for s in samples.values()) * 100:.2f}%); the same count is used for VTK, which at the same sample distance takes the same number of "
-      "samples per ray give or take one, but its fixed-point mapper skips empty 4^3 blocks and stops rays at "
-      "opacity 1 - 1/255, so for it these are *equivalent* samples per second (the work volref does), not "
-      "samples it evaluated. Per core = / threads (llvmpipe at LP_NUM_THREADS=1 still rasterises on one "
+      "samples per ray give or take one, but its fixed-point mapper skips empty 4^3 blocks and stops rays early "
+      "(remaining transparency below 255/32767), so for it these are *equivalent* samples per second (the work volref does), not "
+      "samples it evaluated; likewise volref's own count includes the segments its empty-space skipping passes "
+      "over (as in \"Whole renders\" above). Per core = / threads (llvmpipe at LP_NUM_THREADS=1 still rasterises on one "
       "worker thread plus the main thread).")
     w("")
     w("| case | rays hitting | mean chord | samples per frame | threads | volref M/s (per core) | fixed-point M/s (per core) | GPU M/s (per core) |")
@@ -251,12 +295,13 @@ def section(out, args):
                     if i == 0 else "| | | |")
             w(f"{lead} | {t} | " + " | ".join(cells) + " |")
     w("")
-    w("Estimate check: hits x mean chord / step = "
-      + ", ".join(f"{samples[c]['estimate'] / 1e6:.2f} M ({c})" for c in cases) + ".")
+    check = ("Estimate check: hits x mean chord / step = "
+             + ", ".join(f"{samples[c]['estimate'] / 1e6:.2f} M ({c})" for c in cases) + ".")
     if "dense" in cases and (("dense", "ref_alpha") in errs):
-        w(f" In the dense case every ray that meets the volume gets alpha > 0: the reference image has "
-          f"{errs[('dense', 'ref_alpha')]} such pixels, count_samples.py counts {samples['dense']['hits']} rays "
-          "hitting.")
+        check += (f" In the dense case every ray that meets the volume gets alpha > 0: the reference image has "
+                  f"{errs[('dense', 'ref_alpha')]} such pixels, count_samples.py counts {samples['dense']['hits']} "
+                  "rays hitting.")
+    w(check)
     w("")
 
     # Errors.
@@ -303,18 +348,18 @@ def section(out, args):
         lo, hi = min(ratios_fixed), max(ratios_fixed)
         w(f"- FPS: volref reaches {lo[0]:.3f}x ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.3f}x ({hi[1]}, {hi[2]} "
           f"thread(s)) of the fixed-point mapper's frame rate on frame time alone; reaching 3x needs a "
-          f"{3 / hi[0]:.0f}x to {3 / lo[0]:.0f}x speed-up.")
+          f"{3 / hi[0]:.1f}x to {3 / lo[0]:.1f}x speed-up.")
     if per_core:
         lo, hi = min(per_core), max(per_core)
         w(f"- Throughput: {lo[0]:.1f} ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.1f} ({hi[1]}, {hi[2]} thread(s)) "
-          f"M samples/s/core, {500 / hi[0]:.0f}x to {500 / lo[0]:.0f}x short of 500 M/s/core.")
+          f"M samples/s/core, {500 / hi[0]:.1f}x to {500 / lo[0]:.1f}x short of 500 M/s/core.")
     if lower:
         better = [c for c, v, f in lower if v < f]
         w(f"- Error: volref's step-1 image has a lower RMSE than the fixed-point mapper's in {len(better)} of "
           f"{len(lower)} cases" + (f" ({', '.join(better)})" if better else "") +
           "; " + ", ".join(f"{c} {v:.4f} vs {f:.4f}" for c, v, f in lower) + ".")
     w("")
-    w(WHY)
+    w(WHY + closest_note(ratios_fixed))
     w("")
 
     # Command and machine.
@@ -325,26 +370,47 @@ def section(out, args):
     w("```sh")
     w(args.command)
     w("```")
-    extra = (f"The whole command took {total} on this run (packages already installed, volref already built). "
-             if total else "")
+    extra = (f"The whole command took {total} on this run up to writing this section (packages already "
+             "installed, volref already built). " if total else "")
     w(f"{extra}Settings: VTK_CMP_REPS={reps}, VTK_CMP_FRAMES={frames}, VTK_CMP_THREADS=\"{settings['threads']}\", "
       f"VTK_CMP_REF_STEP={ref_step}; raw results (every run's JSON, the images, the references) are left in "
       f"`{args.out_label or out}`. Load average (1, 5, 15 min) at the start / end of the runs: "
-      f"{settings.get('loadavg_start', '?')} / {settings.get('loadavg_end', '?')}: the machine is shared with "
+      f"{settings.get('loadavg_start', '?')} / {settings.get('loadavg_end', '?')}. The machine is shared with "
       "other builds and tests, so single runs can be off by tens of percent; the interleaving spreads that "
-      "load over all renderers alike.")
-    return "\n".join(L) + "\n"
+      "load over all renderers alike, and the frame times (differences of two medians for volref) are good "
+      "to about +-10-20%." + idle_note(out, settings))
+    return wrap("\n".join(L)) + "\n"
 
 
-WHY = ("Why, in short: volref's reference path evaluates every sample of every ray, one ray at a time, in "
-       "double precision (trilinear reconstruction of doubles, `log1p`/`expm1` opacity correction and a "
-       "compensated sum per sample, one Embree query per pixel), with no empty-space skipping and no early "
-       "ray termination unless the scene asks for it; it is the oracle, built to be right first. The "
-       "fixed-point mapper works on 15-bit integer scalars and tables, precomputed quantised gradients, "
-       "skips empty 4^3 blocks and stops at opacity 1 - 1/255, so in the band-shaped composite cases it "
-       "evaluates a fraction of the samples counted here; in the dense and MIP cases, where it cannot skip "
-       "much, the gap is smallest. Packets/SIMD, float paths and empty-space skipping are the "
-       "performance issue's work (issue 4); these numbers are the baseline it starts from.")
+def wrap(text, width=100):
+    """Wraps prose lines to `width` columns like the rest of docs/performance.md; leaves tables, code
+    blocks and headings alone. List items continue with two spaces."""
+    out, in_code = [], False
+    for line in text.split("\n"):
+        if line.startswith("```"):
+            in_code = not in_code
+            out.append(line)
+        elif in_code or line.startswith("|") or line.startswith("#") or len(line) <= width:
+            out.append(line)
+        else:
+            bullet = line.startswith("- ")
+            out.extend(textwrap.wrap(line, width=width, subsequent_indent="  " if bullet else "",
+                                     break_long_words=False, break_on_hyphens=False))
+    return "\n".join(out)
+
+
+WHY = ("What the renderers do per sample, which is where the gap comes from. volref (this build) "
+       "computes in double precision throughout: unshaded composite and MIP go through its SIMD packet path "
+       "(packets of 16 rays, Highway with run-time dispatch: AVX-512 on this CPU, 8 doubles per vector), the shaded case through the scalar path "
+       "(one ray at a time; central-difference gradients of the trilinear field on the fly, 6 more trilinear "
+       "fetches per sample with opacity > 0); composite rays skip empty 8^3 macrocells (bitwise the same "
+       "image; nothing to skip in the dense case, and MIP does not skip); no early ray termination, since these "
+       "scenes do not ask for it (the reference integrates every ray to its end). vtkFixedPointVolumeRayCastMapper "
+       "works on 15-bit fixed-point scalars and tables, precomputes an encoded gradient per voxel and shades "
+       "by table lookup per encoded normal (in the untimed warm-up frame), skips 4^3 blocks it can prove "
+       "empty and stops a ray once its remaining transparency is below 255/32767 (about 1/128). The GPU mapper runs a "
+       "float32 GLSL shader, compiled by llvmpipe to 256-bit vector code, and also stops at opacity "
+       "1 - 1/255.")
 
 
 def replace_section(doc_path, text):

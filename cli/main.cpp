@@ -41,6 +41,8 @@ int main(int argc, char** argv) {
     rs->add_option("--encoding", resample.encoding, "Output encoding: raw (default) or gzip");
     rs->add_option("--format", resample.format, "Input format: nrrd or raw (default: from the extension)");
 
+    // ---- more subcommands: add each one's block above this line ----
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
     try {
         if (rc->parsed()) return volref::cli::run_render(render);
         if (rs->parsed()) return volref::cli::run_resample(resample);
+        // ---- more subcommands: dispatch above this line ----
     } catch (const volref::Error& e) {
         std::fprintf(stderr, "volref: error: %s\n", e.what());
         return 1;

@@ -39,6 +39,9 @@ public:
     LightTerms light_terms(const LightSpec& light, const glm::dvec3& m, const glm::dvec3& N, const glm::dvec3& view,
                            double depth) const;
     double zero_gradient_tolerance() const { return tolerance_; }
+    // The coefficients (ks = 0 for nodal) and the lights (read by the SIMD path, PacketComposite.h).
+    const ShadingSpec& spec() const { return spec_; }
+    const std::vector<LightSpec>& lights() const { return lights_; }
 
 private:
     ShadingSpec spec_;

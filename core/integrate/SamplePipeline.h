@@ -60,6 +60,8 @@ public:
     // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
     const VolumeSampler* cartesian_sampler() const { return dynamic_cast<const VolumeSampler*>(&sampler_); }
     bool shaded() const { return shader_ != nullptr; }
+    const Shader* shader() const { return shader_; }
+    const GradientSource* gradient_source() const { return gradient_; }
     bool preclassified() const { return pre_ != nullptr; }
 
 private:

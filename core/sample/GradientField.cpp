@@ -41,6 +41,8 @@ GradientField::GradientField(const VolumeSampler& sampler, GradientSpec spec) : 
 
 GradientField::~GradientField() = default;
 
+const Volume* GradientField::cached_component(int a) const { return cache_ ? &cache_->components[a] : nullptr; }
+
 glm::dvec3 GradientField::gradient(const glm::dvec3& world) const {
     if (cache_)
         return {cache_->samplers[0]->trilinear(world), cache_->samplers[1]->trilinear(world),

@@ -31,6 +31,8 @@ public:
     glm::dvec3 gradient(const glm::dvec3& world) const override;
     // The scheme after resolving Default (analytic for tricubic kernels, central otherwise).
     GradientSpec::Scheme scheme() const { return scheme_; }
+    // With `cache`: component a (0, 1, 2) of the per-voxel gradients; null without a cache.
+    const Volume* cached_component(int a) const;
 
 private:
     glm::dvec3 on_the_fly(const glm::dvec3& world) const;

@@ -16,6 +16,8 @@
 //   ml256_setup  ml256 at 1 x 1 pixel: the fixed cost inside render_scene (generating the procedural
 //                volume on one thread, the macrocell grid when skipping, Embree scene, camera, thread
 //                arena); ml256 minus this (on the same path) is the ray casting itself
+//   default_shaded  the default scene shaded as the VTK comparison's shaded case: Blinn-Phong, ka 0.2,
+//                kd 0.7, ks 0.3, n 10, one headlight, central differences on the fly (SIMD path)
 //   shaded       reference_scenes/shaded-composite.json: 64^3, tricubic Catmull-Rom with the analytic
 //                gradient, gradient opacity, Blinn-Phong under two lights, 512 x 512
 // The scene files are read from VOLREF_SOURCE_DIR (a compile definition: the source tree).
@@ -76,11 +78,23 @@ Scene ml256(int size) {
     return s;
 }
 
+Scene default_shaded() {
+    Scene s = reference_scene("default");
+    volref::ShadingSpec shading;
+    shading.ka = 0.2;
+    shading.kd = 0.7;
+    shading.ks = 0.3;
+    shading.n = 10.0;
+    s.volume.shading = shading;
+    return s;
+}
+
 const Scene& scene(const std::string& name) {
     static const std::map<std::string, Scene> scenes{
         {"default", reference_scene("default")},
         {"ml256", ml256(512)},
         {"ml256_setup", ml256(1)},
+        {"default_shaded", default_shaded()},
         {"shaded", reference_scene("shaded-composite")},
     };
     return scenes.at(name);
@@ -154,7 +168,7 @@ void register_render(const std::string& name, Path path, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    for (const char* name : {"default", "ml256", "ml256_setup", "shaded"}) {
+    for (const char* name : {"default", "default_shaded", "ml256", "ml256_setup", "shaded"}) {
         register_render(name, Path::Full, 1);
         register_render(name, Path::Full, 2);
         register_render(name, Path::NoSkipping, 1);  // for ml256_setup: without building the macrocell grid

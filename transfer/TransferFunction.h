@@ -47,6 +47,7 @@ public:
     double inverse_window_width() const { return inv_width_; }
     const PiecewiseLinear<3>& color_function() const { return color_; }
     const PiecewiseLinear<1>& opacity_function() const { return opacity_; }
+    const PiecewiseLinear<1>& gradient_opacity_function() const { return gradient_opacity_; }
 
 private:
     bool normalized_ = false;

@@ -52,6 +52,96 @@ HWY_INLINE V table_channel(D d, const TableLookup& t, const double* ys, int rows
     return hn::IfThenElse(t.below, first, hn::IfThenElse(t.above, last, inner));
 }
 
+// grad f at (x, y, z), where f(x, y, z) = fx, by GradientField's scheme, operation by operation.
+struct PacketGradient {
+    const PacketCompositeInputs& in;
+    const PacketTrilinear& f;
+    const PacketTrilinear* cached[3];
+
+    HWY_INLINE void operator()(const V X[3], V fx, V g[3]) const {
+        const D d;
+        if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
+            for (int a = 0; a < 3; ++a) g[a] = (*cached[a])(X[0], X[1], X[2]);
+            return;
+        }
+        for (int a = 0; a < 3; ++a) {
+            g[a] = hn::Zero(d);
+            if (f.flat[a]) continue;
+            const V h = hn::Set(d, in.spacing[a]), lo = hn::Set(d, in.domain_lo[a]), hi = hn::Set(d, in.domain_hi[a]);
+            const V c = hn::Max(hn::Sub(X[a], h), lo);
+            V P[3] = {X[0], X[1], X[2]};
+            if (in.gradient == PacketCompositeInputs::Gradient::Central) {
+                const V b = hn::Min(hn::Add(X[a], h), hi);
+                P[a] = b;
+                const V fb = f(P[0], P[1], P[2]);
+                P[a] = c;
+                const V fc = f(P[0], P[1], P[2]);
+                g[a] = hn::Div(hn::Sub(fb, fc), hn::Sub(b, c));
+            } else {  // forward where x + h <= hi, else backward over x - c
+                const V xh = hn::Add(X[a], h);
+                P[a] = xh;
+                const V forward = hn::Div(hn::Sub(f(P[0], P[1], P[2]), fx), h);
+                P[a] = c;
+                const V backward = hn::Div(hn::Sub(fx, f(P[0], P[1], P[2])), hn::Sub(X[a], c));
+                g[a] = hn::IfThenElse(hn::Le(xh, hi), forward, backward);
+            }
+        }
+    }
+};
+
+HWY_INLINE V dot3(const V a[3], const V b[3]) {
+    return hn::Add(hn::Add(hn::Mul(a[0], b[0]), hn::Mul(a[1], b[1])), hn::Mul(a[2], b[2]));
+}
+
+// Shader::shade for a packet: m = the material colour, g = grad f, view = -direction, depth = t.
+HWY_INLINE void shade(const PacketCompositeInputs& in, V m[3], const V g[3], const V view[3], V depth) {
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+    const V glen = hn::Sqrt(dot3(g, g));
+    const M lit = hn::Gt(glen, hn::Set(d, in.zero_gradient_tolerance));
+    if (hn::AllFalse(d, lit)) return;
+    const V N[3] = {hn::Div(hn::Neg(g[0]), glen), hn::Div(hn::Neg(g[1]), glen), hn::Div(hn::Neg(g[2]), glen)};
+    auto clamp_dot = [&](V x) { return in.two_sided ? hn::Abs(x) : hn::Max(x, zero); };
+    const V cue = hn::Div(one, hn::Add(hn::Set(d, in.kc), hn::Mul(hn::Set(d, in.kl), depth)));
+    V out[3] = {zero, zero, zero};
+    for (int li = 0; li < in.light_count; ++li) {
+        const PacketCompositeInputs::Light& light = in.lights[li];
+        V L[3];
+        for (int c = 0; c < 3; ++c) L[c] = light.headlight ? view[c] : hn::Set(d, light.direction[c]);
+        const V n_dot_l_raw = dot3(N, L);
+        const V n_dot_l = clamp_dot(n_dot_l_raw);
+        V spec_dot;
+        if (in.phong) {
+            const V s2 = hn::Mul(hn::Set(d, 2.0), n_dot_l_raw);
+            const V R[3] = {hn::Sub(hn::Mul(s2, N[0]), L[0]), hn::Sub(hn::Mul(s2, N[1]), L[1]),
+                            hn::Sub(hn::Mul(s2, N[2]), L[2])};
+            spec_dot = hn::Max(dot3(R, view), zero);
+        } else {
+            V H[3] = {hn::Add(L[0], view[0]), hn::Add(L[1], view[1]), hn::Add(L[2], view[2])};
+            const V inv = hn::Div(one, hn::Sqrt(dot3(H, H)));
+            for (int c = 0; c < 3; ++c) H[c] = hn::Mul(H[c], inv);
+            spec_dot = clamp_dot(dot3(N, H));
+        }
+        V specular = zero;
+        if (in.ks != 0.0) {
+            // s^n = exp(n log s) for s > 0; 0^n = 0 (n > 0), s^0 = 1.
+            const V power = in.n == 0.0 ? one
+                                        : hn::IfThenElseZero(hn::Gt(spec_dot, zero),
+                                                             hn::Exp(d, hn::Mul(hn::Set(d, in.n), hn::Log(d, spec_dot))));
+            specular = hn::Mul(hn::Mul(hn::Set(d, in.ks), power), cue);
+        }
+        for (int c = 0; c < 3; ++c) {
+            const V I = hn::Set(d, light.color[c]);
+            const V ambient = hn::Mul(I, hn::Mul(hn::Set(d, in.ka), m[c]));
+            const V diffuse = hn::Mul(I, hn::Mul(hn::Mul(hn::Mul(hn::Set(d, in.kd), m[c]), n_dot_l), cue));
+            V term = hn::Add(ambient, diffuse);
+            if (in.ks != 0.0) term = hn::Add(term, hn::Mul(I, specular));
+            out[c] = hn::Add(out[c], term);
+        }
+    }
+    for (int c = 0; c < 3; ++c) m[c] = hn::IfThenElse(lit, out[c], m[c]);
+}
+
 void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count) {
     const D d;
@@ -61,6 +151,13 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
     const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
+    // The cached gradient components share the volume's grid.
+    const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
+    const PacketTrilinear gx(cached ? in.cached_gradient[0] : in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear gy(cached ? in.cached_gradient[1] : in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear gz(cached ? in.cached_gradient[2] : in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketGradient gradient{in, trilinear, {&gx, &gy, &gz}};
+    const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
 
     const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
     V Cr = zero, Cg = zero, Cb = zero, tau_s = zero, tau_c = zero, opaque = zero;
@@ -70,17 +167,34 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
         const M alive = hn::Gt(hn::Load(d, packet.live), zero);
-        const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
+        const V P[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
+        const V v = trilinear(P[0], P[1], P[2]);
         // Transfer function.
         const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, in.lo)), hn::Set(d, in.inv_width)) : v;
         const TableLookup ot = locate_rows(d, in.opacity_x, in.opacity_rows, x);
-        const V a = table_channel(d, ot, in.opacity_y, in.opacity_rows, 1, 0, x);
+        V a = table_channel(d, ot, in.opacity_y, in.opacity_rows, 1, 0, x);
+        V g[3];
+        bool have_gradient = false;
+        if (in.gradient_opacity_rows > 0) {
+            // a = clamp(a factor(|grad f|), 0, 1)
+            gradient(P, v, g);
+            have_gradient = true;
+            const V glen = hn::Sqrt(dot3(g, g));
+            const TableLookup gt = locate_rows(d, in.gradient_opacity_x, in.gradient_opacity_rows, glen);
+            const V factor = table_channel(d, gt, in.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen);
+            a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
+        }
         const M visible = hn::And(alive, hn::Gt(a, zero));
         if (!hn::AllFalse(d, visible)) {
             const TableLookup ct = locate_rows(d, in.color_x, in.color_rows, x);
-            const V cr = table_channel(d, ct, in.color_y, in.color_rows, 3, 0, x);
-            const V cg = table_channel(d, ct, in.color_y, in.color_rows, 3, 1, x);
-            const V cb = table_channel(d, ct, in.color_y, in.color_rows, 3, 2, x);
+            V m[3] = {table_channel(d, ct, in.color_y, in.color_rows, 3, 0, x),
+                      table_channel(d, ct, in.color_y, in.color_rows, 3, 1, x),
+                      table_channel(d, ct, in.color_y, in.color_rows, 3, 2, x)};
+            if (in.shaded) {
+                if (!have_gradient) gradient(P, v, g);
+                shade(in, m, g, view, t);
+            }
+            const V cr = m[0], cg = m[1], cb = m[2];
             const V T = hn::Exp(d, hn::Neg(hn::Add(tau_s, tau_c)));
             const M solid = hn::And(visible, hn::Ge(a, one));
             const M partial = hn::AndNot(solid, visible);

@@ -7,6 +7,8 @@
 #include <hwy/targets.h>
 
 #include "TestScenes.h"
+#include "core/integrate/CompositeIntegrator.h"
+#include "core/render/PreparedScene.h"
 
 using namespace volref;
 using namespace volref::test;
@@ -105,8 +107,18 @@ TEST(Simd, ConstantBoxClosedForm) {
 // AVX-512 (8 lanes) or AVX2 (4 lanes): every lane computes the same arithmetic, and both have fused
 // multiply-adds inside Highway's exp/log polynomials. SSE4 has no FMA, so its exp/log differ in the
 // last bits: within 1e-13 of the others.
+namespace {
+Scene shaded_ml_scene();
+void expect_identical_across_instruction_sets(const Scene& s);
+}  // namespace
+
 TEST(Simd, BitwiseIdenticalAcrossInstructionSets) {
-    const Scene s = ml_scene(29, 17);
+    expect_identical_across_instruction_sets(ml_scene(29, 17));
+    expect_identical_across_instruction_sets(shaded_ml_scene());
+}
+
+namespace {
+void expect_identical_across_instruction_sets(const Scene& s) {
     const Image best = render_scene(s, {.threads = 1, .simd = true});
     int compared = 0;
     for (std::int64_t target : {HWY_AVX3, HWY_AVX2, HWY_SSE4}) {
@@ -124,6 +136,7 @@ TEST(Simd, BitwiseIdenticalAcrossInstructionSets) {
     }
     EXPECT_GE(compared, 2);
 }
+}  // namespace
 
 // mip and minip: only reconstruction and comparisons are vectorised, so the packet path is
 // bitwise the scalar one.
@@ -152,4 +165,101 @@ TEST(Simd, SkippingDoesNotChangeThePacketPath) {
         const Image off = render_scene(s, {.threads = 1, .empty_space_skipping = false, .simd = true});
         EXPECT_EQ(std::memcmp(on.pixels.data(), off.pixels.data(), on.pixels.size() * sizeof(double)), 0) << step;
     }
+}
+
+namespace {
+
+// True when the scene's composite integrator takes the SIMD packet path.
+bool takes_packet_path(const Scene& s) {
+    const PreparedScene prepared(s, {.threads = 1});
+    const auto* composite = dynamic_cast<const CompositeIntegrator*>(prepared.integrator.get());
+    return composite && composite->has_packet_path();
+}
+
+Scene shaded_ml_scene() {
+    Scene s = ml_scene(37, 23);
+    ShadingSpec shading;
+    shading.ka = 0.2;
+    shading.kd = 0.7;
+    shading.ks = 0.3;
+    shading.n = 10.0;
+    s.volume.shading = shading;
+    LightSpec directional;
+    directional.type = LightSpec::Type::Directional;
+    directional.direction = glm::normalize(glm::dvec3(0.3, -0.5, 0.8));
+    directional.color = {0.9, 0.6, 0.3};
+    s.lights = {LightSpec{}, directional};
+    return s;
+}
+
+// Max |a - b| over two images.
+double image_difference(const Image& a, const Image& b) {
+    double d = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) d = std::max(d, std::fabs(a.pixels[i] - b.pixels[i]));
+    return d;
+}
+
+}  // namespace
+
+// Shading, gradients (central, forward, cached) and gradient-magnitude opacity in the packet path:
+// the scalar path's arithmetic except exp/expm1/log1p and s^n = exp(n log s) (PacketComposite.h).
+TEST(Simd, ShadedCompositeMatchesTheScalarPath) {
+    Scene s = shaded_ml_scene();
+    ASSERT_TRUE(takes_packet_path(s));
+    // Shading must matter, or the comparison below would prove nothing about it.
+    Scene unshaded = s;
+    unshaded.volume.shading.reset();
+    EXPECT_GT(image_difference(render_scene(s, {.threads = 1}), render_scene(unshaded, {.threads = 1})), 0.05);
+    EXPECT_LT(max_difference(s), 1e-13);
+
+    Scene phong = s;  // Phong, two-sided, depth cue
+    phong.volume.shading->model = ShadingSpec::Model::Phong;
+    phong.volume.shading->two_sided = true;
+    phong.volume.shading->kl = 0.05;
+    ASSERT_TRUE(takes_packet_path(phong));
+    EXPECT_LT(max_difference(phong), 1e-13);
+
+    Scene nodal = s;
+    nodal.volume.shading->model = ShadingSpec::Model::Nodal;
+    nodal.render.step = 0.37;
+    nodal.render.early_termination = 0.7;
+    EXPECT_LT(max_difference(nodal), 1e-13);
+
+    Scene forward = s;
+    forward.volume.gradient.scheme = GradientSpec::Scheme::Forward;
+    ASSERT_TRUE(takes_packet_path(forward));
+    EXPECT_LT(max_difference(forward), 1e-13);
+
+    Scene cached = s;
+    cached.volume.gradient.cache = true;
+    ASSERT_TRUE(takes_packet_path(cached));
+    EXPECT_LT(max_difference(cached), 1e-13);
+}
+
+TEST(Simd, GradientOpacityMatchesTheScalarPath) {
+    Scene s = ml_scene(37, 23);
+    s.volume.transfer.gradient_opacity = {{0.0, 0.1}, {0.5, 0.6}, {2.0, 1.0}};
+    ASSERT_TRUE(takes_packet_path(s));
+    EXPECT_LT(max_difference(s), 1e-13);
+    Scene shaded = shaded_ml_scene();
+    shaded.volume.transfer.gradient_opacity = s.volume.transfer.gradient_opacity;
+    shaded.volume.gradient.scheme = GradientSpec::Scheme::Forward;
+    EXPECT_LT(max_difference(shaded), 1e-13);
+    // With skipping on and off the packet path stays bitwise the same.
+    const Image on = render_scene(shaded, {.threads = 1, .empty_space_skipping = true, .simd = true});
+    const Image off = render_scene(shaded, {.threads = 1, .empty_space_skipping = false, .simd = true});
+    EXPECT_EQ(std::memcmp(on.pixels.data(), off.pixels.data(), on.pixels.size() * sizeof(double)), 0);
+}
+
+// Paths the packet kernel does not serve keep the scalar path (and therefore equal it bitwise).
+TEST(Simd, UnservedScenesTakeTheScalarPath) {
+    Scene s = shaded_ml_scene();
+    s.render.order = CompositeOrder::BackToFront;
+    EXPECT_FALSE(takes_packet_path(s));
+    s = shaded_ml_scene();
+    s.volume.interpolation = Interpolation::TricubicBSpline;
+    EXPECT_FALSE(takes_packet_path(s));
+    s = shaded_ml_scene();
+    s.lights.assign(9, LightSpec{});  // more than kMaxPacketLights
+    EXPECT_FALSE(takes_packet_path(s));
 }

@@ -7,6 +7,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "cli/ConvertCommand.h"
+#include "cli/InfoCommand.h"
 #include "core/Error.h"
 
 int main(int argc, char** argv) {
@@ -41,6 +43,21 @@ int main(int argc, char** argv) {
     rs->add_option("--encoding", resample.encoding, "Output encoding: raw (default) or gzip");
     rs->add_option("--format", resample.format, "Input format: nrrd or raw (default: from the extension)");
 
+    volref::cli::InfoArgs info;
+    CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");
+    ic->add_option("file", info.input, "Volume file (.nrrd .nhdr .raw .nii .nii.gz .mhd .mha .vtk .vti .den)")->required();
+    ic->add_option("--format", info.format, "nrrd, raw, nifti, metaimage, vtk, vti or den (default: from the extension)");
+    ic->add_flag("--json", info.json, "Print JSON instead of text");
+    ic->add_option("--bins", info.bins, "Histogram bins (default 16)");
+
+    volref::cli::ConvertArgs convert;
+    CLI::App* cv = app.add_subcommand("convert", "Convert a volume file to NRRD (.nrrd) or raw + JSON sidecar (.raw)");
+    cv->add_option("input", convert.input, "Input volume (any format `volref info` reads)")->required();
+    cv->add_option("output", convert.output, "Output volume: .nrrd or .raw (+ .raw.json)")->required();
+    cv->add_option("--format", convert.format, "Input format (default: from the extension)");
+    cv->add_option("--type", convert.type, "Output type: f64 (NRRD default) or f32; raw: u8..f64 (default: the input's)");
+    cv->add_option("--encoding", convert.encoding, "raw (default) or gzip");
+
     // ---- more subcommands: add each one's block above this line ----
 
     try {
@@ -52,6 +69,8 @@ int main(int argc, char** argv) {
     try {
         if (rc->parsed()) return volref::cli::run_render(render);
         if (rs->parsed()) return volref::cli::run_resample(resample);
+        if (ic->parsed()) return volref::cli::run_info(info);
+        if (cv->parsed()) return volref::cli::run_convert(convert);
         // ---- more subcommands: dispatch above this line ----
     } catch (const volref::Error& e) {
         std::fprintf(stderr, "volref: error: %s\n", e.what());

@@ -8,6 +8,8 @@ packages=(
   libhwy-dev libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   # bounding meshes: OBJ (tinyobjloader, its double-precision build) and PLY (assimp)
   libtinyobjloader-dev libassimp-dev
+  # volume formats: NIfTI-1/2 (nifti_clib) and VTK XML ImageData headers (expat)
+  libnifti2-dev libexpat1-dev
 )
 missing=()
 for p in "${packages[@]}"; do

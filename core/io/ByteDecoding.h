@@ -1,10 +1,16 @@
-// Byte-level helpers shared by the volume readers (NrrdReader, RawReader): reading a whole file,
-// inflating gzip/zlib data, cutting the samples out of a data region, and turning stored samples of
-// any ScalarType and byte order into doubles. Every failure is a volref::Error whose one-line message
+// Byte-level helpers shared by the volume readers (NRRD, raw, NIfTI, MetaImage, VTK legacy and XML,
+// VolPack .den): reading a whole file, inflating gzip/zlib data, cutting the samples out of a data
+// region, turning stored samples of any ScalarType and byte order into doubles (decode_samples; ascii
+// text: decode_ascii_samples), and storing them in a Volume (store_samples, the one place a reader
+// fills a Volume's values). Every failure is a volref::Error whose one-line message
 // starts with the `where` it is given (the path of the file at fault).
 #pragma once
 #include <algorithm>
 #include <bit>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <optional>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -234,6 +240,71 @@ inline std::vector<double> decode_samples(std::string_view bytes, ScalarType typ
         case ScalarType::F64: decode_as<double>(bytes, swap, out); break;
     }
     return out;
+}
+
+// A whole word as a number in the C locale: an optional sign, decimal or exponent notation, "nan" or
+// "inf" (any case). nullopt for anything else, including numbers beyond double's range.
+inline std::optional<double> parse_number(std::string_view s) {
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    if (s.empty() || s.front() == '+' || (s.size() > 1 && s[0] == '-' && s[1] == '+')) return std::nullopt;
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+    if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+    return value;
+}
+
+// `count` samples written as text (numbers separated by white space) and stored as `type`: integer
+// types need whole numbers within the type's range; f32 values are rounded to float, as a float file
+// would hold them. Fewer numbers is "truncated", more is "dims do not match". `first_line` (when > 0)
+// is the line of the file on which `text` starts, so that a bad number's message names its line.
+inline std::vector<double> decode_ascii_samples(std::string_view text, ScalarType type, std::size_t count,
+                                                const std::string& where, std::size_t first_line = 0) {
+    std::vector<double> values;
+    values.reserve(count);
+    std::size_t line = first_line;
+    const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; };
+    std::size_t i = 0;
+    while (i < text.size()) {
+        while (i < text.size() && is_space(text[i])) {
+            if (text[i] == '\n') ++line;
+            ++i;
+        }
+        const std::size_t start = i;
+        while (i < text.size() && !is_space(text[i])) ++i;
+        if (i == start) break;
+        if (values.size() == count) throw Error(too_long_message(where, count, "more", "values"));
+        const std::string_view word = text.substr(start, i - start);
+        const std::string at = where + (first_line > 0 ? ": line " + std::to_string(line) : std::string()) +
+                               ": ascii sample " + std::to_string(values.size()) + ": ";
+        const auto v = parse_number(word);
+        if (!v) throw Error(at + quoted(word) + " is not a number");
+        double x = *v;
+        if (scalar_type_is_integer(type)) {
+            const auto [lo, hi] = scalar_type_range(type);
+            if (!(x >= lo && x <= hi && std::floor(x) == x))
+                throw Error(at + quoted(word) + " is not an integer in the range of " + scalar_type_name(type));
+        } else if (type == ScalarType::F32) {
+            if (std::isfinite(x) && std::fabs(x) > double(std::numeric_limits<float>::max()))
+                throw Error(at + quoted(word) + " is out of the range of f32");
+            x = double(float(x));
+        }
+        values.push_back(x);
+    }
+    if (values.size() < count) throw Error(truncated_message(where, count, values.size(), "values"));
+    return values;
+}
+
+// The one place a reader fills a Volume's samples: `values` (i fastest, as decode_samples or
+// decode_ascii_samples return them) become the volume's, and `type` its file type. The volume's dims
+// must already be set; a count that does not match them is a reader bug, reported as an Error.
+// (Should the storage become typed, only this function changes.)
+inline void store_samples(Volume& volume, ScalarType type, std::vector<double> values, const std::string& where) {
+    const std::size_t count = checked_voxel_count(volume.dims, where, sizeof(double));
+    if (values.size() != count)
+        throw Error(where + ": internal error: " + std::to_string(values.size()) + " samples for " +
+                    std::to_string(count) + " voxels");
+    volume.type = type;
+    volume.values = std::move(values);
 }
 
 }  // namespace volref::io

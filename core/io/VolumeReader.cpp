@@ -4,33 +4,66 @@
 
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/DenReader.h"
+#include "core/io/MetaImageReader.h"
+#include "core/io/NiftiReader.h"
 #include "core/io/NrrdReader.h"
 #include "core/io/RawReader.h"
+#include "core/io/VtiReader.h"
+#include "core/io/VtkLegacyReader.h"
 
 namespace volref {
 
 namespace {
 
-// The format named by a file's extension (compared without case): .nrrd and .nhdr are NRRD, .raw is
-// raw samples with a JSON sidecar.
-std::string format_from_extension(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext)
+constexpr const char* kFormats = "nrrd, raw, nifti, metaimage, vtk, vti or den";
+
+std::string lower(std::string s) {
+    for (char& c : s)
         if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');
+    return s;
+}
+
+// The format named by a file's extension (compared without case).
+std::string format_from_extension(const std::filesystem::path& path) {
+    const std::string name = lower(path.filename().string());
+    const auto ends_with = [&](const char* suffix) {
+        const std::string s(suffix);
+        return name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0;
+    };
+    if (ends_with(".nii.gz")) return "nifti";
+    const std::string ext = lower(path.extension().string());
     if (ext == ".nrrd" || ext == ".nhdr") return "nrrd";
     if (ext == ".raw") return "raw";
+    if (ext == ".nii" || ext == ".hdr") return "nifti";
+    if (ext == ".mhd" || ext == ".mha") return "metaimage";
+    if (ext == ".vtk") return "vtk";
+    if (ext == ".vti") return "vti";
+    if (ext == ".den") return "den";
     const std::string found = ext.empty() ? "no extension" : "the extension " + io::quoted(ext);
     throw Error(path.string() + ": cannot tell the volume format from " + found +
-                " (supported: .nrrd, .nhdr, .raw; or name the format: nrrd or raw)");
+                " (supported: .nrrd, .nhdr, .raw, .nii, .nii.gz, .hdr, .mhd, .mha, .vtk, .vti, .den; or name the "
+                "format: " + kFormats + ")");
 }
 
 }  // namespace
 
+std::string volume_format(const std::filesystem::path& path, const std::string& format) {
+    if (format.empty()) return format_from_extension(path);
+    for (const char* known : {"nrrd", "raw", "nifti", "metaimage", "vtk", "vti", "den"})
+        if (format == known) return format;
+    throw Error(path.string() + ": unknown volume format " + io::quoted(format) + " (expected " + kFormats + ")");
+}
+
 Volume read_volume(const std::filesystem::path& path, const std::string& format) {
-    const std::string chosen = format.empty() ? format_from_extension(path) : format;
+    const std::string chosen = volume_format(path, format);
     if (chosen == "nrrd") return read_nrrd(path);
     if (chosen == "raw") return read_raw_volume(path);
-    throw Error(path.string() + ": unknown volume format " + io::quoted(format) + " (expected nrrd or raw)");
+    if (chosen == "nifti") return read_nifti(path);
+    if (chosen == "metaimage") return read_metaimage(path);
+    if (chosen == "vtk") return read_vtk_legacy(path);
+    if (chosen == "vti") return read_vti(path);
+    return read_den(path);
 }
 
 }  // namespace volref

@@ -545,10 +545,10 @@ TEST_F(VolumeIo, FormatFromExtensionOrGiven) {
 }
 
 TEST_F(VolumeIo, ErrorUnknownExtensionOrFormat) {
-    const fs::path p = write("v.vtk", "x");
+    const fs::path p = write("v.xyz", "x");
     std::string m = read_error(p);
     EXPECT_THAT(m, StartsWith(p.string()));
-    EXPECT_THAT(m, HasSubstr("'.vtk'"));
+    EXPECT_THAT(m, HasSubstr("'.xyz'"));
     EXPECT_THAT(m, HasSubstr(".nrrd, .nhdr, .raw"));
 
     const fs::path q = write("noext", "x");
@@ -556,9 +556,9 @@ TEST_F(VolumeIo, ErrorUnknownExtensionOrFormat) {
     EXPECT_THAT(m, StartsWith(q.string()));
     EXPECT_THAT(m, HasSubstr("no extension"));
 
-    m = read_error(p, "vtk");
+    m = read_error(p, "xyz");
     EXPECT_THAT(m, StartsWith(p.string()));
-    EXPECT_THAT(m, HasSubstr("unknown volume format 'vtk'"));
+    EXPECT_THAT(m, HasSubstr("unknown volume format 'xyz'"));
 }
 
 // ======================= NRRD errors =======================

@@ -1,0 +1,258 @@
+#include "core/io/MetaImageReader.h"
+
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Error.h"
+#include "core/io/ByteDecoding.h"
+
+namespace volref {
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+    return s;
+}
+
+std::string lower(std::string_view s) {
+    std::string out(s);
+    for (char& c : out)
+        if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');
+    return out;
+}
+
+std::vector<std::string_view> split_words(std::string_view s) {
+    std::vector<std::string_view> words;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
+        const std::size_t start = i;
+        while (i < s.size() && s[i] != ' ' && s[i] != '\t') ++i;
+        if (i > start) words.push_back(s.substr(start, i - start));
+    }
+    return words;
+}
+
+struct Field {
+    std::string key;  // as written
+    std::string value;
+    std::size_t line = 0;
+};
+
+// The header: its fields by lower-case key, and where the data start when ElementDataFile = LOCAL.
+struct Header {
+    std::map<std::string, Field> fields;
+    std::size_t data_offset = 0;  // the byte after the ElementDataFile line
+    bool has_data_file = false;
+};
+
+Header parse_header(const std::string& file, const std::string& where) {
+    Header h;
+    std::size_t pos = 0;
+    std::size_t line = 0;
+    while (pos < file.size()) {
+        ++line;
+        std::size_t eol = file.find('\n', pos);
+        const std::size_t end = eol == std::string::npos ? file.size() : eol;
+        const std::string_view text = trim(std::string_view(file).substr(pos, end - pos));
+        pos = eol == std::string::npos ? file.size() : eol + 1;
+        if (text.empty()) continue;
+        const std::size_t eq = text.find('=');
+        if (eq == std::string_view::npos)
+            throw Error(where + ": line " + std::to_string(line) + ": expected 'Key = Value', got " + io::quoted(text));
+        const std::string key(trim(text.substr(0, eq)));
+        const std::string value(trim(text.substr(eq + 1)));
+        if (key.empty() || key.find_first_of("\t ") != std::string::npos)
+            throw Error(where + ": line " + std::to_string(line) + ": expected 'Key = Value', got " + io::quoted(text));
+        const std::string k = lower(key);
+        if (auto it = h.fields.find(k); it != h.fields.end())
+            throw Error(where + ": line " + std::to_string(line) + ": " + key + " given twice (first on line " +
+                        std::to_string(it->second.line) + ")");
+        h.fields[k] = Field{key, value, line};
+        if (k == "elementdatafile") {
+            h.data_offset = pos;
+            h.has_data_file = true;
+            break;
+        }
+    }
+    return h;
+}
+
+class Fields {
+public:
+    Fields(const Header& h, std::string where) : h_(h), where_(std::move(where)) {}
+
+    const Field* find(const std::string& lower_key) const {
+        const auto it = h_.fields.find(lower_key);
+        return it == h_.fields.end() ? nullptr : &it->second;
+    }
+    // The first of `keys` present.
+    const Field* find_any(std::initializer_list<const char*> keys) const {
+        for (const char* k : keys)
+            if (const Field* f = find(k)) return f;
+        return nullptr;
+    }
+    const Field& require(const char* lower_key, const char* name) const {
+        const Field* f = find(lower_key);
+        if (!f) throw Error(where_ + ": missing required key '" + name + "'");
+        return *f;
+    }
+    [[noreturn]] void fail(const Field& f, const std::string& problem) const {
+        throw Error(where_ + ": line " + std::to_string(f.line) + ": " + f.key + ": " + problem);
+    }
+    bool boolean(const Field& f) const {
+        const std::string v = lower(f.value);
+        if (v == "true" || v == "1") return true;
+        if (v == "false" || v == "0") return false;
+        fail(f, "expected True or False, got " + io::quoted(f.value));
+    }
+    std::vector<double> numbers(const Field& f, std::size_t n, bool positive) const {
+        const auto words = split_words(f.value);
+        if (words.size() != n)
+            fail(f, "expected " + std::to_string(n) + " numbers, got " + io::quoted(f.value));
+        std::vector<double> out;
+        for (std::string_view w : words) {
+            const auto v = io::parse_number(w);
+            if (!v || !std::isfinite(*v) || (positive && !(*v > 0.0)))
+                fail(f, std::string("expected ") + (positive ? "numbers > 0" : "finite numbers") + ", got " +
+                            io::quoted(w));
+            out.push_back(*v);
+        }
+        return out;
+    }
+    std::int64_t integer(const Field& f, std::int64_t min) const {
+        const auto v = io::parse_number(f.value);
+        if (!v || std::floor(*v) != *v || *v < double(min) || *v > 9.0e18)
+            fail(f, "expected an integer >= " + std::to_string(min) + ", got " + io::quoted(f.value));
+        return static_cast<std::int64_t>(*v);
+    }
+
+private:
+    const Header& h_;
+    std::string where_;
+};
+
+ScalarType element_type(const Fields& fields) {
+    const Field& f = fields.require("elementtype", "ElementType");
+    const std::string& v = f.value;
+    if (v == "MET_UCHAR") return ScalarType::U8;
+    if (v == "MET_CHAR") return ScalarType::I8;
+    if (v == "MET_USHORT") return ScalarType::U16;
+    if (v == "MET_SHORT") return ScalarType::I16;
+    if (v == "MET_UINT") return ScalarType::U32;
+    if (v == "MET_INT") return ScalarType::I32;
+    if (v == "MET_FLOAT") return ScalarType::F32;
+    if (v == "MET_DOUBLE") return ScalarType::F64;
+    if (v.rfind("MET_", 0) == 0)
+        fields.fail(f, "type " + io::quoted(v) +
+                           " is not supported (volref reads MET_UCHAR, MET_CHAR, MET_USHORT, MET_SHORT, MET_UINT, "
+                           "MET_INT, MET_FLOAT, MET_DOUBLE)");
+    fields.fail(f, "unknown type " + io::quoted(v));
+}
+
+}  // namespace
+
+Volume read_metaimage(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    const std::string file = io::read_file_bytes(path);
+    const Header header = parse_header(file, where);
+    const Fields fields(header, where);
+
+    if (const Field* f = fields.find("objecttype"); f && lower(f->value) != "image")
+        fields.fail(*f, "ObjectType " + io::quoted(f->value) + " is not supported (volref reads Image)");
+    const Field& ndims_field = fields.require("ndims", "NDims");
+    const std::int64_t ndims = fields.integer(ndims_field, 1);
+    if (ndims > 3) fields.fail(ndims_field, std::to_string(ndims) + " dimensions are not supported (volref reads 1 to 3)");
+    const auto n = static_cast<std::size_t>(ndims);
+
+    Volume volume;
+    volume.dims = {1, 1, 1};
+    const Field& dim_field = fields.require("dimsize", "DimSize");
+    const std::vector<double> dims = fields.numbers(dim_field, n, true);
+    for (std::size_t a = 0; a < n; ++a) {
+        if (std::floor(dims[a]) != dims[a] || dims[a] > 9.0e18)
+            fields.fail(dim_field, "expected integers >= 1, got " + io::quoted(dim_field.value));
+        volume.dims[a] = static_cast<std::int64_t>(dims[a]);
+    }
+    const ScalarType type = element_type(fields);
+    if (const Field* f = fields.find("elementnumberofchannels"); f && fields.integer(*f, 1) != 1)
+        fields.fail(*f, "only 1 channel is supported, got " + io::quoted(f->value));
+    if (const Field* f = fields.find_any({"elementspacing", "elementsize"})) {
+        const auto s = fields.numbers(*f, n, true);
+        for (std::size_t a = 0; a < n; ++a) volume.spacing[int(a)] = s[a];
+    }
+    if (const Field* f = fields.find_any({"offset", "position", "origin"})) {
+        const auto o = fields.numbers(*f, n, false);
+        for (std::size_t a = 0; a < n; ++a) volume.origin[int(a)] = o[a];
+    }
+    if (const Field* f = fields.find_any({"transformmatrix", "rotation", "orientation"})) {
+        const auto m = fields.numbers(*f, n * n, false);
+        for (std::size_t r = 0; r < n; ++r)
+            for (std::size_t c = 0; c < n; ++c)
+                if (m[r * n + c] != (r == c ? 1.0 : 0.0))
+                    fields.fail(*f, "only the identity is supported (volref reads axis-aligned, unrotated grids), got " +
+                                        io::quoted(f->value));
+    }
+    if (const Field* f = fields.find("binarydata"); f && !fields.boolean(*f))
+        fields.fail(*f, "ASCII MetaImage data (BinaryData = False) is not supported");
+    bool msb = false;
+    if (const Field* f = fields.find_any({"binarydatabyteordermsb", "elementbyteordermsb"})) msb = fields.boolean(*f);
+    bool compressed = false;
+    if (const Field* f = fields.find("compresseddata")) compressed = fields.boolean(*f);
+    std::optional<std::int64_t> compressed_size;
+    if (const Field* f = fields.find("compresseddatasize")) compressed_size = fields.integer(*f, 0);
+    std::int64_t header_size = 0;
+    if (const Field* f = fields.find("headersize")) header_size = fields.integer(*f, -1);
+    const std::size_t count = checked_voxel_count(volume.dims, where, sizeof(double));
+    const std::size_t expected = count * scalar_type_size(type);
+    if (!header.has_data_file) throw Error(where + ": missing required key 'ElementDataFile'");
+    const Field& data_field = *fields.find("elementdatafile");
+
+    // The data region: after the header line (LOCAL), or the named file.
+    std::string data_file;
+    std::string data_where = where;
+    std::string_view region;
+    const std::string data_name = data_field.value;
+    if (lower(data_name) == "local") {
+        region = std::string_view(file).substr(header.data_offset);
+    } else {
+        if (lower(data_name) == "list" || data_name.find('%') != std::string::npos ||
+            split_words(data_name).size() > 1)
+            fields.fail(data_field, "several data files are not supported (give one file or LOCAL)");
+        std::filesystem::path p(data_name);
+        if (p.is_relative()) p = path.parent_path() / p;
+        data_file = io::read_file_bytes(p);
+        data_where = p.string() + " (data file of " + where + ")";
+        region = data_file;
+    }
+    // Errors in a data file name it first.
+    const std::string at = lower(data_name) == "local" ? where : data_where;
+    std::string storage;
+    std::string_view bytes;
+    if (compressed) {
+        if (header_size != 0) fields.fail(*fields.find("headersize"), "HeaderSize with CompressedData is not supported");
+        if (compressed_size) {
+            if (std::uint64_t(*compressed_size) > region.size())
+                throw Error(at + ": truncated: CompressedDataSize is " + std::to_string(*compressed_size) +
+                            " bytes, found " + std::to_string(region.size()));
+            if (std::uint64_t(*compressed_size) < region.size())
+                throw Error(at + ": CompressedDataSize is " + std::to_string(*compressed_size) + " bytes, but " +
+                            std::to_string(region.size()) + " bytes of compressed data follow");
+        }
+        bytes = io::sample_bytes(region, io::BinaryEncoding::Gzip, 0, expected, storage, at);
+    } else {
+        bytes = io::sample_bytes(region, io::BinaryEncoding::Raw, header_size, expected, storage, at);
+    }
+    io::store_samples(volume, type, io::decode_samples(bytes, type, msb ? std::endian::big : std::endian::little),
+                      where);
+    return volume;
+}
+
+}  // namespace volref

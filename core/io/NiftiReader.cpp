@@ -1,0 +1,274 @@
+#include "core/io/NiftiReader.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <nifti2_io.h>
+
+#include "core/Error.h"
+#include "core/io/ByteDecoding.h"
+
+namespace volref {
+
+namespace {
+
+// Entries of an axis-aligned matrix below this fraction of their column's largest are taken as 0
+// (float quaternions and sforms carry rounding of about 1e-7).
+constexpr double kOffAxisTolerance = 1e-6;
+
+struct NiftiVersion {
+    int version = 1;          // 1 or 2
+    std::size_t header_size;  // 348 or 540
+};
+
+std::string hex_bytes(std::string_view s) { return io::quoted(s, 8); }
+
+// Checks the first bytes of the header (decompressed for gzip): sizeof_hdr, length and magic.
+NiftiVersion check_header_bytes(const std::filesystem::path& path, const std::string& where) {
+    const std::string file = io::read_file_bytes(path);
+    std::string prefix;
+    if (file.size() >= 2 && static_cast<unsigned char>(file[0]) == 0x1f && static_cast<unsigned char>(file[1]) == 0x8b) {
+        prefix = io::inflate_stream(file, 0, 540, where).data;
+    } else {
+        prefix = file.substr(0, std::min<std::size_t>(file.size(), 540));
+    }
+    if (prefix.size() < 4)
+        throw Error(where + ": truncated header: expected 348 bytes (NIfTI-1) or 540 (NIfTI-2), found " +
+                    std::to_string(prefix.size()));
+    const auto le = io::load_value<std::int32_t>(prefix.data(), std::endian::native != std::endian::little);
+    const auto be = io::load_value<std::int32_t>(prefix.data(), std::endian::native != std::endian::big);
+    NiftiVersion v;
+    if (le == 348 || be == 348) {
+        v = {1, 348};
+    } else if (le == 540 || be == 540) {
+        v = {2, 540};
+    } else {
+        throw Error(where + ": not a NIfTI file: sizeof_hdr at byte 0 is " + std::to_string(le) +
+                    " (expected 348 for NIfTI-1 or 540 for NIfTI-2, in either byte order)");
+    }
+    if (prefix.size() < v.header_size)
+        throw Error(where + ": truncated header: expected " + std::to_string(v.header_size) + " bytes (NIfTI-" +
+                    std::to_string(v.version) + "), found " + std::to_string(prefix.size()));
+    if (v.version == 1) {
+        const std::string_view magic = std::string_view(prefix).substr(344, 4);
+        if (magic != std::string_view("n+1\0", 4) && magic != std::string_view("ni1\0", 4))
+            throw Error(where + ": bad magic at byte 344: " + hex_bytes(magic) + " (expected 'n+1' or 'ni1')");
+    } else {
+        const std::string_view magic = std::string_view(prefix).substr(4, 8);
+        if (magic != std::string_view("n+2\0\r\n\032\n", 8) && magic != std::string_view("ni2\0\r\n\032\n", 8))
+            throw Error(where + ": bad magic at byte 4: " + hex_bytes(magic) +
+                        " (expected 'n+2' or 'ni2' followed by \\0\\r\\n\\x1a\\n)");
+    }
+    return v;
+}
+
+// dim[0..7] and datatype as the header holds them (byte-swapped to native by nifti_clib).
+struct RawFields {
+    std::array<std::int64_t, 8> dim{};
+    int datatype = 0;
+};
+
+RawFields read_raw_fields(const std::filesystem::path& path, const NiftiVersion& v, const std::string& where) {
+    int nver = 0;
+    void* raw = nifti_read_header(path.c_str(), &nver, 0);
+    if (!raw) throw Error(where + ": nifti_clib could not read the NIfTI-" + std::to_string(v.version) + " header");
+    std::unique_ptr<void, void (*)(void*)> guard(raw, &std::free);
+    RawFields f;
+    if (nver == 2) {
+        const auto* h = static_cast<const nifti_2_header*>(raw);
+        for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
+        f.datatype = h->datatype;
+    } else {
+        const auto* h = static_cast<const nifti_1_header*>(raw);
+        for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
+        f.datatype = h->datatype;
+    }
+    return f;
+}
+
+ScalarType scalar_type(int datatype, const NiftiVersion& v, const std::string& where) {
+    switch (datatype) {
+        case DT_UINT8: return ScalarType::U8;
+        case DT_INT8: return ScalarType::I8;
+        case DT_UINT16: return ScalarType::U16;
+        case DT_INT16: return ScalarType::I16;
+        case DT_UINT32: return ScalarType::U32;
+        case DT_INT32: return ScalarType::I32;
+        case DT_FLOAT32: return ScalarType::F32;
+        case DT_FLOAT64: return ScalarType::F64;
+        default: break;
+    }
+    const std::string at = where + ": datatype (byte " + (v.version == 1 ? "70" : "12") + ") ";
+    const char* name = nifti_datatype_string(datatype);
+    if (nifti_is_valid_datatype(datatype))
+        throw Error(at + std::to_string(datatype) + " (" + name +
+                    ") is not supported (volref reads UINT8, INT8, UINT16, INT16, UINT32, INT32, FLOAT32, FLOAT64)");
+    throw Error(at + std::to_string(datatype) + " is not a NIfTI datatype");
+}
+
+struct ImageDeleter {
+    void operator()(nifti_image* nim) const { nifti_image_free(nim); }
+};
+
+// Where voxel axis c goes: world axis `axis[c]`, flipped when `flip[c]`.
+struct Orientation {
+    std::array<int, 3> axis{0, 1, 2};
+    std::array<bool, 3> flip{false, false, false};
+    glm::dvec3 spacing{1.0};  // per voxel axis, > 0
+    glm::dvec3 offset{0.0};   // world position of voxel (0, 0, 0)
+    std::string source = "pixdim";
+};
+
+Orientation orientation(const nifti_image& nim, const std::string& where) {
+    Orientation o;
+    const bool use_sform = nim.sform_code > 0;
+    const bool use_qform = !use_sform && nim.qform_code > 0;
+    for (int c = 0; c < 3; ++c) {
+        const double p = nim.pixdim[c + 1];
+        if (!use_sform && !(std::isfinite(p) && p != 0.0))
+            throw Error(where + ": pixdim[" + std::to_string(c + 1) + "] must be finite and non-zero, got " +
+                        std::to_string(p));
+        o.spacing[c] = std::fabs(p);
+    }
+    if (!use_sform && !use_qform) return o;  // NIfTI's method 1: index times pixdim, no origin
+    const nifti_dmat44& m = use_sform ? nim.sto_xyz : nim.qto_xyz;
+    o.source = use_sform ? "sform" : "qform";
+    std::array<bool, 3> taken{false, false, false};
+    for (int c = 0; c < 3; ++c) {
+        int best = 0;
+        for (int r = 1; r < 3; ++r)
+            if (std::fabs(m.m[r][c]) > std::fabs(m.m[best][c])) best = r;
+        const double big = std::fabs(m.m[best][c]);
+        bool aligned = std::isfinite(big) && big > 0.0 && !taken[std::size_t(best)];
+        for (int r = 0; r < 3 && aligned; ++r)
+            if (r != best && !(std::fabs(m.m[r][c]) <= kOffAxisTolerance * big)) aligned = false;
+        if (!aligned) {
+            std::string rows;
+            for (int r = 0; r < 3; ++r) {
+                char buf[160];
+                std::snprintf(buf, sizeof buf, "%s[%g %g %g %g]", r ? " " : "", m.m[r][0], m.m[r][1], m.m[r][2],
+                              m.m[r][3]);
+                rows += buf;
+            }
+            throw Error(where + ": the " + o.source + " is oblique (voxel axis " + std::to_string(c) +
+                        " is not along one world axis): " + rows +
+                        "; volref reads axis-aligned grids only (resample the image first)");
+        }
+        taken[std::size_t(best)] = true;
+        o.axis[std::size_t(c)] = best;
+        o.flip[std::size_t(c)] = m.m[best][c] < 0.0;
+        // The qform's rotation comes from float quaternions: its magnitude is pixdim's, exactly.
+        o.spacing[c] = use_sform ? big : std::fabs(nim.pixdim[c + 1]);
+    }
+    for (int r = 0; r < 3; ++r) {
+        o.offset[r] = m.m[r][3];
+        if (!std::isfinite(o.offset[r])) throw Error(where + ": the " + o.source + " has a non-finite offset");
+    }
+    return o;
+}
+
+}  // namespace
+
+Volume read_nifti(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    io::open_for_reading(path);
+    static std::once_flag quiet;
+    std::call_once(quiet, [] { nifti_set_debug_level(0); });  // volref reports errors itself
+
+    const NiftiVersion version = check_header_bytes(path, where);
+    const RawFields raw = read_raw_fields(path, version, where);
+    const std::string dim_at = version.version == 1 ? "byte 40" : "byte 16";
+    const std::int64_t ndim = raw.dim[0];
+    if (ndim < 1 || ndim > 7)
+        throw Error(where + ": dim[0] (" + dim_at + ") must be 1 to 7, got " + std::to_string(ndim));
+    for (std::int64_t i = 1; i <= ndim; ++i)
+        if (raw.dim[std::size_t(i)] < 1)
+            throw Error(where + ": dim[" + std::to_string(i) + "] must be >= 1, got " +
+                        std::to_string(raw.dim[std::size_t(i)]));
+    for (std::int64_t i = 4; i <= ndim; ++i)
+        if (raw.dim[std::size_t(i)] > 1)
+            throw Error(where + ": dim[" + std::to_string(i) + "] is " + std::to_string(raw.dim[std::size_t(i)]) +
+                        ": images of more than 3 dimensions (time series, vectors) are not supported");
+    const ScalarType type = scalar_type(raw.datatype, version, where);
+
+    std::unique_ptr<nifti_image, ImageDeleter> nim(nifti_image_read(path.c_str(), 0));
+    if (!nim) throw Error(where + ": nifti_clib could not read the header (see nifti_tool -check_hdr)");
+    const std::array<std::int64_t, 3> file_dims{raw.dim[1], ndim >= 2 ? raw.dim[2] : 1, ndim >= 3 ? raw.dim[3] : 1};
+    const std::size_t count = checked_voxel_count(file_dims, where, sizeof(double));
+    const Orientation o = orientation(*nim, where);
+
+    // The image bytes: in the same file after vox_offset (.nii), or in the .img file.
+    const std::filesystem::path image_path = nim->iname ? std::filesystem::path(nim->iname) : path;
+    const std::string at =
+        image_path == path ? where : image_path.string() + " (image file of " + where + ")";
+    if (nim->iname_offset < 0) throw Error(where + ": vox_offset must be >= 0");
+    const auto offset = static_cast<std::uint64_t>(nim->iname_offset);
+    const std::size_t expected = count * scalar_type_size(type);
+    const std::string file = io::read_file_bytes(image_path);
+    std::string storage;
+    std::string_view bytes;
+    if (nifti_is_gzfile(image_path.c_str())) {
+        storage = io::inflate_stream(file, offset, expected, at).data;
+        if (storage.size() < expected)
+            throw Error(io::truncated_message(at, expected, storage.size()) + " after inflating (from vox_offset " +
+                        std::to_string(offset) + ")");
+        bytes = storage;
+    } else {
+        const std::size_t found = offset >= file.size() ? 0 : file.size() - std::size_t(offset);
+        if (found < expected)
+            throw Error(io::truncated_message(at, expected, found) + " (from vox_offset " + std::to_string(offset) + ")");
+        bytes = std::string_view(file).substr(std::size_t(offset), expected);
+    }
+    const std::endian order = nim->byteorder == 2 /* MSB_FIRST, private to nifti_clib */ ? std::endian::big : std::endian::little;
+    std::vector<double> stored = io::decode_samples(bytes, type, order);
+
+    // Scaling: value = slope * stored + inter, when slope is set and not the identity.
+    ScalarType volume_type = type;
+    const double slope = nim->scl_slope, inter = nim->scl_inter;
+    if (std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0)) {
+        for (double& x : stored) x = slope * x + inter;
+        volume_type = ScalarType::F64;
+    }
+
+    // Reorder so that volume axis a is world axis a, increasing.
+    Volume volume;
+    std::array<int, 3> voxel_axis{};  // voxel_axis[world axis] = voxel axis
+    for (int c = 0; c < 3; ++c) voxel_axis[std::size_t(o.axis[std::size_t(c)])] = c;
+    for (int a = 0; a < 3; ++a) {
+        const int c = voxel_axis[std::size_t(a)];
+        const std::int64_t n = file_dims[std::size_t(c)];
+        volume.dims[std::size_t(a)] = n;
+        volume.spacing[a] = o.spacing[c];
+        volume.origin[a] = o.offset[a] - (o.flip[std::size_t(c)] ? o.spacing[c] * double(n - 1) : 0.0);
+    }
+    const bool identity = voxel_axis == std::array<int, 3>{0, 1, 2} && !o.flip[0] && !o.flip[1] && !o.flip[2];
+    if (identity) {
+        io::store_samples(volume, volume_type, std::move(stored), where);
+        return volume;
+    }
+    std::vector<double> values(count);
+    const std::array<std::int64_t, 3> stride{1, file_dims[0], file_dims[0] * file_dims[1]};
+    std::size_t out = 0;
+    for (std::int64_t k = 0; k < volume.dims[2]; ++k)
+        for (std::int64_t j = 0; j < volume.dims[1]; ++j)
+            for (std::int64_t i = 0; i < volume.dims[0]; ++i) {
+                const std::array<std::int64_t, 3> n{i, j, k};
+                std::int64_t src = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const int c = voxel_axis[std::size_t(a)];
+                    const std::int64_t idx = o.flip[std::size_t(c)] ? volume.dims[std::size_t(a)] - 1 - n[std::size_t(a)]
+                                                                    : n[std::size_t(a)];
+                    src += idx * stride[std::size_t(c)];
+                }
+                values[out++] = stored[std::size_t(src)];
+            }
+    io::store_samples(volume, volume_type, std::move(values), where);
+    return volume;
+}
+
+}  // namespace volref

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "cli/CompareCommand.h"
 #include "cli/ConvertCommand.h"
 #include "cli/InfoCommand.h"
 #include "core/Error.h"
@@ -58,6 +59,25 @@ int main(int argc, char** argv) {
     cv->add_option("--type", convert.type, "Output type: f64 (NRRD default) or f32; raw: u8..f64 (default: the input's)");
     cv->add_option("--encoding", convert.encoding, "raw (default) or gzip");
 
+    volref::cli::CompareArgs compare;
+    CLI::App* cmp = app.add_subcommand(
+        "compare", "Compare two images: max abs, mean abs, RMSE, PSNR, SSIM, pixels over a tolerance; exit 0 within "
+                   "tolerance, 1 not, 2 usage or input errors (docs/compare.md)");
+    cmp->add_option("a", compare.a, "Image A (any format OpenImageIO reads; e.g. volref's EXR)")->required();
+    cmp->add_option("b", compare.b, "Image B, the same size")->required();
+    cmp->add_option("--tolerance", compare.tolerance, "Absolute tolerance per channel (default 0)")
+        ->check(CLI::NonNegativeNumber);
+    cmp->add_flag("--tolerance-from-error", compare.tolerance_from_error,
+                  "Add each input's per-pixel `error` channel (volref EXR) to the tolerance");
+    cmp->add_option("--background", compare.background,
+                    "R,G,B,A: composite premultiplied (EXR) inputs over this background first");
+    cmp->add_option("--heatmap", compare.heatmap, "Write a heat map of the per-pixel max abs difference (PNG)");
+    cmp->add_option("--heatmap-scale", compare.heatmap_scale,
+                    "Difference shown white in the heat map (default: the max abs difference)")
+        ->check(CLI::NonNegativeNumber);
+    cmp->add_flag("--fit", compare.fit, "Fit a gain, an opacity exponent and a sub-pixel shift; name the likely cause");
+    cmp->add_flag("--json", compare.json, "Print the report as JSON");
+
     // ---- more subcommands: add each one's block above this line ----
 
     try {
@@ -71,6 +91,15 @@ int main(int argc, char** argv) {
         if (rs->parsed()) return volref::cli::run_resample(resample);
         if (ic->parsed()) return volref::cli::run_info(info);
         if (cv->parsed()) return volref::cli::run_convert(convert);
+        if (cmp->parsed()) {
+            // compare's exit status 1 means "differs": bad input exits 2 (docs/compare.md).
+            try {
+                return volref::cli::run_compare(compare);
+            } catch (const volref::Error& e) {
+                std::fprintf(stderr, "volref: error: %s\n", e.what());
+                return 2;
+            }
+        }
         // ---- more subcommands: dispatch above this line ----
     } catch (const volref::Error& e) {
         std::fprintf(stderr, "volref: error: %s\n", e.what());

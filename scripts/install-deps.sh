@@ -10,6 +10,8 @@ packages=(
   libtinyobjloader-dev libassimp-dev
   # volume formats: NIfTI-1/2 (nifti_clib) and VTK XML ImageData headers (expat)
   libnifti2-dev libexpat1-dev
+  # volref compare --fit and volref sweep: least-squares fits (Ceres) and the error-against-time plot (gnuplot)
+  libceres-dev gnuplot-nox
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,60 @@
+// Least-squares fits (Ceres) behind `volref compare --fit` and `volref sweep`'s order of accuracy.
+//
+// compare --fit: each model predicts B from A (premultiplied RGBA, ComparedImage.h) with a few
+// convention parameters, fitted by least squares over the pixels' R, G, B, A:
+//   gain       B_rgb = g A_rgb,  B_a = A_a                                   (one parameter g)
+//   opacity    B_a = 1 - (1 - A_a)^k,  B_rgb = A_rgb B_a / A_a                (one parameter k > 0)
+//              (k multiplies the optical depth: a step, opacity unit distance or density scale k times
+//              A's; the colour follows alpha as it does for a constant colour along the ray; pixels with
+//              A_a = 0 or A_a >= 1 do not depend on k and are left out of the fit)
+//   shift      B(x, y) = A(x - sx, y - sy)                                   (two parameters, pixels)
+//              (A interpolated by Ceres' bicubic (Catmull-Rom) interpolator; |s| <= kMaxShiftPixels;
+//              residual over pixels at least kMaxShiftPixels from the border)
+// Residuals are reported as RMS over every value the model covers, before (B - A) and after (B - model).
+//
+// sweep: error = C h^p, fitted in log space with the Cauchy loss (CompareConstants.h).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/film/Image.h"
+
+namespace volref::compare {
+
+struct ModelFit {
+    std::string model;                 // "gain", "opacity", "shift"
+    std::vector<double> values;        // g | k | sx, sy
+    std::string parameters;            // e.g. "g = 1.1"
+    double residual_before = 0.0;      // RMS of B - A over the values the model covers
+    double residual_after = 0.0;       // RMS of B - model(A)
+    bool fitted = false;               // false: not applicable (see note)
+    std::string note;                  // why not applicable
+    double ratio() const { return residual_before > 0.0 ? residual_after / residual_before : 1.0; }
+};
+
+ModelFit fit_gain(const Image& a, const Image& b);
+ModelFit fit_opacity_exponent(const Image& a, const Image& b);
+ModelFit fit_shift(const Image& a, const Image& b);
+
+struct DifferenceExplanation {
+    std::vector<ModelFit> fits;  // gain, opacity, shift
+    std::string verdict;         // one line: "likely cause: ..."
+};
+
+// All three fits and the verdict: the model with the smallest residual ratio after/before is the likely
+// cause when that ratio is <= kExplainedResidualRatio; identical images have nothing to explain.
+DifferenceExplanation explain_difference(const Image& a, const Image& b);
+
+struct PowerLawFit {
+    double c = 0.0, p = 0.0;   // error = c h^p
+    int points = 0;            // points used (h > 0, error > 0)
+    bool ok = false;           // false with fewer than 2 usable points (or equal h)
+};
+
+// Fits error = c h^p (robust, in log space). Points with h <= 0 or error <= 0 (or not finite) are dropped.
+PowerLawFit fit_power_law(const std::vector<double>& h, const std::vector<double>& error);
+
+// The h with c h^p = tolerance: (tolerance / c)^(1 / p).
+double step_for_error(const PowerLawFit& fit, double tolerance);
+
+}  // namespace volref::compare

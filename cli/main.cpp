@@ -3,10 +3,13 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "cli/ExplainCommand.h"
+#include "cli/TraceCommand.h"
 #include "cli/CompareCommand.h"
 #include "cli/ConvertCommand.h"
 #include "cli/InfoCommand.h"
@@ -78,6 +81,21 @@ int main(int argc, char** argv) {
     cmp->add_flag("--fit", compare.fit, "Fit a gain, an opacity exponent and a sub-pixel shift; name the likely cause");
     cmp->add_flag("--json", compare.json, "Print the report as JSON");
 
+    volref::cli::TraceArgs trace;
+    CLI::App* tc = app.add_subcommand("trace", "Every sample along one pixel's ray, as CSV or JSON (docs/trace.md)");
+    tc->add_option("scene", trace.scene, "Scene file (JSON)")->required();
+    tc->add_option("--pixel", trace.pixel, "The pixel X,Y (x right, y down from the top-left corner)")->required();
+    tc->add_option("--format", trace.format, "csv or json (default: json if -o ends in .json, else csv)");
+    tc->add_option("-o,--output", trace.output, "Output file (default: standard output)");
+    tc->add_flag("--no-skipping", trace.no_skipping, "List every segment (no empty-space skipping)");
+    tc->add_option("--set", trace.overrides, "Override one scene value: PATH=VALUE")->take_all();
+
+    volref::cli::ExplainArgs explain;
+    CLI::App* ex = app.add_subcommand("explain", "Work one formula step by step with the renderer's own functions "
+                                                 "(docs/explain.md); --json for programs");
+    ex->add_option("topic", explain.topic, std::string("One of: ") + volref::cli::explain_topics())->required();
+    ex->fallthrough(false)->prefix_command()->allow_extras();  // the topic's options are parsed by run_explain (one-line errors naming the option)
+
     // ---- more subcommands: add each one's block above this line ----
 
     try {
@@ -99,6 +117,11 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "volref: error: %s\n", e.what());
                 return 2;
             }
+        }
+        if (tc->parsed()) return volref::cli::run_trace(trace);
+        if (ex->parsed()) {
+            explain.args = ex->remaining();
+            return volref::cli::run_explain(explain);
         }
         // ---- more subcommands: dispatch above this line ----
     } catch (const volref::Error& e) {

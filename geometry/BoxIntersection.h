@@ -13,16 +13,25 @@
 
 namespace volref {
 
+// One axis' slab lo <= o + t d <= hi: [ta, tb] (ta <= tb); for d = 0 the whole line or nothing
+// (returns false when o is outside [lo, hi]; ta = -inf, tb = +inf otherwise).
+inline bool intersect_slab(double o, double d, double lo, double hi, double& ta, double& tb) {
+    if (d == 0.0) {
+        ta = -std::numeric_limits<double>::infinity();
+        tb = std::numeric_limits<double>::infinity();
+        return !(o < lo || o > hi);
+    }
+    ta = (lo - o) / d;
+    tb = (hi - o) / d;
+    if (ta > tb) std::swap(ta, tb);
+    return true;
+}
+
 inline bool intersect_box(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi, Interval& out) {
     double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 3; ++a) {
-        const double o = ray.origin[a], d = ray.direction[a];
-        if (d == 0.0) {
-            if (o < lo[a] || o > hi[a]) return false;
-            continue;
-        }
-        double ta = (lo[a] - o) / d, tb = (hi[a] - o) / d;
-        if (ta > tb) std::swap(ta, tb);
+        double ta, tb;
+        if (!intersect_slab(ray.origin[a], ray.direction[a], lo[a], hi[a], ta, tb)) return false;
         t0 = std::max(t0, ta);
         t1 = std::min(t1, tb);
     }

@@ -17,12 +17,17 @@ namespace {
 constexpr double kDegree = std::numbers::pi / 180.0;
 
 // The split points of a ray: roots of the bounding surfaces (and extrema), t > 0 only.
+// With `log` set, every root and extremum is also logged with `surface` (also those not kept).
 struct Splits {
     std::array<double, 24> t{};
     int n = 0;
+    std::vector<ShellRoot>* log = nullptr;
+    const char* surface = "";
     void add(double v) {
+        if (log) log->push_back({surface, v});
         if (v > 0.0 && std::isfinite(v) && n < int(t.size())) t[std::size_t(n++)] = v;
     }
+    void name(const char* s) { surface = s; }
 };
 
 }  // namespace
@@ -257,16 +262,27 @@ bool CylindricalShellIntersector::contains_relative(const glm::dvec3& q) const {
 }
 
 void CylindricalShellIntersector::intervals(const Ray& ray, std::vector<Interval>& out) const {
+    intervals(ray, out, nullptr);
+}
+
+void CylindricalShellIntersector::intervals(const Ray& ray, std::vector<Interval>& out, std::vector<ShellRoot>* roots) const {
     const glm::dvec3 o = ray.origin - shell_.center, d = ray.direction;
     Splits splits;
+    splits.log = roots;
+    splits.name("cylinder r1 (extremum, root, root)");
     cylinder_roots(o, d, shell_.r1, splits);
+    splits.name("cylinder r0 (extremum, root, root)");
     if (shell_.r0 > 0) cylinder_roots(o, d, shell_.r0, splits);
     if (d.y != 0.0) {
+        splits.name("plane h0");
         splits.add((shell_.h0 - o.y) / d.y);
+        splits.name("plane h1");
         splits.add((shell_.h1 - o.y) / d.y);
     }
     if (!full_) {
+        splits.name("half-plane a0");
         plane_root(n0_, 0.0, o, d, splits);
+        splits.name("half-plane a1");
         plane_root(n1_, 0.0, o, d, splits);
     }
     collect(splits, o, d, [this](const glm::dvec3& q) { return contains_relative(q); }, out);
@@ -295,15 +311,25 @@ bool SphericalShellIntersector::contains_relative(const glm::dvec3& q) const {
 }
 
 void SphericalShellIntersector::intervals(const Ray& ray, std::vector<Interval>& out) const {
+    intervals(ray, out, nullptr);
+}
+
+void SphericalShellIntersector::intervals(const Ray& ray, std::vector<Interval>& out, std::vector<ShellRoot>* roots) const {
     const glm::dvec3 o = ray.origin - shell_.center, d = ray.direction;
     Splits splits;
+    splits.log = roots;
+    splits.name("sphere r1 (extremum, root, root)");
     sphere_roots(o, d, shell_.r1, splits);
+    splits.name("sphere r0 (extremum, root, root)");
     if (shell_.r0 > 0) sphere_roots(o, d, shell_.r0, splits);
     if (!full_) {
+        splits.name("half-plane lon0");
         plane_root(n0_, 0.0, o, d, splits);
+        splits.name("half-plane lon1");
         plane_root(n1_, 0.0, o, d, splits);
     }
     for (const double lat : {shell_.lat0, shell_.lat1}) {
+        splits.name(lat == shell_.lat0 ? "latitude lat0 (roots, extremum)" : "latitude lat1 (roots, extremum)");
         if (lat <= -90.0 || lat >= 90.0) continue;
         if (lat == 0.0)
             plane_root({0.0, 1.0, 0.0}, 0.0, o, d, splits);

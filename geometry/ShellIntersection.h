@@ -42,6 +42,12 @@ void shell_bounds(const SphericalShell& shell, glm::dvec3& lo, glm::dvec3& hi);
 // how many (0, 1 or 2) were written to `roots`, in no particular order. A double root is written once.
 int solve_quadratic(double a, double b, double c, double roots[2]);
 
+// One split point of intervals(): the surface it belongs to and its t (any sign; only finite t > 0 split).
+struct ShellRoot {
+    const char* surface;
+    double t;
+};
+
 class CylindricalShellIntersector {
 public:
     explicit CylindricalShellIntersector(const CylindricalShell& shell);  // validates
@@ -49,6 +55,8 @@ public:
     bool contains(const glm::dvec3& p) const;
     // Appends the sorted, disjoint intervals (t >= 0) of `ray` inside the shell to `out`.
     void intervals(const Ray& ray, std::vector<Interval>& out) const;
+    // The same, also listing every root and extremum found, in the order found (`volref explain intersect`).
+    void intervals(const Ray& ray, std::vector<Interval>& out, std::vector<ShellRoot>* roots) const;
 
 private:
     bool contains_relative(const glm::dvec3& q) const;  // q = p - centre
@@ -64,6 +72,7 @@ public:
     const SphericalShell& shell() const { return shell_; }
     bool contains(const glm::dvec3& p) const;
     void intervals(const Ray& ray, std::vector<Interval>& out) const;
+    void intervals(const Ray& ray, std::vector<Interval>& out, std::vector<ShellRoot>* roots) const;
 
 private:
     bool contains_relative(const glm::dvec3& q) const;

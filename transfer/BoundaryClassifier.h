@@ -20,6 +20,14 @@ public:
     BoundaryClassifier(std::vector<BoundaryRegion> regions, double unit_distance)
         : regions_(std::move(regions)), unit_distance_(unit_distance) {}
     Classified classify(double value, double gradient_magnitude) const override;
+    // The terms classify() computes (for `volref explain classify-boundary`): the interval n
+    // [fv_n, fv_n+1] holding f, w, the weights av_n (1 - w) and av_n+1 w, g (sum) before the clamp.
+    struct Terms {
+        bool inside = false;  // fv_1 <= f <= fv_N (and N >= 2)
+        std::size_t n = 0;
+        double w = 0.0, low = 0.0, high = 0.0, unclamped = 0.0;
+    };
+    Terms terms(double value, double gradient_magnitude) const;
     bool needs_gradient() const override { return true; }
     double unit_distance() const override { return unit_distance_; }
     // False when [lo, hi] does not meet [fv_1, fv_N] (a = 0 there whatever g), or when every region

@@ -22,10 +22,21 @@ namespace volref {
 
 // Every term of one light's contribution, for `explain` and tests.
 struct LightTerms {
+    glm::dvec3 L{0.0};           // unit vector towards the light (V for a headlight)
+    glm::dvec3 H{0.0};           // blinn-phong: normalize(L + V); phong: R = 2 (N.L) N - L
     double n_dot_l = 0.0;        // after max(., 0) or |.|
     double specular_dot = 0.0;   // N.H (blinn-phong) or R.V (phong), after max(., 0) or |.|
     double depth_cue = 1.0;      // 1 / (kc + kl d)
     glm::dvec3 ambient{0.0}, diffuse{0.0}, specular{0.0};  // I ka m, I kd m (N.L) cue, I ks dot^n cue
+};
+
+// Every term of one shaded sample: |grad f|, N, each light's terms, the result.
+struct ShadeTerms {
+    double gradient_magnitude = 0.0;
+    bool zero_gradient = false;  // |grad f| <= the tolerance: unshaded, c = m
+    glm::dvec3 normal{0.0};      // N = -grad f / |grad f| (0 when zero_gradient)
+    std::vector<LightTerms> lights;
+    glm::dvec3 result{0.0};      // what shade() returns
 };
 
 class Shader {
@@ -35,6 +46,9 @@ public:
     // m: material colour; gradient: grad f in world units; view: unit vector towards the eye;
     // depth: distance from the eye.
     glm::dvec3 shade(const glm::dvec3& m, const glm::dvec3& gradient, const glm::dvec3& view, double depth) const;
+    // The same computation (the same instructions), also filling `terms`.
+    glm::dvec3 shade(const glm::dvec3& m, const glm::dvec3& gradient, const glm::dvec3& view, double depth,
+                     ShadeTerms& terms) const;
     // One light's terms for a unit normal N.
     LightTerms light_terms(const LightSpec& light, const glm::dvec3& m, const glm::dvec3& N, const glm::dvec3& view,
                            double depth) const;
@@ -44,6 +58,9 @@ public:
     const std::vector<LightSpec>& lights() const { return lights_; }
 
 private:
+    template <bool kTerms>
+    glm::dvec3 shade_impl(const glm::dvec3& m, const glm::dvec3& gradient, const glm::dvec3& view, double depth,
+                          ShadeTerms* terms) const;
     ShadingSpec spec_;
     std::vector<LightSpec> lights_;
     double tolerance_;

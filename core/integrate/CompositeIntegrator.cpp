@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/SegmentWalk.h"
@@ -55,11 +57,22 @@ void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ra
 }  // namespace
 
 PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals)
-                                                            : back_to_front(ray, intervals);
+    NoRecording rec;
+    return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
+                                                            : back_to_front(ray, intervals, rec);
 }
 
-PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals) const {
+PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                                 SampleRecorder& recorder) const {
+    Recording rec{recorder};
+    return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
+                                                            : back_to_front(ray, intervals, rec);
+}
+
+// With Rec::kOn the loops below also fill one SampleRecord per visited segment; every statement of
+// the plain loop is unchanged (the records only read its state).
+template <class Rec>
+PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
     const bool terminate = ctx_.render.early_termination.has_value();
     const double threshold = terminate ? *ctx_.render.early_termination : 0.0;
@@ -69,19 +82,50 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
     ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step);
     Segment s;
     while (walk.next(s)) {
-        const PipelineSample p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        PipelineSample p;
+        if constexpr (Rec::kOn) {
+            rec.begin(r, s.t0, s.t1);
+            p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
+            r.composited = true;
+        } else {
+            p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        }
         const double a = p.opacity;
-        if (a <= 0.0) continue;
+        if (a <= 0.0) {
+            if constexpr (Rec::kOn) {  // nothing changes
+                r.transmittance_before = r.transmittance_after = std::exp(-tau.value());
+                r.accumulated = glm::dvec4(C, -std::expm1(-tau.value()));
+                rec.recorder.record(r);
+            }
+            continue;
+        }
         const double T = std::exp(-tau.value());
         if (a >= 1.0) {  // opaque: alpha = 1, nothing behind is visible
             C += T * p.color;
             opaque = true;
+            if constexpr (Rec::kOn) {
+                r.tau = std::numeric_limits<double>::infinity();
+                r.alpha = 1.0;
+                r.transmittance_before = T;
+                r.transmittance_after = 0.0;
+                r.accumulated = glm::dvec4(C, 1.0);
+                rec.recorder.record(r);
+            }
             break;
         }
         const double tau_k = optical_depth(a, s.length(), l);
         const double alpha = -std::expm1(-tau_k);
         C += (T * alpha) * p.color;
         tau.add(tau_k);
+        if constexpr (Rec::kOn) {
+            r.tau = tau_k;
+            r.alpha = alpha;
+            r.transmittance_before = T;
+            r.transmittance_after = std::exp(-tau.value());
+            r.accumulated = glm::dvec4(C, -std::expm1(-tau.value()));
+            rec.recorder.record(r);
+        }
         if (terminate && -std::expm1(-tau.value()) > threshold) break;
     }
     PixelValue out;
@@ -89,24 +133,58 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
     return out;
 }
 
-PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals) const {
+template <class Rec>
+PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
     CompensatedSum tau;
     glm::dvec3 C(0.0);
     bool opaque = false;
+    // The transmittance of what is composited so far (0 once a sample was opaque); records only.
+    [[maybe_unused]] auto transmittance = [&] { return opaque ? 0.0 : std::exp(-tau.value()); };
+    [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value())); };
     for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, [&](const Segment& s) {
-        const PipelineSample p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        PipelineSample p;
+        if constexpr (Rec::kOn) {
+            rec.begin(r, s.t0, s.t1);
+            p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
+            r.composited = true;
+            r.transmittance_before = transmittance();
+        } else {
+            p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        }
         const double a = p.opacity;
-        if (a <= 0.0) return true;
+        if (a <= 0.0) {
+            if constexpr (Rec::kOn) {
+                r.transmittance_after = transmittance();
+                r.accumulated = accumulated();
+                rec.recorder.record(r);
+            }
+            return true;
+        }
         if (a >= 1.0) {
             C = p.color;
             opaque = true;
+            if constexpr (Rec::kOn) {
+                r.tau = std::numeric_limits<double>::infinity();
+                r.alpha = 1.0;
+                r.transmittance_after = 0.0;
+                r.accumulated = accumulated();
+                rec.recorder.record(r);
+            }
             return true;
         }
         const double tau_k = optical_depth(a, s.length(), l);
         const double alpha = -std::expm1(-tau_k);
         C = alpha * p.color + (1.0 - alpha) * C;
         tau.add(tau_k);
+        if constexpr (Rec::kOn) {
+            r.tau = tau_k;
+            r.alpha = alpha;
+            r.transmittance_after = transmittance();
+            r.accumulated = accumulated();
+            rec.recorder.record(r);
+        }
         return true;
     });
     PixelValue out;

@@ -24,6 +24,7 @@
 
 #include "core/integrate/Integrator.h"
 #include "core/integrate/PacketComposite.h"
+#include "core/integrate/SampleRecorder.h"
 
 namespace volref {
 
@@ -31,14 +32,19 @@ class CompositeIntegrator final : public Integrator {
 public:
     explicit CompositeIntegrator(const IntegrationContext& ctx);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
     // The SIMD path (PacketComposite.h) where the scene allows it, else one ray at a time.
     void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
                           int count) const override;
     bool has_packet_path() const { return packet_.has_value(); }
 
 private:
-    PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals) const;
-    PixelValue back_to_front(const Ray& ray, const std::vector<Interval>& intervals) const;
+    // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h.
+    template <class Rec>
+    PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
 };
 

@@ -2,6 +2,8 @@
 
 #include "core/integrate/Segments.h"
 
+#include <type_traits>
+
 namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
@@ -29,15 +31,44 @@ void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Int
 }
 
 PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    NoRecording rec;
+    return integrate_impl(ray, intervals, rec);
+}
+
+PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                                SampleRecorder& recorder) const {
+    Recording rec{recorder};
+    return integrate_impl(ray, intervals, rec);
+}
+
+// With Rec::kOn each sample is also classified (unshaded, for the record) and the record carries the
+// extremum so far and the pixel it gives; the value is the one the plain loop reads (the same sampler
+// call at the same point).
+template <class Rec>
+PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     bool any = false;
     double best = 0.0, t_best = 0.0;
+    [[maybe_unused]] glm::dvec4 so_far(0.0);
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
-        const double v = ctx_.field(ray, s.midpoint());
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        double v;
+        if constexpr (Rec::kOn) {
+            rec.begin(r, s.t0, s.t1);
+            v = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Unshaded, r.sample).value;
+        } else {
+            v = ctx_.field(ray, s.midpoint());
+        }
         if (!any || (maximum_ ? v > best : v < best)) {
             best = v;
             t_best = s.midpoint();
+            if constexpr (Rec::kOn) so_far = pixel(ray, true, t_best).rgba;
         }
         any = true;
+        if constexpr (Rec::kOn) {
+            r.running = best;
+            r.accumulated = so_far;
+            rec.recorder.record(r);
+        }
         return true;
     });
     return pixel(ray, any, t_best);

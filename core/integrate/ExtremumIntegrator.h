@@ -7,6 +7,7 @@
 
 #include "core/integrate/Integrator.h"
 #include "core/integrate/PacketExtremum.h"
+#include "core/integrate/SampleRecorder.h"
 
 namespace volref {
 
@@ -14,11 +15,15 @@ class ExtremumIntegrator final : public Integrator {
 public:
     ExtremumIntegrator(const IntegrationContext& ctx, bool maximum);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
     // The SIMD path (PacketExtremum.h) for trilinear volumes, bitwise the scalar result.
     void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
                           int count) const override;
 
 private:
+    template <class Rec>
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
     std::optional<PacketExtremumInputs> packet_;

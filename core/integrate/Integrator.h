@@ -8,6 +8,7 @@
 
 #include <glm/vec4.hpp>
 
+#include "core/Error.h"
 #include "core/camera/Ray.h"
 #include "core/integrate/SamplePipeline.h"
 #include "core/scene/Scene.h"
@@ -16,6 +17,7 @@
 namespace volref {
 
 class MacrocellGrid;
+class SampleRecorder;
 
 // The largest number of rays the renderer hands to Integrator::integrate_packet at once.
 inline constexpr int kMaxPacketRays = 16;
@@ -49,6 +51,15 @@ public:
         for (int i = 0; i < count; ++i) out[i] = integrate(rays[i], intervals[i]);
     }
     // The extra channels this projection writes (e.g. "Z" for first-hit).
+    // integrate() by the same loop, reporting every sample it visits to `recorder` (SampleRecorder.h),
+    // for `volref trace` and `volref explain`. The result is integrate()'s, bit for bit.
+    virtual PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                        SampleRecorder& recorder) const {
+        (void)ray;
+        (void)intervals;
+        (void)recorder;
+        throw Error("trace: this projection or integrator is not supported yet");
+    }
     virtual bool writes_depth() const { return false; }
 
 protected:

@@ -6,12 +6,38 @@
 namespace volref {
 
 PixelValue LineIntegralIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    NoRecording rec;
+    return integrate_impl(ray, intervals, rec);
+}
+
+PixelValue LineIntegralIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                                    SampleRecorder& recorder) const {
+    Recording rec{recorder};
+    return integrate_impl(ray, intervals, rec);
+}
+
+// With Rec::kOn each record carries the sample's value and coordinate s(v) and the projection of the
+// ray so far (g of the segments up to this one); no classification is involved.
+template <class Rec>
+PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     PixelValue out;
     if (intervals.empty()) return out;
     CompensatedSum integral, length;
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
-        integral.add(ctx_.pipeline.classifier().coordinate(ctx_.field(ray, s.midpoint())) * s.length());
+        const double v = ctx_.field(ray, s.midpoint());
+        const double coordinate = ctx_.pipeline.classifier().coordinate(v);
+        integral.add(coordinate * s.length());
         length.add(s.length());
+        if constexpr (Rec::kOn) {
+            SampleRecord r;
+            rec.begin(r, s.t0, s.t1);
+            r.sample.position = ray.at(s.midpoint());
+            r.sample.value = v;
+            r.coordinate = coordinate;
+            r.running = mean_ ? integral.value() / length.value() : ctx_.render.gain * integral.value();
+            r.accumulated = glm::dvec4(r.running, r.running, r.running, 1.0);
+            rec.recorder.record(r);
+        }
         return true;
     });
     const double g = mean_ ? integral.value() / length.value() : ctx_.render.gain * integral.value();

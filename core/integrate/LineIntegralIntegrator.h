@@ -7,6 +7,7 @@
 // A ray with no interval is (0, 0, 0, 0).
 #pragma once
 #include "core/integrate/Integrator.h"
+#include "core/integrate/SampleRecorder.h"
 
 namespace volref {
 
@@ -14,8 +15,12 @@ class LineIntegralIntegrator final : public Integrator {
 public:
     LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : Integrator(ctx), mean_(mean) {}
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
 
 private:
+    template <class Rec>
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     bool mean_;
 };
 

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/camera/Ray.h"
+#include "core/integrate/SampleRecorder.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/PreClassifiedVolume.h"
 #include "core/sample/VolumeSampler.h"
@@ -36,7 +37,25 @@ public:
 
     // Value, classification and shading at ray(t). The gradient is computed at most once, and only
     // when the classifier or the shader needs it.
-    PipelineSample sample(const Ray& ray, double t, Use use) const {
+    PipelineSample sample(const Ray& ray, double t, Use use) const { return sample_impl<false>(ray, t, use, nullptr); }
+    // The same computation (the same instructions, so the same bits), also reporting every stage:
+    // position, gradient (when computed), classification and the shading terms (SampleRecorder.h).
+    PipelineSample sample_detailed(const Ray& ray, double t, Use use, SampleDetail& detail) const {
+        return sample_impl<true>(ray, t, use, &detail);
+    }
+
+    const Classifier& classifier() const { return classifier_; }
+    const FieldSampler& sampler() const { return sampler_; }
+    // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
+    const VolumeSampler* cartesian_sampler() const { return dynamic_cast<const VolumeSampler*>(&sampler_); }
+    bool shaded() const { return shader_ != nullptr; }
+    const Shader* shader() const { return shader_; }
+    const GradientSource* gradient_source() const { return gradient_; }
+    bool preclassified() const { return pre_ != nullptr; }
+
+private:
+    template <bool kDetail>
+    PipelineSample sample_impl(const Ray& ray, double t, Use use, SampleDetail* detail) const {
         const glm::dvec3 x = ray.at(t);
         PipelineSample s;
         s.value = sampler_.value(x);
@@ -51,20 +70,23 @@ public:
                                   : classifier_.classify(s.value, classifier_.needs_gradient() ? glm::length(gradient()) : 0.0);
         s.opacity = c.opacity;
         const bool shade = shader_ && (use == Use::Surface || (use == Use::Composite && c.opacity > 0.0));
-        s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
+        if constexpr (kDetail) {
+            s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t, detail->shading) : c.color;
+            detail->position = x;
+            detail->value = s.value;
+            detail->has_gradient = have_gradient;
+            detail->gradient = g;
+            detail->classified = true;
+            detail->classified_color = c.color;
+            detail->opacity = c.opacity;
+            detail->shaded = shade;
+            detail->color = s.color;
+        } else {
+            s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
+        }
         return s;
     }
 
-    const Classifier& classifier() const { return classifier_; }
-    const FieldSampler& sampler() const { return sampler_; }
-    // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
-    const VolumeSampler* cartesian_sampler() const { return dynamic_cast<const VolumeSampler*>(&sampler_); }
-    bool shaded() const { return shader_ != nullptr; }
-    const Shader* shader() const { return shader_; }
-    const GradientSource* gradient_source() const { return gradient_; }
-    bool preclassified() const { return pre_ != nullptr; }
-
-private:
     const FieldSampler& sampler_;
     const Classifier& classifier_;
     const GradientSource* gradient_;

@@ -180,3 +180,8 @@ PixelValue PreparedScene::render_pixel(int x, int y) const {
 }
 
 }  // namespace volref
+PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) const {
+    const Ray ray = pixel_ray(x, y);
+    return integrator->integrate_traced(ray, intervals(ray), recorder);
+}
+

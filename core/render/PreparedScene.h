@@ -13,6 +13,7 @@
 #include "core/camera/Camera.h"
 #include "core/grid/Volume.h"
 #include "core/integrate/Integrator.h"
+#include "core/integrate/SampleRecorder.h"
 #include "core/integrate/SamplePipeline.h"
 #include "core/render/Renderer.h"
 #include "core/sample/GradientField.h"
@@ -87,6 +88,8 @@ struct PreparedScene {
     std::vector<Interval> intervals(const Ray& ray) const;
     // One pixel by the scalar path (equal to the rendered pixel within the SIMD path's rounding).
     PixelValue render_pixel(int x, int y) const;
+    // render_pixel by the same loop, reporting every sample to `recorder` (SampleRecorder.h).
+    PixelValue trace_pixel(int x, int y, SampleRecorder& recorder) const;
 };
 
 }  // namespace volref

@@ -1,0 +1,76 @@
+// The calculators of `volref explain TOPIC` (docs/explain.md): each works one formula of the
+// renderer step by step, calling the renderer's own functions (Trilinear.h, VolumeSampler,
+// OpacityCorrection.h, the classifiers, Shader, ShellCoordinates, BoxIntersection.h,
+// ShellIntersection, Camera, the integrators through SampleRecorder) and returns the Explanation
+// (Explanation.h) the command prints. Inputs are typed; the command line parses and checks them
+// (cli/explain_command.cpp); the calculators throw volref::Error for values outside a formula's
+// domain, naming the argument.
+#pragma once
+#include <array>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/camera/Ray.h"
+#include "core/explain/Explanation.h"
+#include "core/scene/Scene.h"
+#include "geometry/ShellSpec.h"
+
+namespace volref {
+
+class VolumeSampler;
+struct PreparedScene;
+
+namespace explain {
+
+// trilinear: corners f1..f8 in Levoy's order (f1 (0,0,0), f2 (1,0,0), f3 (1,1,0), f4 (0,1,0), f5..f8
+// the same at r = 1), local coordinates (p, q, r) in [0, 1].
+Explanation trilinear(const std::array<double, 8>& corners, const glm::dvec3& pqr);
+// trilinear at a world point of a Cartesian volume: the cell, its corners, the local coordinates,
+// then the same steps.
+Explanation trilinear_at(const VolumeSampler& sampler, const glm::dvec3& world);
+
+// composite: samples listed front first, each colour (not premultiplied) and opacity a per unit
+// distance l; each is one segment of length d, composited by CompositeIntegrator itself.
+struct CompositeSample {
+    glm::dvec3 color{1.0};
+    double opacity = 0.0;
+};
+Explanation composite(const std::vector<CompositeSample>& samples, CompositeOrder order, double unit_distance,
+                      double step);
+
+// opacity-correction: a over l, segment length d.
+Explanation opacity_correction(double a, double unit_distance, double length);
+
+// classify-isovalue / classify-boundary: value f and gradient magnitude g.
+Explanation classify_isovalue(double f, double g, const std::vector<IsovalueContour>& contours);
+Explanation classify_boundary(double f, double g, const std::vector<BoundaryRegion>& regions);
+
+// shade: gradient (N = -g / |g|), view vector V (towards the eye, unit), material colour m, depth d.
+struct ShadeInput {
+    glm::dvec3 gradient{0.0, 0.0, -1.0};
+    glm::dvec3 view{0.0, 0.0, 1.0};
+    glm::dvec3 material{1.0};
+    double depth = 0.0;
+    ShadingSpec spec;
+    std::vector<LightSpec> lights{LightSpec{}};
+};
+Explanation shade(const ShadeInput& in);
+
+// coords: a point given in one system (around `center`), in all three.
+enum class CoordinateSystem { Cartesian, Cylindrical, Spherical };
+// Cylindrical: (r, theta, h); spherical: (R, lon, lat); Cartesian: (x, y, z). Angles in degrees.
+Explanation coords(CoordinateSystem given, const glm::dvec3& values, const glm::dvec3& center);
+
+// intersect: a ray (direction normalised by the caller) against a box, a cylindrical or a spherical
+// shell: every slab or root, the intervals.
+Explanation intersect_box(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi);
+Explanation intersect_cylinder(const Ray& ray, const CylindricalShell& shell);
+Explanation intersect_sphere(const Ray& ray, const SphericalShell& shell);
+
+// ray: pixel (x, y) of a prepared scene: the camera's ray, the intervals, every sample (the engine
+// of `volref trace`, PixelTrace.h) and the pixel.
+Explanation ray(const PreparedScene& scene, int x, int y);
+
+}  // namespace explain
+}  // namespace volref

@@ -1,5 +1,7 @@
 // The volref command line. Exit status: 0 success; 1 bad input or failure (one line on stderr,
-// "volref: error: ..."); 2 usage errors (CLI11's message).
+// "volref: error: ..."); 2 usage errors (CLI11's message); 128 + signal when interrupted by SIGINT
+// (130) or SIGTERM (143), with no output written (core/Cancellation.h).
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -13,11 +15,31 @@
 #include "cli/CompareCommand.h"
 #include "cli/ConvertCommand.h"
 #include "cli/InfoCommand.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
+
+namespace {
+extern "C" void on_signal(int signal) { volref::request_cancel(signal); }
+
+void install_signal_handlers() {
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
+}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"volref: a CPU reference volume ray caster, the numerical oracle for GPU volume renderers"};
     app.require_subcommand(1);
+    // Options of every command; they may also follow the command's name (fallthrough).
+    app.fallthrough();
+    std::string max_memory;
+    app.add_option("--max-memory", max_memory,
+                   "Refuse a volume, image or cache needing more than SIZE (e.g. 512M, 4G); default: physical memory")
+        ->envname("VOLREF_MAX_MEMORY");
 
     volref::cli::RenderArgs render;
     CLI::App* rc = app.add_subcommand("render", "Render a scene file to an image (.exr, .png, .tif)");
@@ -104,7 +126,9 @@ int main(int argc, char** argv) {
         // CLI11 prints the message (and --help's text); usage errors exit 2, --help exits 0.
         return app.exit(e) == 0 ? 0 : 2;
     }
+    install_signal_handlers();
     try {
+        if (!max_memory.empty()) volref::set_memory_limit(volref::parse_memory_size(max_memory, "--max-memory"));
         if (rc->parsed()) return volref::cli::run_render(render);
         if (rs->parsed()) return volref::cli::run_resample(resample);
         if (ic->parsed()) return volref::cli::run_info(info);
@@ -124,6 +148,9 @@ int main(int argc, char** argv) {
             return volref::cli::run_explain(explain);
         }
         // ---- more subcommands: dispatch above this line ----
+    } catch (const volref::Cancelled& e) {
+        std::fprintf(stderr, "\nvolref: %s\n", e.what());
+        return 128 + e.signal();
     } catch (const volref::Error& e) {
         std::fprintf(stderr, "volref: error: %s\n", e.what());
         return 1;

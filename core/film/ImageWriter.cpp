@@ -9,6 +9,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
 
@@ -96,6 +97,10 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
         const std::string why = out->geterror();
         fs::remove(tmp, ec);
         throw Error(path.string() + ": cannot write the image: " + why);
+    }
+    if (cancel_requested()) {  // interrupted while writing: the finished file is not put in place
+        fs::remove(tmp, ec);
+        throw_if_cancelled();
     }
     fs::rename(tmp, path, ec);
     if (ec) {

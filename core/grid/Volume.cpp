@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 
 namespace volref {
 
@@ -71,6 +72,9 @@ std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const s
     if (count > kMaxBytes / std::max<std::size_t>(bytes_per_value, 1))
         throw Error(what + ": dims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
                     std::to_string(dims[2]) + " need more than 256 GiB");
+    check_memory(count * std::max<std::size_t>(bytes_per_value, 1),
+                 what + ": a volume of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                     std::to_string(dims[2]));
     return count;
 }
 

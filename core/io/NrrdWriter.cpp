@@ -16,6 +16,7 @@
 
 #include <zlib.h>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
 
@@ -231,6 +232,10 @@ void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptio
     } catch (...) {
         fs::remove(tmp, ec);
         throw;
+    }
+    if (cancel_requested()) {  // interrupted while writing: the finished file is not put in place
+        fs::remove(tmp, ec);
+        throw_if_cancelled();
     }
     fs::rename(tmp, path, ec);
     if (ec) {

@@ -1,6 +1,10 @@
 #include "core/io/OutputFile.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <string>
 #include <system_error>
@@ -16,9 +20,20 @@ void check_output_folder(const fs::path& path) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
         throw Error(path.string() + ": the output folder " + dir.string() + " does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-        throw Error(path.string() + ": the output folder " + dir.string() + " is not writable");
     if (fs::is_directory(path, ec)) throw Error(path.string() + ": is a folder");
+    // access(W_OK) says yes to root on a read-only mount or in /proc: create (and remove) the
+    // temporary file the writer will use, which is the real test.
+    const fs::path probe = temporary_output_path(path);
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd < 0) {
+        const int err = errno;
+        if (err != EEXIST)
+            throw Error(path.string() + ": the output folder " + dir.string() + " is not writable (" +
+                        std::strerror(err) + ")");
+    } else {
+        ::close(fd);
+        fs::remove(probe, ec);
+    }
 }
 
 fs::path temporary_output_path(const fs::path& path) {

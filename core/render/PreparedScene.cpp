@@ -8,6 +8,7 @@
 
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/grid/ProceduralField.h"
 #include "core/io/VolumeReader.h"
 #include "geometry/ShellTessellation.h"
@@ -97,15 +98,23 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
     // the pre-classified volume for classify "pre", the shader for shading.
     const bool shades = vs.shading.has_value() &&
                         (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
+    // Memory (core/MemoryLimit.h): what is held (the volume) plus what is about to be allocated.
+    const std::size_t voxels = volume.values.size(), volume_bytes = voxels * sizeof(double);
+    const std::size_t image_bytes = std::size_t(scene.image.width) * std::size_t(scene.image.height) * 6 * sizeof(double);
+    check_memory(volume_bytes + image_bytes, "image: " + std::to_string(scene.image.width) + " x " +
+                                                 std::to_string(scene.image.height) + " pixels with the volume");
     if (shades || classifier->needs_gradient()) {
         if (shell) {
             gradient = model.shell_field.get();
         } else {
-            gradient_field = std::make_unique<GradientField>(
-                *model.cartesian, resolve_gradient_cache(vs.gradient, volume, *classifier, scene.image, step));
+            const GradientSpec g = resolve_gradient_cache(vs.gradient, volume, *classifier, scene.image, step);
+            if (g.cache) check_memory(volume_bytes + image_bytes + 3 * volume_bytes, "volume.gradient.cache: the gradient volumes");
+            gradient_field = std::make_unique<GradientField>(*model.cartesian, g);
             gradient = gradient_field.get();
         }
     }
+    if (vs.classify == VolumeSpec::Classify::Pre)
+        check_memory(volume_bytes + image_bytes + 4 * volume_bytes, "volume.classify: the pre-classified volume");
     if (vs.classify == VolumeSpec::Classify::Pre)
         preclassified = std::make_unique<PreClassifiedVolume>(*model.cartesian, *classifier, gradient);
     if (shades) {
@@ -179,9 +188,9 @@ PixelValue PreparedScene::render_pixel(int x, int y) const {
     return integrator->integrate(ray, intervals(ray));
 }
 
-}  // namespace volref
 PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) const {
     const Ray ray = pixel_ray(x, y);
     return integrator->integrate_traced(ray, intervals(ray), recorder);
 }
 
+}  // namespace volref

@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/camera/Camera.h"
@@ -124,7 +125,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
     if (integrator->writes_depth()) channels.push_back("Z");
     Image image(W, H, channels);
 
-    const int T = conventions::kTileSize;
+    const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
     const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
     ProgressReporter progress(options.progress, tiles_x * tiles_y);
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -135,6 +136,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
             Ray rays[kMaxPacketRays];
             PixelValue values[kMaxPacketRays];
             for (int tile = r.begin(); tile != r.end(); ++tile) {
+                if (cancel_requested()) return;  // SIGINT/SIGTERM: stop at the next tile (Cancellation.h)
                 const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
                 const int x_end = std::min(x0 + T, W);
                 for (int y = y0; y < std::min(y0 + T, H); ++y)
@@ -155,6 +157,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
             }
         });
     });
+    throw_if_cancelled();
     return image;
 }
 

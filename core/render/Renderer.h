@@ -18,6 +18,10 @@ struct RenderOptions {
     // (conventions section 4). The image is bitwise the same either way; false is for checking that.
     bool empty_space_skipping = true;
     bool simd = true;       // use the SIMD packet paths where the scene allows (PacketComposite.h)
+    // Fixed-step integrator: also render at step / 2 and write the step-doubling estimate as the
+    // "error" channel (StepDoubling.h). The adaptive integrator always writes its own estimate.
+    bool error_estimate = false;
+    int tile_size = 0;      // pixels per tile side; 0: conventions::kTileSize (the image does not depend on it)
 };
 
 // The volume a VolumeSpec names: read from its file or made from its procedural field, with the

@@ -12,6 +12,8 @@ packages=(
   libnifti2-dev libexpat1-dev
   # volref compare --fit and volref sweep: least-squares fits (Ceres) and the error-against-time plot (gnuplot)
   libceres-dev gnuplot-nox
+  # scripts/sanitize.sh and scripts/fuzz.sh: clang with AddressSanitizer, UBSan and libFuzzer (docs/robustness.md)
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -11,6 +11,7 @@ struct RenderArgs {
     std::filesystem::path output;
     int threads = 0;
     bool no_skipping = false;  // --no-skipping: RenderOptions::empty_space_skipping = false
+    bool error = false;        // --error: RenderOptions::error_estimate (step doubling, fixed integrator)
     std::vector<std::string> overrides;  // --set PATH=VALUE
 };
 

@@ -48,6 +48,9 @@ int main(int argc, char** argv) {
     rc->add_option("--threads", render.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
     rc->add_flag("--no-skipping", render.no_skipping,
                  "Sample every segment (no empty-space skipping); the image is the same, only slower");
+    rc->add_flag("--error", render.error,
+                 "Fixed-step integrator: also render at step/2 and write the step-doubling error estimate as the "
+                 "EXR `error` channel (the adaptive integrator always writes its own)");
     rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
         ->take_all();
 

@@ -57,4 +57,38 @@ inline constexpr int kTileSize = 16;
 
 // 8-bit and 16-bit outputs: q = round(clamp(v, 0, 1) * (2^bits - 1)), round half away from zero.
 
+// ---- Adaptive integration (render.integrator "adaptive"; core/integrate/Adaptive*.h, docs/accuracy.md) ----
+// The default render.tolerance: absolute error per channel (R, G, B, A) of a pixel.
+inline constexpr double kAdaptiveDefaultTolerance = 1e-6;
+// Each smooth piece is integrated by Gauss-Kronrod G7/K15 with recursive bisection; a leaf [a, b] is
+// accepted when its error estimate e (|K15 - G7| of the emission plus the colour bound times
+// |K15 - G7| of the optical depth, times the transmittance in front) is at most
+//   tolerance * (b - a) / (total length of the ray's intervals)   (the budget is shared by length),
+// or at most kAdaptiveRoundoffRelative * |K15| (the estimate is then rounding, QUADPACK's test), or
+// when the leaf is kAdaptiveMaxDepth bisections deep (its estimate is still reported: 2^-48 of a
+// piece is below any length the double t of a ray resolves for pieces up to 2^48 ulps long).
+inline constexpr int kAdaptiveMaxDepth = 48;
+inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16;  // 50 eps
+// Opacities are clamped to 1 - 2^-53 inside a piece so that sigma = -log1p(-a) / l stays finite at an
+// isolated point where a reaches 1 (a ramp ending at 1, a value touching a row with a = 1): the
+// integral changes only where a > 1 - 2^-53, a set of length ~ 2^-53 of the ramp. A piece whose
+// opacity is 1 at its midpoint is opaque (the ray ends there, T = 0 behind it).
+inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
+// Projections whose adaptive result is exact up to rounding (mip/minip: the cubic's extrema; first
+// hit: the cubic's first root) report error = kRoundingErrorRelative * (1 + max |channel|): a bound
+// on the rounding of reconstruction and classification (a few dozen operations of relative 2^-53).
+inline constexpr double kRoundingErrorRelative = 1e-13;
+
+// Step doubling (volref render --error with the fixed integrator): the image I_h is rendered again at
+// h / 2; for a method of order 2, I_h - I = c h^2 + O(h^3) gives I_h - I ~ (4 / 3) (I_h - I_{h/2}).
+// The error channel is kStepDoublingSafety * (4 / 3) * max over R, G, B, A of |I_h - I_{h/2}|; the
+// safety factor covers pixels not yet in the asymptotic range (c varies with h where segment ends move
+// across cell faces and transfer-function breakpoints), measured in tests/unit/test_adaptive.cpp.
+inline constexpr double kStepDoublingSafety = 5.0;
+// ... and the difference used is the largest over the pixel's (2 r + 1)^2 neighbourhood, r = this:
+// where the difference vanishes or shrinks by accident (a chord shorter than h / 2 has one segment at
+// both steps; the error constant changes sign between h and h / 2 as segment ends cross cell faces),
+// the neighbours' rays cross the same cells and are not all in that accident.
+inline constexpr int kStepDoublingNeighbourhood = 1;
+
 }  // namespace volref::conventions

@@ -1,6 +1,7 @@
 #include "core/integrate/Integrator.h"
 
 #include "core/Error.h"
+#include "core/integrate/AdaptiveIntegrator.h"
 #include "core/integrate/CompositeIntegrator.h"
 #include "core/integrate/ExtremumIntegrator.h"
 #include "core/integrate/FirstHitIntegrator.h"
@@ -12,6 +13,10 @@ std::unique_ptr<Integrator> make_integrator(const IntegrationContext& ctx) {
     const RenderSpec& r = ctx.render;
     if (r.early_termination && (r.projection != Projection::Composite || r.order != CompositeOrder::FrontToBack))
         throw Error("render.early_termination: only the composite projection in front-to-back order terminates early");
+    if (r.projection == Projection::FirstHit && !r.isovalue) throw Error("render.isovalue: required by projection first-hit");
+    // Adaptive: one integrator for every projection but first-hit, which isolates its roots itself.
+    if (r.integrator == IntegrationMethod::Adaptive && r.projection != Projection::FirstHit)
+        return std::make_unique<AdaptiveIntegrator>(ctx);
     switch (r.projection) {
         case Projection::Composite: return std::make_unique<CompositeIntegrator>(ctx);
         case Projection::Mip: return std::make_unique<ExtremumIntegrator>(ctx, true);

@@ -25,6 +25,7 @@ inline constexpr int kMaxPacketRays = 16;
 struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)
+    double error = 0.0;  // the estimated bound on |error| over R, G, B, A (integrators that write "error")
 };
 
 // What every integrator reads: the sample pipeline, the step in world units, the render settings.
@@ -50,7 +51,6 @@ public:
                                   int count) const {
         for (int i = 0; i < count; ++i) out[i] = integrate(rays[i], intervals[i]);
     }
-    // The extra channels this projection writes (e.g. "Z" for first-hit).
     // integrate() by the same loop, reporting every sample it visits to `recorder` (SampleRecorder.h),
     // for `volref trace` and `volref explain`. The result is integrate()'s, bit for bit.
     virtual PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
@@ -60,7 +60,10 @@ public:
         (void)recorder;
         throw Error("trace: this projection or integrator is not supported yet");
     }
+    // The extra channels this projection writes (e.g. "Z" for first-hit).
     virtual bool writes_depth() const { return false; }
+    // True when PixelValue::error is this integrator's error estimate (the "error" channel).
+    virtual bool writes_error() const { return false; }
 
 protected:
     const IntegrationContext& ctx_;

@@ -24,6 +24,7 @@
 #include "core/integrate/Integrator.h"
 #include "core/integrate/PacketComposite.h"
 #include "core/integrate/SamplePipeline.h"
+#include "core/integrate/StepDoubling.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/PreClassifiedVolume.h"
@@ -113,8 +114,22 @@ private:
 
 }  // namespace
 
-Image render_scene(const Scene& scene, const RenderOptions& options) {
+Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats* stats) {
+    if (options.error_estimate && scene.render.integrator == IntegrationMethod::Fixed) {
+        // Step doubling: the image at h, and its error estimate from the image at h / 2.
+        RenderOptions single = options;
+        single.error_estimate = false;
+        const Image coarse = render_scene(scene, single, stats);
+        Scene half = scene;
+        half.render.step *= 0.5;
+        return with_step_doubling_error(coarse, render_scene(half, single));
+    }
     const PreparedScene prepared(scene, options);
+    if (stats) {
+        stats->non_finite_voxels = 0;
+        for (double v : prepared.model.volume.values)
+            if (!std::isfinite(v)) ++stats->non_finite_voxels;
+    }
     const Camera& camera = *prepared.camera;
     const BoundingGeometry& geometry = prepared.geometry;
     const int volume_id = prepared.volume_id;
@@ -123,6 +138,8 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
     if (integrator->writes_depth()) channels.push_back("Z");
+    const std::size_t error_channel = channels.size();
+    if (integrator->writes_error()) channels.push_back("error");
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
@@ -151,6 +168,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options) {
                         for (int i = 0; i < count; ++i) {
                             for (int c = 0; c < 4; ++c) image.at(xs + i, y, std::size_t(c)) = values[i].rgba[c];
                             if (integrator->writes_depth()) image.at(xs + i, y, 4) = values[i].depth;
+                            if (integrator->writes_error()) image.at(xs + i, y, error_channel) = values[i].error;
                         }
                     }
                 progress.tile_done();

@@ -4,6 +4,8 @@
 // Every pixel is computed from its own ray alone (no shared accumulators), so the image is bitwise
 // the same for any thread count and any tile order.
 #pragma once
+#include <cstddef>
+
 #include "core/film/Image.h"
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
@@ -31,7 +33,13 @@ Volume load_volume(const VolumeSpec& spec);
 // The world-space step: render.step, times the smallest spacing when step_units is voxel.
 double world_step(const RenderSpec& render, const Volume& volume);
 
-Image render_scene(const Scene& scene, const RenderOptions& options = {});
+// What a render noticed about its input.
+struct RenderStats {
+    std::size_t non_finite_voxels = 0;  // NaN or +-Inf voxels (transparent; docs/accuracy.md)
+};
+
+// `stats` (optional) receives what the render noticed (non-finite voxels).
+Image render_scene(const Scene& scene, const RenderOptions& options = {}, RenderStats* stats = nullptr);
 
 // Resolves `"cache": "auto"` (core/Conventions.h, kGradientCacheBreakEven): the expected gradient
 // evaluations per voxel e = pixels (diagonal / step) (visible voxel fraction) / voxels, with a voxel

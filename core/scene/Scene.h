@@ -142,6 +142,9 @@ struct ImageSpec {
 enum class Projection { Composite, Mip, Minip, Average, FirstHit, Xray };
 enum class CompositeOrder { FrontToBack, BackToFront };
 enum class StepUnits { Voxel, World };
+// How a ray's integral is computed: `Fixed` steps of render.step (conventions section 4), or
+// `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
+enum class IntegrationMethod { Fixed, Adaptive };
 
 struct RenderSpec {
     Projection projection = Projection::Composite;
@@ -151,6 +154,8 @@ struct RenderSpec {
     std::optional<double> isovalue;       // required by first-hit
     std::optional<double> early_termination;  // accumulated alpha threshold in (0, 1]; absent = off
     double gain = 1.0;                    // xray: the line integral is multiplied by this
+    IntegrationMethod integrator = IntegrationMethod::Fixed;
+    double tolerance = 1e-6;              // adaptive: absolute error per channel, > 0
 };
 
 struct Scene {

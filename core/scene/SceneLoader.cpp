@@ -18,6 +18,7 @@
 #include <glm/matrix.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/scene/JsonReader.h"
 
@@ -47,9 +48,6 @@ using json_reader::read_vec3;
 constexpr std::int64_t kMaxFieldVoxels = std::int64_t{1} << 31;  // procedural fields: at most 2^31 voxels
 constexpr std::int64_t kMaxImageSide = 32768;                    // image width and height: [1, 32768]
 constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 28;  // width * height <= 2^28
-
-// Values of keys that are validated but not stored in Scene (only one value is implemented).
-enum class Integrator { Midpoint };
 
 // ------------------------------------------------------------------------------------------------
 // --set PATH=VALUE overrides
@@ -686,8 +684,12 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                        {{"voxel", StepUnits::Voxel}, {"world", StepUnits::World}});
     s.isovalue = r.optional_number("isovalue");
     s.early_termination = r.optional_number("early_termination", Range::left_open(0, 1));
-    r.choice<Integrator>("integrator", Integrator::Midpoint, {{"midpoint", Integrator::Midpoint}}, {"adaptive"});
-    r.reject("tolerance", "tolerance (of the adaptive integrator) is not implemented yet");
+    // "midpoint" is the fixed-step integrator's earlier name (kept for existing scene files).
+    s.integrator = r.choice<IntegrationMethod>("integrator", IntegrationMethod::Fixed,
+                                               {{"fixed", IntegrationMethod::Fixed},
+                                                {"midpoint", IntegrationMethod::Fixed},
+                                                {"adaptive", IntegrationMethod::Adaptive}});
+    s.tolerance = r.number("tolerance", conventions::kAdaptiveDefaultTolerance, Range::positive());
     if (const std::optional<std::string> p = r.optional_string("profile"); p && *p != "reference")
         r.fail("profile", "profile " + describe(Json(*p)) + " is not implemented yet (implemented: \"reference\")");
     s.gain = r.number("gain", 1.0, Range::positive());

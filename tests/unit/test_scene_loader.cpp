@@ -881,10 +881,13 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
                            "not implemented yet"));
     EXPECT_TRUE(fails_with(volume_with(R"("clip_planes": [])"), "volume.clip_planes", "not implemented yet"));
     EXPECT_TRUE(fails_with(volume_with(R"("crop": {})"), "volume.crop", "not implemented yet"));
-    EXPECT_TRUE(fails_with(scene_with(R"("render": {"integrator": "adaptive"})"), "render.integrator",
-                           "\"adaptive\" is not implemented yet"));
-    EXPECT_NO_THROW(parse(scene_with(R"("render": {"integrator": "midpoint"})")));
-    EXPECT_TRUE(fails_with(scene_with(R"("render": {"tolerance": 1e-6})"), "render.tolerance", "not implemented yet"));
+    // render.integrator and render.tolerance are implemented (issue 6): tests/unit/test_adaptive.cpp.
+    EXPECT_EQ(parse(scene_with(R"("render": {"integrator": "adaptive", "tolerance": 1e-8})")).render.integrator,
+              IntegrationMethod::Adaptive);
+    EXPECT_EQ(parse(scene_with(R"("render": {"integrator": "midpoint"})")).render.integrator, IntegrationMethod::Fixed);
+    EXPECT_EQ(parse(scene_with(R"("render": {})")).render.tolerance, 1e-6);
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"tolerance": 0})"), "render.tolerance", "expected a number > 0"));
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"integrator": "exact"})"), "render.integrator", "\"adaptive\""));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk"})"), "render.profile",
                            "profile \"vtk\" is not implemented yet"));
     EXPECT_TRUE(fails_with(R"({"volumes": [{"source": "a.nrrd"}, {"source": "b.nrrd"}]})", "volumes",

@@ -1,0 +1,355 @@
+#include "core/integrate/AdaptiveIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/integrate/AdaptiveCellWalk.h"
+#include "core/integrate/AdaptiveQuadrature.h"
+#include "core/integrate/CompensatedSum.h"
+#include "core/integrate/Segments.h"
+#include "core/sample/VolumeSampler.h"
+#include "transfer/TransferFunction.h"
+
+namespace volref {
+
+namespace gk = gauss_kronrod;
+
+namespace {
+
+double max_abs(const glm::dvec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+double max_abs(const glm::dvec4& v) { return std::max(max_abs(glm::dvec3(v)), std::fabs(v.w)); }
+
+double rounding_bound(const glm::dvec4& rgba) {
+    return conventions::kRoundingErrorRelative * (1.0 + max_abs(rgba));
+}
+
+}  // namespace
+
+AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+    const RenderSpec& r = ctx.render;
+    if (r.early_termination)
+        throw Error("render.integrator: \"adaptive\" integrates the whole ray; it cannot be combined with render.early_termination");
+    cartesian_ = ctx.pipeline.cartesian_sampler();
+    if (cartesian_) {
+        cut_cells_ = true;
+        const Interpolation interp = cartesian_->interpolation();
+        cut_offset_ = interp == Interpolation::Nearest ? 0.5 : 0.0;
+        cubic_ = interp == Interpolation::Trilinear;
+        if (cubic_ && !ctx.pipeline.preclassified())
+            if (const auto* tf = dynamic_cast<const TransferFunction*>(&ctx.pipeline.classifier())) {
+                rows_ = tf;
+                for (double x : tf->color_function().xs()) row_values_.push_back(x);
+                for (double x : tf->opacity_function().xs()) row_values_.push_back(x);
+                std::sort(row_values_.begin(), row_values_.end());
+                row_values_.erase(std::unique(row_values_.begin(), row_values_.end()), row_values_.end());
+            }
+    }
+    if ((r.projection == Projection::Mip || r.projection == Projection::Minip) &&
+        !(cartesian_ && (cubic_ || cartesian_->interpolation() == Interpolation::Nearest)))
+        throw Error("render.integrator: \"adaptive\" mip/minip needs a Cartesian grid with trilinear or nearest "
+                    "interpolation (the extremum is found exactly there)");
+}
+
+PixelValue AdaptiveIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    switch (ctx_.render.projection) {
+        case Projection::Composite: return composite(ray, intervals);
+        case Projection::Average:
+        case Projection::Xray: return line_integral(ray, intervals);
+        case Projection::Mip:
+        case Projection::Minip: return extremum(ray, intervals);
+        case Projection::FirstHit: break;  // FirstHitIntegrator
+    }
+    throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
+}
+
+void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const {
+    out.clear();
+    if (!cut_cells_) {  // beam space: the fixed integrator's segment ends
+        const std::int64_t n = segment_count(iv, ctx_.step);
+        out.push_back(iv.t0);
+        for (std::int64_t k = 0; k < n; ++k) out.push_back(segment(iv, ctx_.step, k, n).t1);
+        return;
+    }
+    const Volume& v = cartesian_->volume();
+    grid_cuts(ray, iv.t0, iv.t1, v, cut_offset_, out);
+    if (!rows_ || row_values_.empty()) return;
+    // Rows: the roots of s(f(t)) = x_k inside each cell, s the transfer function's coordinate.
+    std::vector<double> all;
+    all.reserve(out.size() * 2);
+    for (std::size_t p = 0; p + 1 < out.size(); ++p) {
+        const double ta = out[p], tb = out[p + 1], L = tb - ta;
+        all.push_back(ta);
+        Cubic s = cell_cubic(*cartesian_, ray, ta, tb);
+        if (rows_->normalized()) {
+            const double w = rows_->inverse_window_width();
+            s = s.affine(w, -rows_->window()[0] * w);
+        }
+        double ex[2];
+        const int ne = cubic_extrema(s, L, ex);
+        double pts[4] = {0.0, 0.0, 0.0, 0.0};
+        int np = 0;
+        pts[np++] = 0.0;
+        for (int k = 0; k < ne; ++k) pts[np++] = ex[k];
+        pts[np++] = L;
+        const std::size_t first = all.size();
+        for (int m = 0; m + 1 < np; ++m) {  // s is monotone on [pts[m], pts[m + 1]]
+            const double xa = pts[m], xb = pts[m + 1];
+            const double va = s(xa), vb = s(xb);
+            const double lo = std::min(va, vb), hi = std::max(va, vb);
+            for (auto it = std::upper_bound(row_values_.begin(), row_values_.end(), lo);
+                 it != row_values_.end() && *it < hi; ++it) {
+                const double x = *it;
+                const double root = bisect_to_rounding([&](double y) { return s(y) - x; }, xa, xb, va < x ? -1 : 1);
+                const double t = ta + root;
+                if (t > ta && t < tb) all.push_back(t);
+            }
+        }
+        std::sort(all.begin() + std::ptrdiff_t(first), all.end());
+    }
+    all.push_back(out.back());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    out.swap(all);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Composite
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+struct LeafRecord {
+    glm::dvec3 contribution;  // T(a) E
+    double e_emission;        // T(a) e_E
+    double e_tau;
+};
+
+struct CompositeState {
+    const SamplePipeline* pipeline;
+    const Ray* ray;
+    double l;          // opacity_unit_distance
+    double tolerance;  // render.tolerance
+    double total;      // length of all intervals
+    CompensatedSum tau;
+    CompensatedSum C[3];
+    double colour_bound = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
+    std::vector<LeafRecord> leaves;
+
+    // sigma and colour at t; transparent where the value (or the shaded colour) is not finite.
+    void sample(double t, double& sigma, glm::dvec3& c) const {
+        const PipelineSample p = pipeline->sample(*ray, t, SamplePipeline::Use::Composite);
+        const double a = std::min(p.opacity, conventions::kAdaptiveMaxOpacity);
+        if (!(a > 0.0) || !std::isfinite(p.value) || !std::isfinite(p.color.x + p.color.y + p.color.z)) {
+            sigma = 0.0;
+            c = glm::dvec3(0.0);
+            return;
+        }
+        sigma = -std::log1p(-a) / l;
+        c = p.color;
+    }
+
+    void leaf(double a, double b, int depth) {
+        const gk::Tables& g = gk::tables();
+        const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+        double sigma[gk::kNodes];
+        glm::dvec3 c[gk::kNodes];
+        double cmax = 0.0;
+        for (int i = 0; i < gk::kNodes; ++i) {
+            sample(mid + half * g.x[std::size_t(i)], sigma[i], c[i]);
+            cmax = std::max(cmax, max_abs(c[i]));
+        }
+        colour_bound = std::max(colour_bound, cmax);
+        double dtau_k = 0.0, dtau_g = 0.0;
+        glm::dvec3 ek(0.0), eg(0.0);
+        for (int i = 0; i < gk::kNodes; ++i) {
+            dtau_k += g.wk[std::size_t(i)] * sigma[i];
+            if (sigma[i] == 0.0) continue;
+            double tau_i = 0.0;
+            for (int j = 0; j < gk::kNodes; ++j) tau_i += g.sk[std::size_t(i)][std::size_t(j)] * sigma[j];
+            ek += (g.wk[std::size_t(i)] * sigma[i] * std::exp(-half * tau_i)) * c[i];
+        }
+        for (int q = 0; q < gk::kGaussNodes; ++q) {
+            const int i = 2 * q + 1;
+            dtau_g += g.wg[std::size_t(q)] * sigma[i];
+            if (sigma[i] == 0.0) continue;
+            double tau_q = 0.0;
+            for (int j = 0; j < gk::kGaussNodes; ++j) tau_q += g.sg[std::size_t(q)][std::size_t(j)] * sigma[2 * j + 1];
+            eg += (g.wg[std::size_t(q)] * sigma[i] * std::exp(-half * tau_q)) * c[i];
+        }
+        dtau_k *= half;
+        dtau_g *= half;
+        ek *= half;
+        eg *= half;
+        const double T = std::exp(-tau.value());
+        const double e_e = max_abs(ek - eg), e_t = std::fabs(dtau_k - dtau_g);
+        const double estimate = T * (e_e + colour_bound * e_t);
+        const double budget = tolerance * (b - a) / total;
+        const double roundoff = conventions::kAdaptiveRoundoffRelative * T * (max_abs(ek) + colour_bound * dtau_k);
+        const double m = 0.5 * (a + b);
+        const bool splittable = m > a && m < b && depth < conventions::kAdaptiveMaxDepth;
+        if (estimate <= budget || estimate <= roundoff || !splittable) {
+            const glm::dvec3 contribution = T * ek;
+            for (int ch = 0; ch < 3; ++ch) C[ch].add(contribution[ch]);
+            tau.add(dtau_k);
+            leaves.push_back({contribution, T * e_e, e_t});
+            return;
+        }
+        leaf(a, m, depth + 1);
+        leaf(m, b, depth + 1);
+    }
+};
+
+}  // namespace
+
+PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals) const {
+    PixelValue out;
+    CompositeState st{&ctx_.pipeline, &ray, ctx_.pipeline.classifier().unit_distance(), ctx_.render.tolerance, 0.0, {}, {}, 1.0, {}};
+    for (const Interval& iv : intervals) st.total += iv.length();
+    if (!(st.total > 0.0)) return out;
+    bool opaque = false;
+    glm::dvec3 opaque_colour(0.0);
+    std::vector<double> cut;
+    for (const Interval& iv : intervals) {
+        cuts(ray, iv, cut);
+        for (std::size_t p = 0; p + 1 < cut.size() && !opaque; ++p) {
+            const double a = cut[p], b = cut[p + 1];
+            if (!(b > a)) continue;
+            const PipelineSample pm = ctx_.pipeline.sample(ray, 0.5 * (a + b), SamplePipeline::Use::Composite);
+            if (pm.opacity >= 1.0 && std::isfinite(pm.value)) {  // opaque piece: the ray ends at a
+                const PipelineSample ps = ctx_.pipeline.sample(ray, a + 1e-9 * (b - a), SamplePipeline::Use::Composite);
+                opaque_colour = std::exp(-st.tau.value()) * ps.color;
+                for (int ch = 0; ch < 3; ++ch) st.C[ch].add(opaque_colour[ch]);
+                opaque = true;
+                break;
+            }
+            st.leaf(a, b, 0);
+        }
+        if (opaque) break;
+    }
+    const double T_end = opaque ? 0.0 : std::exp(-st.tau.value());
+    out.rgba = glm::dvec4(st.C[0].value(), st.C[1].value(), st.C[2].value(), opaque ? 1.0 : -std::expm1(-st.tau.value()));
+    // Posterior error: leaf i's tau error scales everything emitted behind it.
+    glm::dvec3 behind = opaque_colour;
+    double colour_err = 0.0, tau_err = 0.0;
+    for (auto it = st.leaves.rbegin(); it != st.leaves.rend(); ++it) {
+        colour_err += it->e_emission + it->e_tau * max_abs(behind);
+        tau_err += it->e_tau;
+        behind += it->contribution;
+    }
+    out.error = std::max(colour_err, T_end * tau_err) + rounding_bound(out.rgba);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// average / xray
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+struct LineState {
+    const SamplePipeline* pipeline;
+    const Ray* ray;
+    double budget_per_length;  // accepted error of the integral per unit length
+    CompensatedSum integral;
+    double error = 0.0;
+
+    double s(double t) const {
+        const double v = pipeline->value(*ray, t);
+        if (!std::isfinite(v)) return 0.0;
+        const double x = pipeline->classifier().coordinate(v);
+        return std::isfinite(x) ? x : 0.0;
+    }
+    void leaf(double a, double b, int depth) {
+        const gk::Tables& g = gk::tables();
+        const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+        double k = 0.0, q = 0.0;
+        for (int i = 0; i < gk::kNodes; ++i) {
+            const double f = s(mid + half * g.x[std::size_t(i)]);
+            k += g.wk[std::size_t(i)] * f;
+            if (i % 2 == 1) q += g.wg[std::size_t(i / 2)] * f;
+        }
+        k *= half;
+        q *= half;
+        const double e = std::fabs(k - q);
+        const double m = 0.5 * (a + b);
+        const bool splittable = m > a && m < b && depth < conventions::kAdaptiveMaxDepth;
+        if (e <= budget_per_length * (b - a) || e <= conventions::kAdaptiveRoundoffRelative * std::fabs(k) || !splittable) {
+            integral.add(k);
+            error += e;
+            return;
+        }
+        leaf(a, m, depth + 1);
+        leaf(m, b, depth + 1);
+    }
+};
+
+}  // namespace
+
+PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals) const {
+    PixelValue out;
+    if (intervals.empty()) return out;
+    CompensatedSum length;
+    for (const Interval& iv : intervals) length.add(iv.length());
+    const double L = length.value();
+    const bool mean = ctx_.render.projection == Projection::Average;
+    const double tol = ctx_.render.tolerance;
+    // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
+    const double per_length = mean ? tol : (L > 0.0 ? tol / (ctx_.render.gain * L) : 0.0);
+    LineState st{&ctx_.pipeline, &ray, per_length, {}, 0.0};
+    std::vector<double> cut;
+    for (const Interval& iv : intervals) {
+        cuts(ray, iv, cut);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p)
+            if (cut[p + 1] > cut[p]) st.leaf(cut[p], cut[p + 1], 0);
+    }
+    const double g = mean ? (L > 0.0 ? st.integral.value() / L : 0.0) : ctx_.render.gain * st.integral.value();
+    out.rgba = glm::dvec4(g, g, g, 1.0);
+    out.error = (mean ? (L > 0.0 ? st.error / L : 0.0) : ctx_.render.gain * st.error) + rounding_bound(out.rgba);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// mip / minip
+// ---------------------------------------------------------------------------------------------
+
+PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals) const {
+    const bool maximum = ctx_.render.projection == Projection::Mip;
+    bool any = false;
+    double best = 0.0, t_best = 0.0;
+    auto consider = [&](double t) {
+        const double v = ctx_.field(ray, t);
+        if (!std::isfinite(v)) return;  // non-finite values are ignored
+        if (!any || (maximum ? v > best : v < best)) {
+            best = v;
+            t_best = t;
+        }
+        any = true;
+    };
+    const Volume& v = cartesian_->volume();
+    std::vector<double> cut;
+    for (const Interval& iv : intervals) {
+        grid_cuts(ray, iv.t0, iv.t1, v, cut_offset_, cut);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p) {
+            const double ta = cut[p], tb = cut[p + 1];
+            if (!cubic_) {  // nearest: constant on the piece
+                consider(0.5 * (ta + tb));
+                continue;
+            }
+            consider(ta);
+            consider(tb);
+            double ex[2];
+            const int ne = cubic_extrema(cell_cubic(*cartesian_, ray, ta, tb), tb - ta, ex);
+            for (int k = 0; k < ne; ++k) consider(ta + ex[k]);
+        }
+    }
+    PixelValue out;
+    if (any) {
+        const PipelineSample p = ctx_.pipeline.sample(ray, t_best, SamplePipeline::Use::Unshaded);
+        out.rgba = glm::dvec4(p.opacity * p.color, p.opacity);
+    }
+    out.error = rounding_bound(out.rgba);
+    return out;
+}
+
+}  // namespace volref

@@ -1,0 +1,78 @@
+// AdaptiveIntegrator: the reference integrator of render.integrator "adaptive" (docs/accuracy.md).
+//
+// Each ray interval is cut where the integrand is not smooth, then each smooth piece is integrated by
+// Gauss-Kronrod G7/K15 with recursive bisection until its error estimate fits its share of
+// render.tolerance (core/Conventions.h, "Adaptive integration"). All in double.
+//
+// Cuts (pieces):
+//   Cartesian trilinear: the cell faces (AdaptiveCellWalk.h); inside a cell the field is a cubic in t
+//     (CellCubic.h); with a post-classified transfer function also every t where the cubic crosses a
+//     row value of the colour or opacity function (the roots, isolated between the cubic's extrema and
+//     bisected to rounding). Between cuts the value and the transfer function are then smooth, and so
+//     is the integrand unless shading (max(N.L, 0) has kinks), gradient opacity (rows of |grad f|) or
+//     Levoy's classification (tents) add kinks inside: those are found only by bisection.
+//   Cartesian tricubic: the cell faces (the kernels' knots); rows of the transfer function by bisection.
+//   Cartesian nearest: the faces of the nearest-neighbour regions (u = i + 1/2): the value is constant
+//     between them.
+//   Beam-space grids (shells): the fixed integrator's segment ends (render.step); coordinate surfaces and
+//     rows are found only by bisection (a weaker guarantee, docs/accuracy.md).
+//
+// Composite (emission-absorption, conventions section 3 in continuous form): with
+// sigma(t) = -log1p(-a(t)) / l, T(t) = exp(-tau(t)), tau(t) = integral of sigma up to t,
+//   C = integral c(t) sigma(t) T(t) dt,   A = 1 - T(end) = -expm1(-tau_total).
+// A leaf [a, b] gives Delta tau = integral of sigma (K15) and E = integral c sigma exp(-(tau(t) - tau(a)))
+// (K15, with tau(t) - tau(a) at the nodes from the integration matrix, AdaptiveQuadrature.h); then
+// C += T(a) E and tau += Delta tau, both compensated sums (never a product of transmittances). The same
+// with G7 gives the estimates e_E = max_ch |E_K15 - E_G7| and e_tau = |Delta tau_K15 - Delta tau_G7|.
+// A piece whose opacity is 1 at its midpoint is opaque: C += T c(start of the piece), A = 1, and the
+// ray ends. The order (front to back, back to front) does not apply.
+//
+// Error (PixelValue::error, the "error" channel): to first order in the leaf estimates,
+//   colour: sum_i T_i e_E,i + sum_i e_tau,i * max_ch C_after,i   (C_after,i: what is emitted behind leaf i,
+//           which an error d in tau_i scales by exp(-d)),   alpha: T_end sum_i e_tau,i,
+// the larger of the two, plus kRoundingErrorRelative (1 + max |channel|).
+//
+// average / xray: the integral of the transfer function's coordinate s(f(t)), K15 per leaf, error
+// sum |K15 - G7| (times gain, or divided by the length for average). Cartesian trilinear: s is a cubic
+// inside a cell, so G7 is already exact there.
+// mip / minip (Cartesian trilinear or nearest): the maximum / minimum of the field over the ray, exact:
+// per cell the cubic's values at the cell ends and at the roots of its derivative (nearest: each
+// region's constant). Error: rounding only.
+//
+// Non-finite values (NaN, +-Inf voxels, read by a sample): the sample is transparent (no opacity, no
+// emission) and contributes 0 to line integrals; mip/minip ignore it (docs/accuracy.md).
+#pragma once
+#include <vector>
+
+#include "core/integrate/CellCubic.h"
+#include "core/integrate/Integrator.h"
+
+namespace volref {
+
+class TransferFunction;
+class VolumeSampler;
+
+class AdaptiveIntegrator final : public Integrator {
+public:
+    // Throws volref::Error (naming render.integrator) for what it does not integrate.
+    explicit AdaptiveIntegrator(const IntegrationContext& ctx);
+    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    bool writes_error() const override { return true; }
+
+    // The cut points of one interval (t0, ..., t1), increasing: the pieces described above.
+    void cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const;
+
+private:
+    PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
+    PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals) const;
+    PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;
+
+    const VolumeSampler* cartesian_ = nullptr;
+    double cut_offset_ = 0.0;             // 0: cell faces; 0.5: nearest regions
+    bool cut_cells_ = false;              // Cartesian: cut at grid planes
+    bool cubic_ = false;                  // Cartesian trilinear: cubic per cell
+    const TransferFunction* rows_ = nullptr;  // post-classified transfer function: cut at its rows
+    std::vector<double> row_values_;      // its distinct row values (the function's coordinate), sorted
+};
+
+}  // namespace volref

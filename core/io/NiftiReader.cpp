@@ -67,7 +67,7 @@ NiftiVersion check_header_bytes(const std::filesystem::path& path, const std::st
     return v;
 }
 
-// dim[0..7] and datatype as the header holds them (byte-swapped to native by nifti_clib).
+// dim[0..7] and datatype as the header holds them (in native byte order).
 struct RawFields {
     std::array<std::int64_t, 8> dim{};
     int datatype = 0;
@@ -78,6 +78,11 @@ RawFields read_raw_fields(const std::filesystem::path& path, const NiftiVersion&
     void* raw = nifti_read_header(path.c_str(), &nver, 0);
     if (!raw) throw Error(where + ": nifti_clib could not read the NIfTI-" + std::to_string(v.version) + " header");
     std::unique_ptr<void, void (*)(void*)> guard(raw, &std::free);
+    // nifti_read_header leaves the header in the file's byte order: swap it (nifti_clib's own swap)
+    // when sizeof_hdr reads back wrong.
+    const std::int32_t size_field = nver == 2 ? static_cast<const nifti_2_header*>(raw)->sizeof_hdr
+                                              : static_cast<const nifti_1_header*>(raw)->sizeof_hdr;
+    if (size_field != (nver == 2 ? 540 : 348)) swap_nifti_header(raw, nver);
     RawFields f;
     if (nver == 2) {
         const auto* h = static_cast<const nifti_2_header*>(raw);

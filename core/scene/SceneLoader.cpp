@@ -264,7 +264,8 @@ FieldSpec read_field(ObjectReader& r) {
     return f;
 }
 
-// A file path (format from the extension), {"file": PATH, "format": "nrrd" | "raw"} or a field.
+// A file path (format from the extension), {"file": PATH, "format": "nrrd" | "raw" | "nifti" | "metaimage" |
+// "vtk" | "vti" | "den"} or a field.
 VolumeSourceSpec read_source(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     VolumeSourceSpec s;
     if (v.is_string()) {
@@ -286,7 +287,8 @@ VolumeSourceSpec read_source(const Json& v, const std::string& path, const Conte
     }
     r.allow({"file", "format"}, "for a file source");
     s.file = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
-    s.format = std::string(r.choice<std::string_view>("format", "", {{"nrrd", "nrrd"}, {"raw", "raw"}}));
+    s.format = std::string(r.choice<std::string_view>("format", "", {{"nrrd", "nrrd"}, {"raw", "raw"}, {"nifti", "nifti"}, {"metaimage", "metaimage"},
+                                                         {"vtk", "vtk"}, {"vti", "vti"}, {"den", "den"}}));
     return s;
 }
 

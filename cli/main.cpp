@@ -13,6 +13,7 @@
 #include "cli/ExplainCommand.h"
 #include "cli/TraceCommand.h"
 #include "cli/CompareCommand.h"
+#include "cli/SweepCommand.h"
 #include "cli/ConvertCommand.h"
 #include "cli/InfoCommand.h"
 #include "core/Cancellation.h"
@@ -121,6 +122,27 @@ int main(int argc, char** argv) {
     ex->add_option("topic", explain.topic, std::string("One of: ") + volref::cli::explain_topics())->required();
     ex->fallthrough(false)->prefix_command()->allow_extras();  // the topic's options are parsed by run_explain (one-line errors naming the option)
 
+    volref::cli::SweepArgs sweep;
+    CLI::App* sw = app.add_subcommand(
+        "sweep", "Render every combination of scene parameters, time each (median of N whole-process runs), measure "
+                 "the error against a reference; table, sweep.csv, sweep.png/.svg (gnuplot), order of accuracy");
+    sw->add_option("scene", sweep.scene, "Scene file (JSON)")->required();
+    sw->add_option("--param", sweep.params, "PATH=V1,V2,...: a scene key and its values (as --set); repeatable")
+        ->required()
+        ->take_all();
+    sw->add_option("--reference", sweep.reference,
+                   "adaptive (render.integrator=adaptive) or fine (fixed step = smallest swept step / 16); default: "
+                   "adaptive when available");
+    sw->add_option("--repeat", sweep.repeat, "Runs per combination; the median wall time is reported (default 3)")
+        ->check(CLI::Range(1, 1000));
+    sw->add_option("--tolerance", sweep.tolerance, "Max abs error per channel to count pixels over and predict a step for "
+                                                   "(default 1e-3)")
+        ->check(CLI::PositiveNumber);
+    sw->add_option("-o,--output", sweep.output, "Folder for sweep.csv, sweep.png, sweep.svg (default: .)");
+    sw->add_option("--threads", sweep.threads, "Worker threads of each render (default: all cores)")
+        ->check(CLI::Range(1, 4096));
+    sw->add_option("--set", sweep.overrides, "Override one scene value for every render: PATH=VALUE")->take_all();
+
     // ---- more subcommands: add each one's block above this line ----
 
     try {
@@ -150,6 +172,7 @@ int main(int argc, char** argv) {
             explain.args = ex->remaining();
             return volref::cli::run_explain(explain);
         }
+        if (sw->parsed()) return volref::cli::run_sweep(sweep);
         // ---- more subcommands: dispatch above this line ----
     } catch (const volref::Cancelled& e) {
         std::fprintf(stderr, "\nvolref: %s\n", e.what());

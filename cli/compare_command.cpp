@@ -116,8 +116,11 @@ int run_compare(const CompareArgs& args) {
             for (const ModelFit& f : fit->fits)
                 j["fit"][f.model] = {{"fitted", f.fitted},
                                      {"values", f.values},
+                                     {"judged_on", f.judged_on},
                                      {"residual_before", f.residual_before},
                                      {"residual_after", f.residual_after},
+                                     {"rgba_residual_before", f.rgba_before},
+                                     {"rgba_residual_after", f.rgba_after},
                                      {"note", f.note}};
             j["fit"]["verdict"] = fit->verdict;
         }
@@ -140,9 +143,14 @@ int run_compare(const CompareArgs& args) {
             for (const ModelFit& f : fit->fits) {
                 if (!f.fitted)
                     std::printf("fit %-8s not fitted: %s\n", f.model.c_str(), f.note.c_str());
-                else
+                else if (f.judged_on == "RGBA")
                     std::printf("fit %-8s %s; RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
                                 number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
+                else
+                    std::printf("fit %-8s %s; RMS residual in %s %s -> %s (RGBA %s -> %s)\n", f.model.c_str(),
+                                f.parameters.c_str(), f.judged_on.c_str(), number(f.residual_before, "%.4e").c_str(),
+                                number(f.residual_after, "%.4e").c_str(), number(f.rgba_before, "%.4e").c_str(),
+                                number(f.rgba_after, "%.4e").c_str());
             }
             std::printf("%s\n", fit->verdict.c_str());
         }

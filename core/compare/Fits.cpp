@@ -83,13 +83,12 @@ T opacity_ratio(double alpha, const T& k) {
 
 bool depends_on_opacity_exponent(double alpha) { return alpha > 0.0 && alpha < 1.0; }
 
+// Fitted on alpha alone: B_a - (1 - (1 - A_a)^k) = B_a - A_a ratio.
 struct OpacityResidual {
-    const double* a;
-    const double* b;
+    double a_alpha, b_alpha;
     template <typename T>
     bool operator()(const T* k, T* r) const {
-        const T ratio = opacity_ratio(a[3], k[0]);
-        for (int c = 0; c < 4; ++c) r[c] = T(b[c]) - T(a[c]) * ratio;  // alpha: A_a ratio = 1 - (1 - A_a)^k
+        r[0] = T(b_alpha) - T(a_alpha) * opacity_ratio(a_alpha, k[0]);
         return true;
     }
 };
@@ -133,8 +132,9 @@ ModelFit fit_gain(const Image& a, const Image& b) {
         after += (b.pixels[i] - model) * (b.pixels[i] - model);
     }
     const double values = std::max<double>(1.0, double(n * 4));
-    fit.residual_before = std::sqrt(before / values);
-    fit.residual_after = std::sqrt(after / values);
+    fit.judged_on = "RGBA";
+    fit.rgba_before = fit.residual_before = std::sqrt(before / values);
+    fit.rgba_after = fit.residual_after = std::sqrt(after / values);
     fit.values = {g};
     fit.parameters = format("g = %.9g", g);
     fit.fitted = n > 0;
@@ -152,13 +152,13 @@ ModelFit fit_opacity_exponent(const Image& a, const Image& b) {
     if (!used.empty()) {
         ceres::Problem problem;
         for (std::size_t i = 0; i < used.size(); i += fit_stride(used.size()))
-            problem.AddResidualBlock(new ceres::AutoDiffCostFunction<OpacityResidual, 4, 1>(
-                                         new OpacityResidual{&a.pixels[used[i] * 4], &b.pixels[used[i] * 4]}),
+            problem.AddResidualBlock(new ceres::AutoDiffCostFunction<OpacityResidual, 1, 1>(new OpacityResidual{
+                                         a.pixels[used[i] * 4 + 3], b.pixels[used[i] * 4 + 3]}),
                                      nullptr, &k);
         problem.SetParameterLowerBound(&k, 0, 1e-9);
         solve(problem);
     }
-    double before = 0.0, after = 0.0;
+    double before = 0.0, after = 0.0, alpha_before = 0.0, alpha_after = 0.0;
     for (std::size_t p = 0; p < n; ++p) {
         const double alpha = a.pixels[p * 4 + 3];
         const double ratio = depends_on_opacity_exponent(alpha) ? opacity_ratio(alpha, k) : 1.0;
@@ -166,11 +166,18 @@ ModelFit fit_opacity_exponent(const Image& a, const Image& b) {
             const double av = a.pixels[p * 4 + c], bv = b.pixels[p * 4 + c];
             before += (bv - av) * (bv - av);
             after += (bv - av * ratio) * (bv - av * ratio);
+            if (c == 3) {
+                alpha_before += (bv - av) * (bv - av);
+                alpha_after += (bv - av * ratio) * (bv - av * ratio);
+            }
         }
     }
     const double values = std::max<double>(1.0, double(n * 4));
-    fit.residual_before = std::sqrt(before / values);
-    fit.residual_after = std::sqrt(after / values);
+    fit.judged_on = "alpha";
+    fit.rgba_before = std::sqrt(before / values);
+    fit.rgba_after = std::sqrt(after / values);
+    fit.residual_before = std::sqrt(alpha_before / std::max<double>(1.0, double(n)));
+    fit.residual_after = std::sqrt(alpha_after / std::max<double>(1.0, double(n)));
     fit.values = {k};
     fit.parameters = format("k = %.9g", k);
     fit.fitted = !used.empty();
@@ -218,8 +225,9 @@ ModelFit fit_shift(const Image& a, const Image& b) {
         }
     }
     const double values = double(used.size() * 4);
-    fit.residual_before = std::sqrt(before / values);
-    fit.residual_after = std::sqrt(after / values);
+    fit.judged_on = "RGBA";
+    fit.rgba_before = fit.residual_before = std::sqrt(before / values);
+    fit.rgba_after = fit.residual_after = std::sqrt(after / values);
     fit.values = {s[0], s[1]};
     fit.parameters = format("sx = %.6g, sy = %.6g pixels", s[0], s[1]);
     fit.fitted = true;
@@ -231,7 +239,7 @@ DifferenceExplanation explain_difference(const Image& a, const Image& b) {
         throw Error("--fit: the images must have the same size and R, G, B, A");
     DifferenceExplanation e;
     e.fits = {fit_gain(a, b), fit_opacity_exponent(a, b), fit_shift(a, b)};
-    if (e.fits[0].residual_before == 0.0) {
+    if (e.fits[0].rgba_before == 0.0) {
         e.verdict = "likely cause: none needed, the images are identical";
         return e;
     }
@@ -241,12 +249,13 @@ DifferenceExplanation explain_difference(const Image& a, const Image& b) {
     if (!best || best->ratio() > kExplainedResidualRatio) {
         e.verdict = "likely cause: none of gain, opacity exponent or shift explains the difference";
         if (best)
-            e.verdict += " (the best, " + best->model + ", leaves " +
-                         format("%.0f", 100.0 * best->ratio()) + "% of the RMS difference)";
-        e.verdict += ": a different sample placement, reconstruction, transfer function or a bug";
+            e.verdict += " (the best, " + best->model + ", leaves " + format("%.0f", 100.0 * best->ratio()) +
+                         "% of the RMS difference in " + best->judged_on + ")";
+        e.verdict += ": another cause (discretisation: step, sample placement, reconstruction, transfer-function "
+                     "tables; or a bug)";
         return e;
     }
-    const std::string kept = format("%.0f", 100.0 * best->ratio()) + "% of the RMS difference left";
+    const std::string kept = format("%.0f", 100.0 * best->ratio()) + "% of the RMS difference in " + best->judged_on + " left";
     if (best->model == "gain")
         e.verdict = "likely cause: a colour gain, B = " + format("%.6g", best->values[0]) +
                     " A (exposure, a colour or transfer-function scale, or sRGB against linear; " + kept + ")";

@@ -5,12 +5,15 @@
 //   gain       B_rgb = g A_rgb,  B_a = A_a                                   (one parameter g)
 //   opacity    B_a = 1 - (1 - A_a)^k,  B_rgb = A_rgb B_a / A_a                (one parameter k > 0)
 //              (k multiplies the optical depth: a step, opacity unit distance or density scale k times
-//              A's; the colour follows alpha as it does for a constant colour along the ray; pixels with
-//              A_a = 0 or A_a >= 1 do not depend on k and are left out of the fit)
+//              A's. Alpha follows exactly for any ray, since T_B = exp(-k tau) = T_A^k, so k is fitted to
+//              alpha and the model is judged by the alpha residual; the colour prediction is exact only
+//              for a constant colour along the ray and is reported as the RGBA residual. Pixels with
+//              A_a = 0 or A_a >= 1 do not depend on k and are left out of the fit.)
 //   shift      B(x, y) = A(x - sx, y - sy)                                   (two parameters, pixels)
 //              (A interpolated by Ceres' bicubic (Catmull-Rom) interpolator; |s| <= kMaxShiftPixels;
 //              residual over pixels at least kMaxShiftPixels from the border)
-// Residuals are reported as RMS over every value the model covers, before (B - A) and after (B - model).
+// Residuals are reported as RMS over every value the model is judged on (gain, shift: R, G, B, A; opacity:
+// A), before (B - A) and after (B - model); rgba_before/after are over R, G, B, A for every model.
 //
 // sweep: error = C h^p, fitted in log space with the Cauchy loss (CompareConstants.h).
 #pragma once
@@ -25,8 +28,10 @@ struct ModelFit {
     std::string model;                 // "gain", "opacity", "shift"
     std::vector<double> values;        // g | k | sx, sy
     std::string parameters;            // e.g. "g = 1.1"
-    double residual_before = 0.0;      // RMS of B - A over the values the model covers
-    double residual_after = 0.0;       // RMS of B - model(A)
+    std::string judged_on;             // "RGBA" or "alpha": the values residual_* are over
+    double residual_before = 0.0;      // RMS of B - A over the values the model is judged on
+    double residual_after = 0.0;       // RMS of B - model(A) over the same
+    double rgba_before = 0.0, rgba_after = 0.0;  // the same over R, G, B, A
     bool fitted = false;               // false: not applicable (see note)
     std::string note;                  // why not applicable
     double ratio() const { return residual_before > 0.0 ? residual_after / residual_before : 1.0; }

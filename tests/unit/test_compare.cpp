@@ -393,6 +393,23 @@ TEST(CompareFit, RecoversAnOpacityExponent) {
     EXPECT_GT(e.fits[0].residual_after, 100 * e.fits[1].residual_after);
 }
 
+// The opacity model is judged on alpha, which follows T_B = T_A^k for any ray: B's colour here does not
+// follow A's alpha ratio (colour varying along the ray), yet k = 2.5 is recovered from alpha and named.
+TEST(CompareFit, OpacityExponentFromAlphaWhateverTheColour) {
+    auto alpha = [](int x, int y) { return 0.1 + 0.8 * (0.5 + 0.5 * std::cos(0.29 * x - 0.17 * y)); };
+    const Image a = make_image(16, 16, [&](int x, int y, int c) { return c == 3 ? alpha(x, y) : 0.3 * alpha(x, y); });
+    const Image b = make_image(16, 16, [&](int x, int y, int c) {
+        const double ab = 1.0 - std::pow(1.0 - alpha(x, y), 2.5);
+        return c == 3 ? ab : smooth(x, y, c) * ab;
+    });
+    const ModelFit f = fit_opacity_exponent(a, b);
+    EXPECT_EQ(f.judged_on, "alpha");
+    EXPECT_NEAR(f.values[0], 2.5, 1e-6);
+    EXPECT_LT(f.residual_after, 1e-9);
+    EXPECT_GT(f.rgba_after, 1e-3);  // the colour is not explained
+    EXPECT_NE(explain_difference(a, b).verdict.find("2.5 times A's optical depth"), std::string::npos);
+}
+
 // B(x, y) = f(x - 0.3, y + 0.2) for a smooth f sampled at the pixels: the shift fit finds (0.3, -0.2)
 // to the accuracy of bicubic interpolation of f (a wavelength of ~20 pixels: ~1e-3 pixel).
 TEST(CompareFit, RecoversASubPixelShift) {
@@ -431,4 +448,23 @@ TEST_F(CompareCli, FitThroughTheCommand) {
     r = run(p("a.exr") + " " + p("b.exr") + " --fit");
     EXPECT_NE(r.out.find("likely cause: a colour gain, B = 1.25 A"), std::string::npos) << r.out;
     EXPECT_TRUE(r.err.empty()) << r.err;  // Ceres stays silent
+}
+
+// Two real renders, the second with opacity_unit_distance halved: every segment's optical depth doubles,
+// so alpha_B = 1 - (1 - alpha_A)^2 exactly and --fit must find k = 2 (to float storage).
+TEST_F(CompareCli, FitFindsTheOpacityUnitDistanceOfRealRenders) {
+    std::ofstream(dir_ / "s.json") << R"({
+  "volume": { "source": { "field": "gaussian", "dims": [9, 9, 9], "center": [4, 4, 4], "sigma": 2.5 },
+              "transfer": { "opacity": [[0, 0], [1, 0.6]], "color": [[0, 0.2, 0.4, 1.0], [1, 1.0, 0.6, 0.2]] } },
+  "image": { "width": 12, "height": 12 }
+})";
+    const std::string render = std::string(VOLREF_CLI) + " render " + p("s.json") + " > /dev/null 2>&1 -o ";
+    ASSERT_EQ(std::system((render + p("a.exr")).c_str()), 0);
+    ASSERT_EQ(std::system((render + p("b.exr") + " --set volume.transfer.opacity_unit_distance=0.5").c_str()), 0);
+    const CmdResult r = run(p("a.exr") + " " + p("b.exr") + " --fit --json");
+    ASSERT_EQ(r.status, 1) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_NEAR(j["fit"]["opacity"]["values"][0].get<double>(), 2.0, 1e-5);
+    EXPECT_NE(j["fit"]["verdict"].get<std::string>().find("opacity correction, B has 2 times"), std::string::npos)
+        << j["fit"]["verdict"];
 }

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <mutex>
@@ -30,7 +31,12 @@ std::string hex_bytes(std::string_view s) { return io::quoted(s, 8); }
 
 // Checks the first bytes of the header (decompressed for gzip): sizeof_hdr, length and magic.
 NiftiVersion check_header_bytes(const std::filesystem::path& path, const std::string& where) {
-    const std::string file = io::read_file_bytes(path);
+    // The first 64 KiB of the file: plenty for 540 header bytes, even compressed.
+    std::string file(std::size_t(1) << 16, '\0');
+    {
+        const io::FileHandle f = io::open_for_reading(path);
+        file.resize(std::fread(file.data(), 1, file.size(), f.get()));
+    }
     std::string prefix;
     if (file.size() >= 2 && static_cast<unsigned char>(file[0]) == 0x1f && static_cast<unsigned char>(file[1]) == 0x8b) {
         prefix = io::inflate_stream(file, 0, 540, where).data;
@@ -209,27 +215,34 @@ Volume read_nifti(const std::filesystem::path& path) {
 
     // The image bytes: in the same file after vox_offset (.nii), or in the .img file.
     const std::filesystem::path image_path = nim->iname ? std::filesystem::path(nim->iname) : path;
-    const std::string at =
-        image_path == path ? where : image_path.string() + " (image file of " + where + ")";
     if (nim->iname_offset < 0) throw Error(where + ": vox_offset must be >= 0");
     const auto offset = static_cast<std::uint64_t>(nim->iname_offset);
     const std::size_t expected = count * scalar_type_size(type);
-    const std::string file = io::read_file_bytes(image_path);
-    std::string storage;
+    // Errors in a separate .img file start with its path and end with "(image file of HEADER)".
+    const std::string at = image_path.string();
+    std::string file, storage;
     std::string_view bytes;
-    if (nifti_is_gzfile(image_path.c_str())) {
-        storage = io::inflate_stream(file, offset, expected, at).data;
-        if (storage.size() < expected)
-            throw Error(io::truncated_message(at, expected, storage.size()) + " after inflating (from vox_offset " +
-                        std::to_string(offset) + ")");
-        bytes = storage;
-    } else {
-        const std::size_t found = offset >= file.size() ? 0 : file.size() - std::size_t(offset);
-        if (found < expected)
-            throw Error(io::truncated_message(at, expected, found) + " (from vox_offset " + std::to_string(offset) + ")");
-        bytes = std::string_view(file).substr(std::size_t(offset), expected);
+    try {
+        file = io::read_file_bytes(image_path);
+        if (nifti_is_gzfile(image_path.c_str())) {
+            storage = io::inflate_stream(file, offset, expected, at).data;
+            if (storage.size() < expected)
+                throw Error(io::truncated_message(at, expected, storage.size()) + " after inflating (from vox_offset " +
+                            std::to_string(offset) + ")");
+            bytes = storage;
+        } else {
+            const std::size_t found = offset >= file.size() ? 0 : file.size() - std::size_t(offset);
+            if (found < expected)
+                throw Error(io::truncated_message(at, expected, found) + " (from vox_offset " + std::to_string(offset) +
+                            ")");
+            bytes = std::string_view(file).substr(std::size_t(offset), expected);
+        }
+    } catch (const Error& e) {
+        if (image_path == path) throw;
+        throw Error(std::string(e.what()) + " (image file of " + where + ")");
     }
-    const std::endian order = nim->byteorder == 2 /* MSB_FIRST, private to nifti_clib */ ? std::endian::big : std::endian::little;
+    // nifti_clib's MSB_FIRST (2) is defined only inside the library.
+    const std::endian order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
     std::vector<double> stored = io::decode_samples(bytes, type, order);
 
     // Scaling: value = slope * stored + inter, when slope is set and not the identity.

@@ -265,6 +265,25 @@ TEST_F(Formats, Nifti2Float32) {
     EXPECT_EQ(v.at(0, 1, 0), double(1e30f));
 }
 
+// A header + image pair (.hdr + .img, magic "ni1", vox_offset 0).
+TEST_F(Formats, Nifti1HeaderImagePair) {
+    std::string h = nifti1_header({2, 2, 1}, 256 /* INT8 */, 8, std::endian::little);
+    h.replace(344, 4, std::string("ni1\0", 4));
+    put<float>(h, 108, 0.0f, std::endian::little);
+    write("pair.img", std::string{char(-128), char(-1), char(0), char(127)});
+    const Volume v = volref::read_volume(write("pair.hdr", h));
+    EXPECT_EQ(v.type, ScalarType::I8);
+    EXPECT_EQ(v.values, (std::vector<double>{-128, -1, 0, 127}));
+    fs::remove(dir_ / "pair.img");
+    try {
+        volref::read_volume(dir_ / "pair.hdr");
+        ADD_FAILURE();
+    } catch (const volref::Error& e) {
+        EXPECT_THAT(e.what(), StartsWith((dir_ / "pair.img").string() + ": cannot read file"));
+        EXPECT_THAT(e.what(), HasSubstr("(image file of " + (dir_ / "pair.hdr").string() + ")"));
+    }
+}
+
 TEST_F(Formats, NiftiErrors) {
     const auto le = std::endian::little;
     const std::string data(12, 'x');

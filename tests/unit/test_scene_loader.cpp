@@ -799,7 +799,7 @@ TEST(SceneLoaderErrors, UnknownEnumValues) {
     EXPECT_TRUE(fails_with(volume_with(R"("classify": "before")"), "volume.classify",
                            "expected one of \"post\", \"pre\", got \"before\""));
     EXPECT_TRUE(fails_with(source_with(R"({"field": "sphere"})"), "volume.source.field", "expected one of"));
-    EXPECT_TRUE(fails_with(source_with(R"({"file": "a.vtk", "format": "vtk"})"), "volume.source.format",
+    EXPECT_TRUE(fails_with(source_with(R"({"file": "a.vtk", "format": "xyz"})"), "volume.source.format",
                            "expected one of \"nrrd\", \"raw\""));
     EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "fisheye"})"), "camera.type", "expected one of"));
     EXPECT_TRUE(fails_with(scene_with(R"("lights": [{"type": "spot"}])"), "lights[0].type", "expected one of"));

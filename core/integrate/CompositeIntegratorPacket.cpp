@@ -1,6 +1,10 @@
 // CompositeIntegrator's SIMD side: when the scene allows the packet path (PacketComposite.h), and
 // the hand-over of packets to it.
 #include "core/integrate/CompositeIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+
 #include "core/sample/GradientField.h"
 #include "transfer/Shader.h"
 #include "transfer/TransferFunction.h"
@@ -15,6 +19,8 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
         ctx.render.order != CompositeOrder::FrontToBack)
         return;
     const Volume& v = sampler->volume();
+    // Non-finite voxels: the scalar path, whose pipeline makes them transparent (docs/accuracy.md).
+    if (!std::all_of(v.values.begin(), v.values.end(), [](double x) { return std::isfinite(x); })) return;
     PacketCompositeInputs in;
     if (tf->needs_gradient() || p.shaded()) {
         const auto* field = dynamic_cast<const GradientField*>(p.gradient_source());

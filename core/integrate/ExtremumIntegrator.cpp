@@ -2,6 +2,8 @@
 
 #include "core/integrate/Segments.h"
 
+#include <algorithm>
+#include <cmath>
 #include <type_traits>
 
 namespace volref {
@@ -10,6 +12,8 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
     const VolumeSampler* sampler = ctx.pipeline.cartesian_sampler();
     if (!sampler || sampler->interpolation() != Interpolation::Trilinear) return;
     const Volume& v = sampler->volume();
+    // Non-finite voxels: the scalar path, which ignores them (docs/accuracy.md).
+    if (!std::all_of(v.values.begin(), v.values.end(), [](double x) { return std::isfinite(x); })) return;
     PacketExtremumInputs in;
     in.voxels = v.values.data();
     for (int a = 0; a < 3; ++a) {
@@ -58,12 +62,12 @@ PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<
         } else {
             v = ctx_.field(ray, s.midpoint());
         }
-        if (!any || (maximum_ ? v > best : v < best)) {
+        if (std::isfinite(v) && (!any || (maximum_ ? v > best : v < best))) {  // non-finite values are ignored
             best = v;
             t_best = s.midpoint();
             if constexpr (Rec::kOn) so_far = pixel(ray, true, t_best).rgba;
         }
-        any = true;
+        any = any || std::isfinite(v);
         if constexpr (Rec::kOn) {
             r.running = best;
             r.accumulated = so_far;

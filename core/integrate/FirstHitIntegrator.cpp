@@ -21,6 +21,7 @@ int sign(double x) { return (x > 0.0) - (x < 0.0); }
 
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
                                            double iso) {
+    // Non-finite values (NaN, +-Inf voxels) never cross: parts with a non-finite end are passed over.
     auto g = [&](double t) { return sampler.trilinear(ray.at(t)) - iso; };
     if (g(t0) == 0.0) return t0;
     std::vector<double> cuts;
@@ -39,6 +40,10 @@ std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const R
         double ga = g(ta);
         for (int m = 0; m + 1 < n; ++m) {
             const double a = ts[m], b = ts[m + 1], gb = g(b);
+            if (!std::isfinite(ga) || !std::isfinite(gb)) {
+                ga = gb;
+                continue;
+            }
             if (ga == 0.0) return a;
             if (gb == 0.0) return b;
             if (sign(ga) != sign(gb)) return bisect_to_rounding(g, a, b, sign(ga));
@@ -75,6 +80,11 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
         }
         for (std::int64_t k = 0; k < n && !hit; ++k) {
             const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
+            if (!std::isfinite(ga) || !std::isfinite(gb)) {  // non-finite values never cross
+                ta = tb;
+                ga = gb;
+                continue;
+            }
             if (gb == 0.0) {
                 hit = tb;
             } else if (sign(gb) != sign(ga)) {

@@ -1,5 +1,7 @@
 #include "core/integrate/LineIntegralIntegrator.h"
 
+#include <cmath>
+
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/Segments.h"
 
@@ -26,7 +28,7 @@ PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vec
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
         const double v = ctx_.field(ray, s.midpoint());
         const double coordinate = ctx_.pipeline.classifier().coordinate(v);
-        integral.add(coordinate * s.length());
+        integral.add(std::isfinite(coordinate) ? coordinate * s.length() : 0.0);  // non-finite: 0 (docs/accuracy.md)
         length.add(s.length());
         if constexpr (Rec::kOn) {
             SampleRecord r;

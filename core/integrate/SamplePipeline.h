@@ -4,6 +4,8 @@
 //   -> shading c' = shader(c, grad f, V, d) (only when the scene asks for shading).
 // Integrators ask it for samples; they never build a stage themselves.
 #pragma once
+#include <cmath>
+
 #include <glm/geometric.hpp>
 
 #include "core/camera/Ray.h"
@@ -83,6 +85,12 @@ private:
             detail->color = s.color;
         } else {
             s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
+        }
+        // A non-finite value (a NaN or +-Inf voxel read by the sample) or colour is transparent
+        // (docs/accuracy.md, "Non-finite voxels").
+        if (!std::isfinite(s.value) || !std::isfinite(s.opacity) || !std::isfinite(s.color.r + s.color.g + s.color.b)) {
+            s.opacity = 0.0;
+            s.color = glm::dvec3(0.0);
         }
         return s;
     }

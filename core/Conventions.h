@@ -74,6 +74,19 @@ inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16
 // integral changes only where a > 1 - 2^-53, a set of length ~ 2^-53 of the ramp. A piece whose
 // opacity is 1 at its midpoint is opaque (the ray ends there, T = 0 behind it).
 inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
+// Where the field along a piece is not a cubic (tricubic cells, beam-space grids), transfer-function
+// rows are located by sampling the piece at this many + 1 equally spaced points (a crossing is a sign
+// change of s - x_k between neighbours, then bisected to rounding). 8 intervals per cell resolve the
+// up to 9 roots of a tricubic cell's degree-9 polynomial when they are not closer than 1/8 cell.
+inline constexpr int kAdaptiveRowSamples = 8;
+// Each accepted pair of halves [a, m], [m, b] is checked against the rule on [a, b]: the estimate is
+// |K15[a, b] - (K15[a, m] + K15[m, b])| + |K15 - G7| of each half (a rule against its halves catches
+// what both rules of one evaluation miss). Where kinks of the integrand lie inside pieces (shading,
+// gradient opacity, Levoy's classification, tricubic and beam-space pieces, nearest), that estimate
+// is multiplied by this safety factor, for acceptance and in the error channel: the halving estimate
+// assumes the rule's error falls by 2^(order) per halving, a kink's only by 4 (measured: without the
+// factor, up to 1.7 x underestimates on the reference scenes; tests/unit/test_adaptive.cpp).
+inline constexpr double kAdaptiveWeakSafety = 10.0;
 // Projections whose adaptive result is exact up to rounding (mip/minip: the cubic's extrema; first
 // hit: the cubic's first root) report error = kRoundingErrorRelative * (1 + max |channel|): a bound
 // on the rounding of reconstruction and classification (a few dozen operations of relative 2^-53).

@@ -37,15 +37,23 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
         const Interpolation interp = cartesian_->interpolation();
         cut_offset_ = interp == Interpolation::Nearest ? 0.5 : 0.0;
         cubic_ = interp == Interpolation::Trilinear;
-        if (cubic_ && !ctx.pipeline.preclassified())
-            if (const auto* tf = dynamic_cast<const TransferFunction*>(&ctx.pipeline.classifier())) {
-                rows_ = tf;
-                for (double x : tf->color_function().xs()) row_values_.push_back(x);
-                for (double x : tf->opacity_function().xs()) row_values_.push_back(x);
-                std::sort(row_values_.begin(), row_values_.end());
-                row_values_.erase(std::unique(row_values_.begin(), row_values_.end()), row_values_.end());
-            }
     }
+    // Rows of a post-classified transfer function (nearest: the value is constant between cuts).
+    const bool nearest = cartesian_ && cartesian_->interpolation() == Interpolation::Nearest;
+    if (!ctx.pipeline.preclassified() && !nearest)
+        if (const auto* tf = dynamic_cast<const TransferFunction*>(&ctx.pipeline.classifier())) {
+            rows_ = tf;
+            for (double x : tf->color_function().xs()) row_values_.push_back(x);
+            for (double x : tf->opacity_function().xs()) row_values_.push_back(x);
+            std::sort(row_values_.begin(), row_values_.end());
+            row_values_.erase(std::unique(row_values_.begin(), row_values_.end()), row_values_.end());
+        }
+    // Composite: is every kink of the integrand at a cut? Only for trilinear reconstruction with a
+    // transfer function (rows located as cubic roots) or pre-classification (trilinear opacity and
+    // colour), unshaded, without gradient opacity. Otherwise the estimate carries kAdaptiveWeakSafety.
+    const bool smooth_between_cuts = cubic_ && !ctx.pipeline.shaded() && !ctx.pipeline.classifier().needs_gradient() &&
+                                     (rows_ || ctx.pipeline.preclassified());
+    weak_ = !smooth_between_cuts;
     if ((r.projection == Projection::Mip || r.projection == Projection::Minip) &&
         !(cartesian_ && (cubic_ || cartesian_->interpolation() == Interpolation::Nearest)))
         throw Error("render.integrator: \"adaptive\" mip/minip needs a Cartesian grid with trilinear or nearest "
@@ -70,11 +78,12 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
         const std::int64_t n = segment_count(iv, ctx_.step);
         out.push_back(iv.t0);
         for (std::int64_t k = 0; k < n; ++k) out.push_back(segment(iv, ctx_.step, k, n).t1);
-        return;
+    } else {
+        grid_cuts(ray, iv.t0, iv.t1, cartesian_->volume(), cut_offset_, out);
     }
-    const Volume& v = cartesian_->volume();
-    grid_cuts(ray, iv.t0, iv.t1, v, cut_offset_, out);
     if (!rows_ || row_values_.empty()) return;
+    if (!cubic_) return sampled_row_cuts(ray, out);
+    const Volume& v = cartesian_->volume();
     // Rows: the roots of s(f(t)) = x_k inside each cell, s the transfer function's coordinate.
     std::vector<double> all;
     all.reserve(out.size() * 2);
@@ -113,6 +122,41 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
     out.swap(all);
 }
 
+void AdaptiveIntegrator::sampled_row_cuts(const Ray& ray, std::vector<double>& out) const {
+    // Not a cubic (tricubic: degree 9 per cell; beam space): the coordinate s(t) at
+    // kAdaptiveRowSamples + 1 equally spaced points of each piece; a row value strictly between two
+    // consecutive samples' s (or equal to the later one) is a crossing, bisected on the sampler to
+    // rounding. Crossings that come and go between two samples are left to the quadrature.
+    const int n = conventions::kAdaptiveRowSamples;
+    auto s = [&](double t) { return rows_->coordinate(ctx_.field(ray, t)); };
+    std::vector<double> all;
+    all.reserve(out.size() * 2);
+    for (std::size_t p = 0; p + 1 < out.size(); ++p) {
+        const double ta = out[p], tb = out[p + 1];
+        all.push_back(ta);
+        double xa = ta, va = s(ta);
+        for (int k = 1; k <= n; ++k) {
+            const double xb = k == n ? tb : ta + (tb - ta) * double(k) / double(n), vb = s(xb);
+            if (std::isfinite(va) && std::isfinite(vb) && va != vb) {
+                const double lo = std::min(va, vb), hi = std::max(va, vb);
+                const std::size_t first = all.size();
+                for (auto it = std::upper_bound(row_values_.begin(), row_values_.end(), lo);
+                     it != row_values_.end() && *it < hi; ++it) {
+                    const double x = *it;
+                    const double t = bisect_to_rounding([&](double y) { return s(y) - x; }, xa, xb, va < x ? -1 : 1);
+                    if (t > ta && t < tb) all.push_back(t);
+                }
+                std::sort(all.begin() + std::ptrdiff_t(first), all.end());
+            }
+            xa = xb;
+            va = vb;
+        }
+    }
+    all.push_back(out.back());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    out.swap(all);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Composite
 // ---------------------------------------------------------------------------------------------
@@ -130,6 +174,7 @@ struct CompositeState {
     const Ray* ray;
     double l;          // opacity_unit_distance
     double tolerance;  // render.tolerance
+    double safety;     // 1, or kAdaptiveWeakSafety where kinks inside pieces are not located
     double total;      // length of all intervals
     CompensatedSum tau;
     CompensatedSum C[3];
@@ -149,62 +194,87 @@ struct CompositeState {
         c = p.color;
     }
 
-    void leaf(double a, double b, int depth) {
+    // One G7/K15 evaluation of [a, b]: the emission E (relative to T(a)) and Delta tau by both rules.
+    struct Rule {
+        glm::dvec3 ek{0.0}, eg{0.0};
+        double tk = 0.0, tg = 0.0;
+        double em_error() const { return max_abs(ek - eg); }
+        double tau_error() const { return std::fabs(tk - tg); }
+    };
+    Rule evaluate(double a, double b) {
         const gk::Tables& g = gk::tables();
         const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
         double sigma[gk::kNodes];
         glm::dvec3 c[gk::kNodes];
-        double cmax = 0.0;
         for (int i = 0; i < gk::kNodes; ++i) {
             sample(mid + half * g.x[std::size_t(i)], sigma[i], c[i]);
-            cmax = std::max(cmax, max_abs(c[i]));
+            colour_bound = std::max(colour_bound, max_abs(c[i]));
         }
-        colour_bound = std::max(colour_bound, cmax);
-        double dtau_k = 0.0, dtau_g = 0.0;
-        glm::dvec3 ek(0.0), eg(0.0);
+        Rule r;
         for (int i = 0; i < gk::kNodes; ++i) {
-            dtau_k += g.wk[std::size_t(i)] * sigma[i];
+            r.tk += g.wk[std::size_t(i)] * sigma[i];
             if (sigma[i] == 0.0) continue;
             double tau_i = 0.0;
             for (int j = 0; j < gk::kNodes; ++j) tau_i += g.sk[std::size_t(i)][std::size_t(j)] * sigma[j];
-            ek += (g.wk[std::size_t(i)] * sigma[i] * std::exp(-half * tau_i)) * c[i];
+            r.ek += (g.wk[std::size_t(i)] * sigma[i] * std::exp(-half * tau_i)) * c[i];
         }
         for (int q = 0; q < gk::kGaussNodes; ++q) {
             const int i = 2 * q + 1;
-            dtau_g += g.wg[std::size_t(q)] * sigma[i];
+            r.tg += g.wg[std::size_t(q)] * sigma[i];
             if (sigma[i] == 0.0) continue;
             double tau_q = 0.0;
             for (int j = 0; j < gk::kGaussNodes; ++j) tau_q += g.sg[std::size_t(q)][std::size_t(j)] * sigma[2 * j + 1];
-            eg += (g.wg[std::size_t(q)] * sigma[i] * std::exp(-half * tau_q)) * c[i];
+            r.eg += (g.wg[std::size_t(q)] * sigma[i] * std::exp(-half * tau_q)) * c[i];
         }
-        dtau_k *= half;
-        dtau_g *= half;
-        ek *= half;
-        eg *= half;
-        const double T = std::exp(-tau.value());
-        const double e_e = max_abs(ek - eg), e_t = std::fabs(dtau_k - dtau_g);
-        const double estimate = T * (e_e + colour_bound * e_t);
-        const double budget = tolerance * (b - a) / total;
-        const double roundoff = conventions::kAdaptiveRoundoffRelative * T * (max_abs(ek) + colour_bound * dtau_k);
+        r.tk *= half;
+        r.tg *= half;
+        r.ek *= half;
+        r.eg *= half;
+        return r;
+    }
+
+    // [a, b] with its rule P already evaluated: its halves L and R are evaluated; the pair is accepted
+    // when the estimate  e = |P - (L + R)| + |K15 - G7|_L + |K15 - G7|_R  (emission with R behind L:
+    // E = E_L + exp(-Delta tau_L) E_R; and optical depth) fits the budget; otherwise each half goes on.
+    // Comparing a rule with its halves catches what both rules of one evaluation miss together (a
+    // narrow feature between nodes, an unlocated kink).
+    void process(double a, double b, int depth, const Rule& P) {
         const double m = 0.5 * (a + b);
-        const bool splittable = m > a && m < b && depth < conventions::kAdaptiveMaxDepth;
-        if (estimate <= budget || estimate <= roundoff || !splittable) {
-            const glm::dvec3 contribution = T * ek;
-            for (int ch = 0; ch < 3; ++ch) C[ch].add(contribution[ch]);
-            tau.add(dtau_k);
-            leaves.push_back({contribution, T * e_e, e_t});
+        const double T = std::exp(-tau.value());
+        if (!(m > a && m < b) || depth >= conventions::kAdaptiveMaxDepth) {
+            commit(T, P.ek, P.tk, 0.0, safety * P.em_error(), safety * P.tau_error());
             return;
         }
-        leaf(a, m, depth + 1);
-        leaf(m, b, depth + 1);
+        const Rule L = evaluate(a, m), R = evaluate(m, b);
+        const glm::dvec3 E = L.ek + std::exp(-L.tk) * R.ek;
+        const double e_e = safety * (max_abs(P.ek - E) + L.em_error() + R.em_error());
+        const double e_t = safety * (std::fabs(P.tk - (L.tk + R.tk)) + L.tau_error() + R.tau_error());
+        const double estimate = T * (e_e + colour_bound * e_t);
+        const double budget = tolerance * (b - a) / total;
+        const double roundoff = conventions::kAdaptiveRoundoffRelative * T * (max_abs(E) + colour_bound * (L.tk + R.tk));
+        if (estimate <= budget || estimate <= roundoff) {
+            commit(T, E, L.tk, R.tk, e_e, e_t);
+            return;
+        }
+        process(a, m, depth + 1, L);
+        process(m, b, depth + 1, R);
     }
+    void commit(double T, const glm::dvec3& E, double dtau0, double dtau1, double e_e, double e_t) {
+        const glm::dvec3 contribution = T * E;
+        for (int ch = 0; ch < 3; ++ch) C[ch].add(contribution[ch]);
+        tau.add(dtau0);
+        tau.add(dtau1);
+        leaves.push_back({contribution, T * e_e, e_t});
+    }
+    void integrate(double a, double b) { process(a, b, 0, evaluate(a, b)); }
 };
 
 }  // namespace
 
 PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals) const {
     PixelValue out;
-    CompositeState st{&ctx_.pipeline, &ray, ctx_.pipeline.classifier().unit_distance(), ctx_.render.tolerance, 0.0, {}, {}, 1.0, {}};
+    CompositeState st{&ctx_.pipeline, &ray, ctx_.pipeline.classifier().unit_distance(), ctx_.render.tolerance,
+                      weak_ ? conventions::kAdaptiveWeakSafety : 1.0, 0.0, {}, {}, 1.0, {}};
     for (const Interval& iv : intervals) st.total += iv.length();
     if (!(st.total > 0.0)) return out;
     bool opaque = false;
@@ -223,7 +293,7 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
                 opaque = true;
                 break;
             }
-            st.leaf(a, b, 0);
+            st.integrate(a, b);
         }
         if (opaque) break;
     }
@@ -251,6 +321,7 @@ struct LineState {
     const SamplePipeline* pipeline;
     const Ray* ray;
     double budget_per_length;  // accepted error of the integral per unit length
+    double safety;             // as CompositeState::safety
     CompensatedSum integral;
     double error = 0.0;
 
@@ -260,28 +331,43 @@ struct LineState {
         const double x = pipeline->classifier().coordinate(v);
         return std::isfinite(x) ? x : 0.0;
     }
-    void leaf(double a, double b, int depth) {
-        const gk::Tables& g = gk::tables();
+    struct Rule {
+        double k = 0.0, g = 0.0;
+    };
+    Rule evaluate(double a, double b) const {
+        const gk::Tables& t = gk::tables();
         const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
-        double k = 0.0, q = 0.0;
+        Rule r;
         for (int i = 0; i < gk::kNodes; ++i) {
-            const double f = s(mid + half * g.x[std::size_t(i)]);
-            k += g.wk[std::size_t(i)] * f;
-            if (i % 2 == 1) q += g.wg[std::size_t(i / 2)] * f;
+            const double f = s(mid + half * t.x[std::size_t(i)]);
+            r.k += t.wk[std::size_t(i)] * f;
+            if (i % 2 == 1) r.g += t.wg[std::size_t(i / 2)] * f;
         }
-        k *= half;
-        q *= half;
-        const double e = std::fabs(k - q);
+        r.k *= half;
+        r.g *= half;
+        return r;
+    }
+    // As CompositeState::process: a rule against its halves.
+    void process(double a, double b, int depth, const Rule& P) {
         const double m = 0.5 * (a + b);
-        const bool splittable = m > a && m < b && depth < conventions::kAdaptiveMaxDepth;
-        if (e <= budget_per_length * (b - a) || e <= conventions::kAdaptiveRoundoffRelative * std::fabs(k) || !splittable) {
-            integral.add(k);
+        if (!(m > a && m < b) || depth >= conventions::kAdaptiveMaxDepth) {
+            integral.add(P.k);
+            error += safety * std::fabs(P.k - P.g);
+            return;
+        }
+        const Rule L = evaluate(a, m), R = evaluate(m, b);
+        const double sum = L.k + R.k;
+        const double e = safety * (std::fabs(P.k - sum) + std::fabs(L.k - L.g) + std::fabs(R.k - R.g));
+        if (e <= budget_per_length * (b - a) || e <= conventions::kAdaptiveRoundoffRelative * std::fabs(sum)) {
+            integral.add(L.k);
+            integral.add(R.k);
             error += e;
             return;
         }
-        leaf(a, m, depth + 1);
-        leaf(m, b, depth + 1);
+        process(a, m, depth + 1, L);
+        process(m, b, depth + 1, R);
     }
+    void integrate(double a, double b) { process(a, b, 0, evaluate(a, b)); }
 };
 
 }  // namespace
@@ -296,12 +382,12 @@ PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<I
     const double tol = ctx_.render.tolerance;
     // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
     const double per_length = mean ? tol : (L > 0.0 ? tol / (ctx_.render.gain * L) : 0.0);
-    LineState st{&ctx_.pipeline, &ray, per_length, {}, 0.0};
+    LineState st{&ctx_.pipeline, &ray, per_length, cubic_ ? 1.0 : conventions::kAdaptiveWeakSafety, {}, 0.0};
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
         cuts(ray, iv, cut);
         for (std::size_t p = 0; p + 1 < cut.size(); ++p)
-            if (cut[p + 1] > cut[p]) st.leaf(cut[p], cut[p + 1], 0);
+            if (cut[p + 1] > cut[p]) st.integrate(cut[p], cut[p + 1]);
     }
     const double g = mean ? (L > 0.0 ? st.integral.value() / L : 0.0) : ctx_.render.gain * st.integral.value();
     out.rgba = glm::dvec4(g, g, g, 1.0);

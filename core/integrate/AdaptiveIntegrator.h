@@ -11,11 +11,13 @@
 //     bisected to rounding). Between cuts the value and the transfer function are then smooth, and so
 //     is the integrand unless shading (max(N.L, 0) has kinks), gradient opacity (rows of |grad f|) or
 //     Levoy's classification (tents) add kinks inside: those are found only by bisection.
-//   Cartesian tricubic: the cell faces (the kernels' knots); rows of the transfer function by bisection.
+//   Cartesian tricubic: the cell faces (the kernels' knots), and the rows' crossings found by sampling
+//     each piece at kAdaptiveRowSamples + 1 points (a sign change of s - x_k, bisected to rounding).
 //   Cartesian nearest: the faces of the nearest-neighbour regions (u = i + 1/2): the value is constant
 //     between them.
-//   Beam-space grids (shells): the fixed integrator's segment ends (render.step); coordinate surfaces and
-//     rows are found only by bisection (a weaker guarantee, docs/accuracy.md).
+//   Beam-space grids (shells): the fixed integrator's segment ends (render.step), and the rows' crossings
+//     found by sampling as for tricubic; coordinate surfaces are not located (a weaker guarantee,
+//     docs/accuracy.md).
 //
 // Composite (emission-absorption, conventions section 3 in continuous form): with
 // sigma(t) = -log1p(-a(t)) / l, T(t) = exp(-tau(t)), tau(t) = integral of sigma up to t,
@@ -66,12 +68,15 @@ private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;
+    // The rows' crossings inside each piece of `out` where the field is not a cubic, found by sampling.
+    void sampled_row_cuts(const Ray& ray, std::vector<double>& out) const;
 
     const VolumeSampler* cartesian_ = nullptr;
     double cut_offset_ = 0.0;             // 0: cell faces; 0.5: nearest regions
     bool cut_cells_ = false;              // Cartesian: cut at grid planes
     bool cubic_ = false;                  // Cartesian trilinear: cubic per cell
-    const TransferFunction* rows_ = nullptr;  // post-classified transfer function: cut at its rows
+    bool weak_ = false;                   // composite: kinks inside pieces (kAdaptiveWeakSafety applies)
+    const TransferFunction* rows_ = nullptr;  // post-classified transfer function (not nearest): cut at its rows
     std::vector<double> row_values_;      // its distinct row values (the function's coordinate), sorted
 };
 

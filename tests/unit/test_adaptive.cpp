@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <vector>
 
 #include "TestScenes.h"
@@ -13,9 +14,11 @@
 #include "core/integrate/CellCubic.h"
 #include "core/render/PreparedScene.h"
 #include "core/sample/Trilinear.h"
+#include "core/scene/SceneLoader.h"
 
 using namespace volref;
 using namespace volref::test;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -453,4 +456,63 @@ TEST(Adaptive, FixedStepConvergesToAdaptive) {
     EXPECT_GT(order, 1.6);
     EXPECT_LT(order, 2.6);
     EXPECT_LT(e.back(), 1e-8);
+}
+
+// The cases with the weaker guarantee (docs/accuracy.md): shading, Levoy's classification, tricubic
+// and nearest reconstruction, pre-classification, a beam-space grid. Each reference scene at 16 x 16:
+// the adaptive image at tolerance 1e-5 is within its error channel of the adaptive image at 1e-9 on
+// all but at most 2 pixels (a heuristic bound there), the channel is at most the tolerance (plus the
+// fine run's own estimate), and the fixed
+// step converges to it (halving the step from 1/8 to 1/16 voxel shrinks the largest difference; by
+// about 4 where the integrand is continuous, 2 with nearest's jumps).
+TEST(Adaptive, WeakerGuaranteeScenesStayWithinTheirEstimate) {
+    struct Case {
+        const char* scene;
+        std::vector<std::string> sets;
+    };
+    const std::vector<Case> cases{
+        {"shaded-composite.json", {}},
+        {"levoy-isosurfaces.json", {}},
+        {"radar-sweep.json", {}},
+        {"default.json", {"volume.interpolation=tricubic-bspline"}},
+        {"default.json", {"volume.interpolation=nearest"}},
+        {"default.json", {"volume.classify=pre"}},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::string> sets = c.sets;
+        for (const char* s : {"image.width=16", "image.height=16", "render.integrator=adaptive"}) sets.push_back(s);
+        sets.push_back("render.tolerance=1e-9");
+        Scene s = load_scene(fs::path(VOLREF_SOURCE_DIR) / "reference_scenes" / c.scene, sets);
+        const Image fine = render_scene(s, {2, false});
+        s.render.tolerance = 1e-5;
+        const Image coarse = render_scene(s, {2, false});
+        s.render.integrator = IntegrationMethod::Fixed;
+        s.render.step = 1.0 / 8.0;
+        const Image fixed8 = render_scene(s, {2, false});
+        s.render.step = 1.0 / 16.0;
+        const Image fixed = render_scene(s, {2, false});
+        const std::size_t e = channel(coarse, "error");
+        ASSERT_LT(e, coarse.channels.size());
+        double worst = 0.0, worst_fixed = 0.0, worst_fixed8 = 0.0, max_est = 0.0;
+        int under = 0;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) {
+                const double measured = pixel_diff(coarse, fine, x, y);
+                // The weaker guarantee: a heuristic bound (kAdaptiveWeakSafety); counted, not required.
+                if (coarse.at(x, y, e) + fine.at(x, y, e) < measured) {
+                    ++under;
+                    std::printf("  %s pixel %d,%d: estimate %.3e < measured %.3e\n", c.scene, x, y,
+                                coarse.at(x, y, e) + fine.at(x, y, e), measured);
+                }
+                EXPECT_LE(coarse.at(x, y, e), 1e-5 + fine.at(x, y, e)) << c.scene << " " << x << "," << y;
+                worst = std::max(worst, measured);
+                worst_fixed = std::max(worst_fixed, pixel_diff(fixed, fine, x, y));
+                worst_fixed8 = std::max(worst_fixed8, pixel_diff(fixed8, fine, x, y));
+                max_est = std::max(max_est, coarse.at(x, y, e));
+            }
+        std::printf("%s %s: |tol 1e-5 - tol 1e-9| %.2e (estimate up to %.2e), |fixed - adaptive| %.2e (1/8), %.2e (1/16)\n",
+                    c.scene, c.sets.empty() ? "" : c.sets[0].c_str(), worst, max_est, worst_fixed8, worst_fixed);
+        EXPECT_LT(worst_fixed, 0.6 * worst_fixed8) << c.scene;  // the fixed step converges to it
+        EXPECT_LE(under, 2) << c.scene;  // of 256 pixels (measured: 1 in shaded-composite, by 1.2 x; 0 elsewhere)
+    }
 }

@@ -129,6 +129,11 @@ EOF
 example explain opacity-correction --opacity 0.5 --unit-distance 1 --length 0.5
 example explain opacity-correction --opacity 1e-10 --length 0.001
 text <<'EOF'
+The same with `--json`, for programs:
+
+EOF
+example explain opacity-correction --opacity 0.5 --length 0.5 --json
+text <<'EOF'
 ## classify-isovalue
 
 Levoy's isovalue contours (conventions section 7): each contour `fv,av,r` (isovalue, opacity,

@@ -90,6 +90,26 @@ TEST(Trace, LastRowIsTheRenderedPixelComposite) {
             }
 }
 
+// Pre-classification, tricubic reconstruction and early termination go through the same loop.
+TEST(Trace, LastRowIsTheRenderedPixelForOtherPipelines) {
+    Scene pre = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, true);
+    pre.volume.classify = VolumeSpec::Classify::Pre;
+    expect_last_row_is_pixel(pre, true, 8, 8);
+    Scene cubic = blob_scene(Projection::Composite, CompositeOrder::BackToFront, true);
+    cubic.volume.interpolation = Interpolation::TricubicCatmullRom;
+    expect_last_row_is_pixel(cubic, true, 7, 8);
+    Scene early = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, false);
+    early.render.early_termination = 0.3;
+    early.volume.transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {1.0, 1.0}};
+    expect_last_row_is_pixel(early, true, 8, 8);
+    const PreparedScene p(early, {});
+    const explain::PixelTrace t = explain::trace_pixel(p, 8, 8);
+    // the loop stopped after the first sample where A exceeds 0.3: the rows end there
+    EXPECT_GT(t.samples.back().record.accumulated.a, 0.3);
+    EXPECT_LE(t.samples[t.samples.size() - 2].record.accumulated.a, 0.3);
+    EXPECT_LT(t.samples.back().record.t1, t.intervals.back().t1);
+}
+
 TEST(Trace, SkippingLeavesOutOnlyTransparentSamples) {
     const Scene s = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, false);
     RenderOptions on, off;

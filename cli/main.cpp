@@ -162,7 +162,9 @@ int main(int argc, char** argv) {
             // compare's exit status 1 means "differs": bad input exits 2 (docs/compare.md).
             try {
                 return volref::cli::run_compare(compare);
-            } catch (const volref::Error& e) {
+            } catch (const volref::Cancelled&) {
+                throw;
+            } catch (const std::exception& e) {
                 std::fprintf(stderr, "volref: error: %s\n", e.what());
                 return 2;
             }

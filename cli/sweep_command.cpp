@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "cli/SweepCommand.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/compare/ChildProcess.h"
 #include "core/compare/CompareConstants.h"
@@ -148,7 +149,7 @@ int run_sweep(const SweepArgs& args) {
         adaptive ? std::string("render.integrator=adaptive")
                  : std::string(kStepPath) + "=" + fmt("%.17g", min_step / kFineReferenceDivisor);
     const std::string reference_text =
-        adaptive ? std::string("adaptive (render.integrator=adaptive at the scene's render.tolerance)")
+        adaptive ? "adaptive (render.integrator=adaptive, render.tolerance = " + fmt("%g", base.render.tolerance) + ")"
                  : "fine (" + std::string(kStepPath) + " = " + fmt("%g", min_step / kFineReferenceDivisor) +
                        ", the smallest swept step / " + fmt("%g", kFineReferenceDivisor) + ")";
 
@@ -175,7 +176,9 @@ int run_sweep(const SweepArgs& args) {
         std::vector<std::string> argv{exe, "render", args.scene.string(), "-o", out.string()};
         if (args.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(args.threads)});
         for (const std::string& s : sets) argv.insert(argv.end(), {"--set", s});
+        throw_if_cancelled();
         const ProcessRun run = run_process(argv, work.path / "render.err");
+        throw_if_cancelled();  // Ctrl-C reaches the child too: report the interruption, not its failure
         if (run.status != 0) throw Error("sweep: rendering " + what + " failed: " + run.first_error);
         return run.seconds;
     };

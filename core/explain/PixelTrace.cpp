@@ -26,13 +26,21 @@ GridLocation locate(const PreparedScene& scene, const glm::dvec3& position) {
     } else if (scene.model.shell_grid) {
         const ShellGrid& grid = *scene.model.shell_grid;
         g.index = grid.continuous_index(position);
+        // The cell and fraction of ShellSampler's trilinear reconstruction (docs/shells.md section 3):
+        // non-periodic axes clamp u to [0, n - 1] and take i = min(floor(u), n - 2) (0 when n = 1);
+        // periodic axes take i = floor(u) in [0, n - 1] (the cell [n - 1, n) wraps to sample 0).
         for (int a = 0; a < 3; ++a) {
             const std::int64_t n = grid.dims()[std::size_t(a)];
-            const double u = g.index[a];
-            std::int64_t i = std::isfinite(u) ? std::int64_t(std::floor(u)) : 0;
-            i = std::clamp<std::int64_t>(i, 0, std::max<std::int64_t>(0, n - 2));
+            double u = std::isfinite(g.index[a]) ? g.index[a] : 0.0;
+            std::int64_t i = 0;
+            if (grid.axis(a).periodic) {
+                i = std::clamp<std::int64_t>(std::int64_t(std::floor(u)), 0, n - 1);
+            } else if (n > 1) {
+                u = std::clamp(u, 0.0, double(n - 1));
+                i = std::min<std::int64_t>(std::int64_t(std::floor(u)), n - 2);
+            }
             g.cell[std::size_t(a)] = i;
-            g.local[a] = u - double(i);
+            g.local[a] = n == 1 && !grid.axis(a).periodic ? 0.0 : u - double(i);
         }
     }
     return g;

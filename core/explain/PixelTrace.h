@@ -5,8 +5,8 @@
 // PreparedScene::render_pixel gives, bit for bit (and the rendered image's pixel, up to the SIMD
 // path's documented rounding). Each sample is also located on the grid: the continuous index u of its
 // position and the cell and local coordinates that reconstruction uses (VolumeSampler::locate on a
-// Cartesian grid; on a beam-space grid the index of ShellGrid::continuous_index, cell floor(u)
-// clamped to [0, n - 2], local u - cell).
+// Cartesian grid; on a beam-space grid the index of ShellGrid::continuous_index and the cell and
+// fraction of ShellSampler's trilinear reconstruction, docs/shells.md section 3).
 #pragma once
 #include <array>
 #include <cstdint>

@@ -347,3 +347,37 @@ TEST(Trace, CommandLineErrorsAreOneLine) {
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.err.rfind("volref: error: --format:", 0), 0u) << r.err;
 }
+
+// On a beam-space grid the grid columns are the shell's: a full-turn cylinder r in [0, 10] (11 samples,
+// u0 = r), theta in [0, 360) (36 samples, periodic, u1 = theta / 10), h in [0, 3] (4 samples, u2 = h);
+// the cell is min(floor(u), n - 2) on r and h and floor(u) on the periodic angle (cell 35 runs over the
+// seam back to sample 0), the local coordinates u - cell.
+TEST(Trace, GridColumnsOnACylindricalShell) {
+    Scene s = test::field_scene(test::constant_field(1.0, {11, 36, 4}));
+    s.volume.origin.reset();
+    s.volume.spacing.reset();
+    s.volume.bounds.type = BoundsSpec::Type::Cylindrical;
+    s.volume.bounds.cylinder.r1 = 10.0;
+    s.volume.bounds.cylinder.h1 = 3.0;
+    s.volume.transfer.opacity = {{0.0, 0.05}};
+    s.image.width = s.image.height = 16;
+    const PreparedScene p(s, {});
+    for (const auto& px : {std::array<int, 2>{5, 8}, std::array<int, 2>{11, 7}}) {
+        const explain::PixelTrace t = explain::trace_pixel(p, px[0], px[1]);
+        ASSERT_FALSE(t.samples.empty());
+        for (const explain::TracedSample& row : t.samples) {
+            const glm::dvec3 x = row.record.sample.position;
+            const double r = std::hypot(x.x, x.z);
+            double theta = std::atan2(-x.z, x.x) * 180.0 / M_PI;
+            if (theta < 0.0) theta += 360.0;
+            EXPECT_NEAR(row.grid.index[0], r, 1e-9);
+            EXPECT_NEAR(row.grid.index[1], theta / 10.0, 1e-9);
+            EXPECT_NEAR(row.grid.index[2], x.y, 1e-9);
+            EXPECT_EQ(row.grid.cell[0], std::min<std::int64_t>(9, std::int64_t(std::floor(row.grid.index[0]))));
+            EXPECT_EQ(row.grid.cell[1], std::int64_t(std::floor(row.grid.index[1])));
+            EXPECT_EQ(row.grid.cell[2], std::min<std::int64_t>(2, std::int64_t(std::floor(row.grid.index[2]))));
+            for (int a = 0; a < 3; ++a)
+                EXPECT_NEAR(row.grid.local[a], row.grid.index[a] - double(row.grid.cell[std::size_t(a)]), 1e-12);
+        }
+    }
+}

@@ -60,12 +60,12 @@ inline constexpr int kTileSize = 16;
 // ---- Adaptive integration (render.integrator "adaptive"; core/integrate/Adaptive*.h, docs/accuracy.md) ----
 // The default render.tolerance: absolute error per channel (R, G, B, A) of a pixel.
 inline constexpr double kAdaptiveDefaultTolerance = 1e-6;
-// Each smooth piece is integrated by Gauss-Kronrod G7/K15 with recursive bisection; a leaf [a, b] is
-// accepted when its error estimate e (|K15 - G7| of the emission plus the colour bound times
-// |K15 - G7| of the optical depth, times the transmittance in front) is at most
+// Each smooth piece is integrated by Gauss-Kronrod G7/K15 with recursive bisection; the halves of
+// [a, b] are accepted when their error estimate e (below, kAdaptiveWeakSafety: emission error plus the
+// colour bound times the optical depth's error, times the transmittance in front) is at most
 //   tolerance * (b - a) / (total length of the ray's intervals)   (the budget is shared by length),
 // or at most kAdaptiveRoundoffRelative * |K15| (the estimate is then rounding, QUADPACK's test), or
-// when the leaf is kAdaptiveMaxDepth bisections deep (its estimate is still reported: 2^-48 of a
+// when they are kAdaptiveMaxDepth bisections deep (the estimate is still reported: 2^-48 of a
 // piece is below any length the double t of a ray resolves for pieces up to 2^48 ulps long).
 inline constexpr int kAdaptiveMaxDepth = 48;
 inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16;  // 50 eps

@@ -254,6 +254,30 @@ TEST_F(SweepCli, CsvErrorsMatchRendersMeasuredHere) {
     EXPECT_GT(over, 0);  // the tolerance matters in this test
 }
 
+// Without --reference, a volref that has the adaptive integrator measures against it: the CSV's max abs is
+// the one measured here against `volref render --set render.integrator=adaptive`.
+TEST_F(SweepCli, DefaultReferenceIsTheAdaptiveIntegrator) {
+    const std::string set = " --set image.width=8 --set image.height=8";
+    const CmdResult r = run("sweep " + scene() + " --param render.step=0.5 --repeat 1 -o " + dir_.string() + set);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("reference: adaptive (render.integrator=adaptive, render.tolerance = 1e-06)"),
+              std::string::npos)
+        << r.out;
+    ASSERT_EQ(run("render " + scene() + " -o " + (dir_ / "h.exr").string() + set + " --set render.step=0.5").status, 0);
+    ASSERT_EQ(run("render " + scene() + " -o " + (dir_ / "ref.exr").string() + set +
+                  " --set render.integrator=adaptive")
+                  .status,
+              0);
+    const std::vector<double> a = read_rgba(dir_ / "h.exr"), b = read_rgba(dir_ / "ref.exr");
+    ASSERT_EQ(a.size(), b.size());
+    double max_abs = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) max_abs = std::max(max_abs, std::abs(a[i] - b[i]));
+    const auto f = split(split(slurp(dir_ / "sweep.csv"), '\n').at(1), ',');
+    ASSERT_EQ(f.size(), 10u);
+    EXPECT_GT(max_abs, 1e-6);
+    EXPECT_NEAR(std::stod(f[4]), max_abs, 1e-8 * max_abs);
+}
+
 TEST_F(SweepCli, BadParamsAreNamedAndWriteNothing) {
     auto expect_error = [&](const std::string& args, const std::string& needle) {
         const CmdResult r = run("sweep " + scene() + " " + args + " -o " + dir_.string());

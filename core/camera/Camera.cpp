@@ -51,8 +51,8 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
 }
 
 Ray Camera::ray(double fx, double fy) const {
-    const double nx = 2.0 * fx / double(width_) - 1.0;
-    const double ny = 1.0 - 2.0 * fy / double(height_);
+    const glm::dvec2 device = ndc(fx, fy);
+    const double nx = device.x, ny = device.y;
     Ray r;
     switch (kind_) {
         case Kind::Perspective:

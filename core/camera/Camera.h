@@ -18,6 +18,7 @@
 // Rays are integrated for t >= 0 only (there is no near plane).
 #pragma once
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/camera/Ray.h"
@@ -34,6 +35,10 @@ public:
     // The ray through film point (fx, fy) (pixel centres at integer + 0.5).
     Ray ray(double fx, double fy) const;
     Ray pixel_ray(int x, int y) const;
+    // The normalised device coordinates (nx, ny) of film point (fx, fy) that ray() uses.
+    glm::dvec2 ndc(double fx, double fy) const {
+        return {2.0 * fx / double(width_) - 1.0, 1.0 - 2.0 * fy / double(height_)};
+    }
 
 private:
     enum class Kind { Perspective, Orthographic, Matrices } kind_;

@@ -35,8 +35,8 @@ Explanation ray(const PreparedScene& scene, int x, int y) {
     add(cam, "image", {double(s.image.width), double(s.image.height)}, "W, H");
     add(cam, "pixel", {double(x), double(y)}, "x right, y down from the top-left corner");
     add(cam, "film point", {x + 0.5, y + 0.5}, "the pixel's centre");
-    add(cam, "(nx, ny)", {2.0 * (x + 0.5) / s.image.width - 1.0, 1.0 - 2.0 * (y + 0.5) / s.image.height},
-        "(2 (x + 0.5) / W - 1, 1 - 2 (y + 0.5) / H)");
+    const glm::dvec2 n = scene.camera->ndc(x + 0.5, y + 0.5);
+    add(cam, "(nx, ny)", {n.x, n.y}, "(2 (x + 0.5) / W - 1, 1 - 2 (y + 0.5) / H)");
     add(cam, "origin", v3(t.ray.origin), "the eye (perspective) or a point of the eye's plane");
     add(cam, "direction", v3(t.ray.direction), "unit length");
 

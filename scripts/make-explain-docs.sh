@@ -37,7 +37,7 @@ shares that engine). `--json` prints the same numbers for programs.
 - **Options** are `--name VALUE`; lists are comma-separated without spaces (`--point 0.2,0.3,0.8`);
   `--samples`, `--contour`, `--region`, `--light` take several values or may be repeated. A bad value
   is one line on stderr naming the option (`volref: error: --point: each of p, q, r must be in [0, 1],
-  got 2.000000`) and exit status 1.
+  got 2`) and exit status 1.
 - **JSON**: `{"topic": T, "sections": [{"title": ..., "steps": {NAME: VALUE}, "formulas": {NAME: TEXT},
   "columns": [...], "rows": [{COLUMN: VALUE}], "notes": [...]}]}`; a vector value is an array. The
   keys are the names printed in the text output.

@@ -6,6 +6,7 @@
 
 #include "core/Error.h"
 #include "core/explain/Explain.h"
+#include "core/explain/NumberFormat.h"
 #include "core/sample/Trilinear.h"
 #include "core/sample/VolumeSampler.h"
 
@@ -61,7 +62,7 @@ void add_steps(Explanation& e, const std::array<double, 8>& f, const glm::dvec3&
 Explanation trilinear(const std::array<double, 8>& corners, const glm::dvec3& pqr) {
     for (int a = 0; a < 3; ++a)
         if (!(pqr[a] >= 0.0 && pqr[a] <= 1.0))
-            throw Error("--point: each of p, q, r must be in [0, 1], got " + std::to_string(pqr[a]));
+            throw Error("--point: each of p, q, r must be in [0, 1], got " + number(pqr[a]));
     Explanation e;
     e.topic = "trilinear";
     add_steps(e, corners, pqr);

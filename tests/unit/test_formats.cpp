@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
+#include "core/io/VolumeInfo.h"
 #include "core/io/VolumeReader.h"
 
 namespace {
@@ -373,6 +374,14 @@ TEST_F(Formats, MetaImageCompressedFloat) {
     EXPECT_EQ(v.at(0, 1, 2), 7.0);
 }
 
+// HeaderSize = -1: the samples end the data file, whatever precedes them.
+TEST_F(Formats, MetaImageHeaderSizeMinusOne) {
+    write("t.raw", std::string("anything at all") + char(1) + char(2) + char(3));
+    const Volume v = volref::read_volume(
+        write("t.mhd", "NDims = 1\nDimSize = 3\nElementType = MET_CHAR\nHeaderSize = -1\nElementDataFile = t.raw\n"));
+    EXPECT_EQ(v.values, (std::vector<double>{1, 2, 3}));
+}
+
 TEST_F(Formats, MetaImageErrors) {
     const std::string head = "NDims = 3\nDimSize = 2 2 1\n";
     EXPECT_THAT(read_error(write("a.mha", head + "ElementType = MET_LONG_LONG\nElementDataFile = LOCAL\n" + std::string(32, 'x'))),
@@ -636,6 +645,24 @@ TEST_F(Formats, DenErrors) {
                 HasSubstr("map_len[1] at byte 52 must be >= 1, got 0"));
     EXPECT_THAT(read_error(write("e.den", den_header({3, 2, 2}, 12, std::endian::little).substr(0, 40))),
                 HasSubstr("truncated header: expected 62 bytes, found 40"));
+}
+
+// volref info's summary: range over the finite values, NaN and infinities counted apart; with 4 bins
+// over [0, 4] of width 1, value v goes to bin floor(v), and the maximum 4 to the last bin.
+TEST(FormatsSummary, HistogramByHand) {
+    Volume v;
+    v.dims = {7, 1, 1};
+    v.values = {0, 1, 2, 3, std::nan(""), -INFINITY, 4};
+    const volref::VolumeSummary s = volref::summarize(v, 4);
+    EXPECT_EQ(s.voxels, 7u);
+    EXPECT_EQ(s.finite, 5u);
+    EXPECT_EQ(s.nan, 1u);
+    EXPECT_EQ(s.infinite, 1u);
+    EXPECT_EQ(s.min, 0.0);
+    EXPECT_EQ(s.max, 4.0);
+    EXPECT_EQ(s.histogram, (std::vector<std::uint64_t>{1, 1, 1, 2}));
+    v.values = {5, 5, 5, 5, 5, 5, 5};  // min == max: all in bin 0
+    EXPECT_EQ(volref::summarize(v, 3).histogram, (std::vector<std::uint64_t>{7, 0, 0}));
 }
 
 TEST_F(Formats, ExplicitFormatOverridesTheExtension) {

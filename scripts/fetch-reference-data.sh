@@ -33,7 +33,8 @@ declare -A sha256=(
 sudo=""
 [ "$(id -u)" -ne 0 ] && sudo="sudo"
 work=$(mktemp -d)
-chmod 755 "$work"  # apt-get download runs as _apt when it can: let it write here
+# (As root, apt-get download notes that it downloads unsandboxed: _apt cannot write to this private
+# folder. The note goes to $work/apt.log and is shown only if the download fails.)
 trap 'rm -rf "$work"' EXIT
 updated=0
 

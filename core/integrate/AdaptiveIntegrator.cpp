@@ -9,6 +9,7 @@
 #include "core/integrate/AdaptiveQuadrature.h"
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/Segments.h"
+#include "core/sample/MacrocellGrid.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/TransferFunction.h"
 
@@ -285,6 +286,10 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
         for (std::size_t p = 0; p + 1 < cut.size() && !opaque; ++p) {
             const double a = cut[p], b = cut[p + 1];
             if (!(b > a)) continue;
+            // Empty-space skipping: a piece lies in one cell (nearest: reads one voxel, a corner of the
+            // cell of its midpoint); in an empty macrocell every sample of it has opacity 0.
+            if (ctx_.macrocells && cut_cells_ && ctx_.macrocells->empty(ctx_.macrocells->macrocell_at(ray.at(0.5 * (a + b)))))
+                continue;
             const PipelineSample pm = ctx_.pipeline.sample(ray, 0.5 * (a + b), SamplePipeline::Use::Composite);
             if (pm.opacity >= 1.0 && std::isfinite(pm.value)) {  // opaque piece: the ray ends at a
                 const PipelineSample ps = ctx_.pipeline.sample(ray, a + 1e-9 * (b - a), SamplePipeline::Use::Composite);

@@ -22,10 +22,13 @@
 // Composite (emission-absorption, conventions section 3 in continuous form): with
 // sigma(t) = -log1p(-a(t)) / l, T(t) = exp(-tau(t)), tau(t) = integral of sigma up to t,
 //   C = integral c(t) sigma(t) T(t) dt,   A = 1 - T(end) = -expm1(-tau_total).
-// A leaf [a, b] gives Delta tau = integral of sigma (K15) and E = integral c sigma exp(-(tau(t) - tau(a)))
-// (K15, with tau(t) - tau(a) at the nodes from the integration matrix, AdaptiveQuadrature.h); then
-// C += T(a) E and tau += Delta tau, both compensated sums (never a product of transmittances). The same
-// with G7 gives the estimates e_E = max_ch |E_K15 - E_G7| and e_tau = |Delta tau_K15 - Delta tau_G7|.
+// A rule on [a, b] gives Delta tau = integral of sigma (K15) and E = integral c sigma exp(-(tau(t) - tau(a)))
+// (K15, with tau(t) - tau(a) at the nodes from the integration matrix, AdaptiveQuadrature.h), and the
+// same by G7. The halves L, R of [a, b] are accepted together when
+//   e = |P - (L + R)| + |K15 - G7|_L + |K15 - G7|_R   (E of L + R = E_L + exp(-Delta tau_L) E_R),
+// for the emission (e_E, max over channels) and the optical depth (e_tau), times kAdaptiveWeakSafety
+// where kinks lie inside pieces, fits T(a) (e_E + K e_tau) <= tolerance (b - a) / (ray length); then
+// C += T(a) E and tau += Delta tau, both compensated sums (never a product of transmittances).
 // A piece whose opacity is 1 at its midpoint is opaque: C += T c(start of the piece), A = 1, and the
 // ray ends. The order (front to back, back to front) does not apply.
 //

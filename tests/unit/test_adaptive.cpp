@@ -12,6 +12,7 @@
 #include "core/Error.h"
 #include "core/integrate/AdaptiveQuadrature.h"
 #include "core/integrate/CellCubic.h"
+#include "core/integrate/StepDoubling.h"
 #include "core/render/PreparedScene.h"
 #include "core/sample/Trilinear.h"
 #include "core/scene/SceneLoader.h"
@@ -515,4 +516,22 @@ TEST(Adaptive, WeakerGuaranteeScenesStayWithinTheirEstimate) {
         EXPECT_LT(worst_fixed, 0.6 * worst_fixed8) << c.scene;  // the fixed step converges to it
         EXPECT_LE(under, 2) << c.scene;  // of 144 pixels (measured at 16 x 16: 1 of 256 in shaded-composite, by 1.2 x)
     }
+}
+
+// The step-doubling estimate by hand: |I_h - I_{h/2}| = 0.003 on one channel of the centre pixel of a
+// 3 x 4 image (0 elsewhere): every pixel within one of it gets 5 * 4/3 * 0.003 = 0.02, the last column
+// (two away) 0; the coarse image's channels are kept.
+TEST(Adaptive, StepDoublingEstimateByHand) {
+    Image coarse(4, 3, {"R", "G", "B", "A", "Z"}), fine(4, 3, {"R", "G", "B", "A"});
+    for (double& v : coarse.pixels) v = 0.25;
+    for (double& v : fine.pixels) v = 0.25;
+    fine.at(1, 1, 2) = 0.253;
+    const Image out = with_step_doubling_error(coarse, fine);
+    ASSERT_EQ(out.channels.size(), 6u);
+    EXPECT_EQ(out.channels[5], "error");
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) {
+            EXPECT_NEAR(out.at(x, y, 5), x <= 2 ? 0.02 : 0.0, 1e-15) << x << "," << y;
+            EXPECT_EQ(out.at(x, y, 4), 0.25);
+        }
 }

@@ -74,6 +74,10 @@ inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16
 // integral changes only where a > 1 - 2^-53, a set of length ~ 2^-53 of the ramp. A piece whose
 // opacity is 1 at its midpoint is opaque (the ray ends there, T = 0 behind it).
 inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
+// The colour of an opaque piece [a, b] is c(a+), read at a + kAdaptiveOpaqueColourOffset (b - a): just
+// inside the piece, so that a jump of the transfer function at a (a root found to rounding) is on
+// the piece's side.
+inline constexpr double kAdaptiveOpaqueColourOffset = 1e-9;
 // Where the field along a piece is not a cubic (tricubic cells, beam-space grids), transfer-function
 // rows are located by sampling the piece at this many + 1 equally spaced points (a crossing is a sign
 // change of s - x_k between neighbours, then bisected to rounding). 8 intervals per cell resolve the

@@ -292,7 +292,8 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
                 continue;
             const PipelineSample pm = ctx_.pipeline.sample(ray, 0.5 * (a + b), SamplePipeline::Use::Composite);
             if (pm.opacity >= 1.0 && std::isfinite(pm.value)) {  // opaque piece: the ray ends at a
-                const PipelineSample ps = ctx_.pipeline.sample(ray, a + 1e-9 * (b - a), SamplePipeline::Use::Composite);
+                const PipelineSample ps = ctx_.pipeline.sample(ray, a + conventions::kAdaptiveOpaqueColourOffset * (b - a),
+                                                               SamplePipeline::Use::Composite);
                 opaque_colour = std::exp(-st.tau.value()) * ps.color;
                 for (int ch = 0; ch < 3; ++ch) st.C[ch].add(opaque_colour[ch]);
                 opaque = true;

@@ -190,6 +190,22 @@ TEST_F(CompareCli, ReadsPngAsPremultipliedAndCompositesExrOverBackground) {
     EXPECT_NEAR(png.rgba.at(0, 0, 1), (50.0 / 255) * (100.0 / 255), 1e-15);
     EXPECT_NEAR(png.rgba.at(0, 0, 3), 100.0 / 255, 1e-15);
 
+    // A grey 8-bit PNG without alpha: Y becomes R, G and B; alpha is 1; quantisation q on every channel.
+    {
+        auto out = OIIO::ImageOutput::create((dir_ / "y.png").string());
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(1, 1, 1, OIIO::TypeDesc::UINT8);
+        const std::uint8_t v = 51;
+        ASSERT_TRUE(out->open((dir_ / "y.png").string(), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, &v));
+        out->close();
+    }
+    const ComparedImage grey = read_compared_image(dir_ / "y.png");
+    EXPECT_FALSE(grey.unassociated);
+    for (std::size_t c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(grey.rgba.at(0, 0, c), 51.0 / 255);
+    EXPECT_EQ(grey.rgba.at(0, 0, 3), 1.0);
+    EXPECT_DOUBLE_EQ(quantisation_bound(grey, 0, 1), 0.5 / 255);
+
     write_exr(dir_ / "a.exr", 1, 1, {"R", "G", "B", "A"}, {0.25f, 0.125f, 0.0f, 0.5f});
     const ComparedImage exr = read_compared_image(dir_ / "a.exr", glm::dvec4(1.0, 0.5, 0.25, 0.5));
     EXPECT_EQ(exr.bits, 0);

@@ -34,7 +34,7 @@ inline constexpr double kQuantisationHalfStep = 0.5;
 // Heat map: pixel value d = max over the compared channels of |A - B|, mapped by t = clamp(d / S, 0, 1)
 // (S = --heatmap-scale, default the image's max abs difference; S = 0 maps everything to black) through
 // the "hot" colour map: black (t = 0) -> red (1/3) -> yellow (2/3) -> white (1), linear in each third:
-//   r = min(1, 3t), g = clamp(3t - 1, 0, 1), b = clamp(3t - 2, 0, 1); stored as 8-bit RGB PNG
+//   r = min(1, 3t), g = clamp(3t - 1, 0, 1), b = clamp(3t - 2, 0, 1); stored as an opaque 8-bit RGBA PNG
 // (each value round(255 v)). (core/compare/HeatMap.cpp)
 
 // (--fit) At most kFitMaxPixels pixels enter a fit, every k-th in scan order with k = ceil(N / max);

@@ -1,6 +1,7 @@
 // The heat map of a difference image: per pixel d = max over channels |A - B| (ImageMetrics.h),
 // t = clamp(d / scale, 0, 1), colour by the "hot" map of core/compare/CompareConstants.h
-// (black 0 -> red 1/3 -> yellow 2/3 -> white 1), written as 8-bit RGB PNG (atomically).
+// (black 0 -> red 1/3 -> yellow 2/3 -> white 1), written as an opaque 8-bit RGBA PNG by volref's image
+// writer (atomically).
 #pragma once
 #include <array>
 #include <filesystem>

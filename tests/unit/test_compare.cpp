@@ -363,7 +363,7 @@ TEST_F(CompareCli, HeatMapColours) {
     ASSERT_EQ(r.status, 0) << r.err;
     auto in = OIIO::ImageInput::open(p("h.png"));
     ASSERT_TRUE(in);
-    ASSERT_EQ(in->spec().nchannels, 3);
+    ASSERT_EQ(in->spec().nchannels, 4);  // opaque RGBA: read R, G, B
     std::vector<std::uint8_t> px(12);
     ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px.data()));
     EXPECT_EQ(std::vector<std::uint8_t>(px.begin(), px.begin() + 3), (std::vector<std::uint8_t>{255, 255, 255}));

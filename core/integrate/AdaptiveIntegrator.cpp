@@ -9,6 +9,7 @@
 #include "core/integrate/AdaptiveQuadrature.h"
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/Segments.h"
+#include "core/render/PreparedScene.h"  // ShellField: the beam-space grid behind the pipeline's sampler
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/TransferFunction.h"
@@ -33,6 +34,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
     if (r.early_termination)
         throw Error("render.integrator: \"adaptive\" integrates the whole ray; it cannot be combined with render.early_termination");
     cartesian_ = ctx.pipeline.cartesian_sampler();
+    if (const auto* shell = dynamic_cast<const ShellField*>(&ctx.pipeline.sampler())) shell_grid_ = &shell->shell_sampler().grid();
     if (cartesian_) {
         cut_cells_ = true;
         const Interpolation interp = cartesian_->interpolation();
@@ -79,6 +81,7 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
         const std::int64_t n = segment_count(iv, ctx_.step);
         out.push_back(iv.t0);
         for (std::int64_t k = 0; k < n; ++k) out.push_back(segment(iv, ctx_.step, k, n).t1);
+        if (shell_grid_) sampled_shell_cuts(ray, out);
     } else {
         grid_cuts(ray, iv.t0, iv.t1, cartesian_->volume(), cut_offset_, out);
     }
@@ -117,6 +120,60 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
             }
         }
         std::sort(all.begin() + std::ptrdiff_t(first), all.end());
+    }
+    all.push_back(out.back());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    out.swap(all);
+}
+
+void AdaptiveIntegrator::sampled_shell_cuts(const Ray& ray, std::vector<double>& out) const {
+    // The beam-space cell (per axis: floor of the continuous index, clamped to [0, n - 2] on
+    // non-periodic axes, modulo n on periodic ones) at kAdaptiveRowSamples + 1 points of each piece;
+    // where it differs between neighbours, the sub-interval is halved until no double lies between its
+    // ends, and that end is a cut (every boundary between two samples whose cells differ is found; a
+    // ray entering and leaving a cell between two samples is left to the quadrature).
+    const ShellGrid& g = *shell_grid_;
+    auto cell = [&](double t) {
+        const glm::dvec3 u = g.continuous_index(ray.at(t));
+        std::array<std::int64_t, 3> c{};
+        for (int a = 0; a < 3; ++a) {
+            const std::int64_t n = g.dims()[std::size_t(a)];
+            if (n < 2 || !std::isfinite(u[a])) continue;
+            const std::int64_t f = std::int64_t(std::floor(u[a]));
+            c[std::size_t(a)] = g.axis(a).periodic ? ((f % n) + n) % n : std::clamp<std::int64_t>(f, 0, n - 2);
+        }
+        return c;
+    };
+    std::vector<double> all;
+    all.reserve(out.size() * 2);
+    auto find = [&](auto&& self, double xa, const std::array<std::int64_t, 3>& ca, double xb,
+                    const std::array<std::int64_t, 3>& cb, int depth) -> void {
+        if (ca == cb) return;
+        const double m = 0.5 * (xa + xb);
+        if (!(m > xa && m < xb) || depth > 2200) {
+            all.push_back(xb);
+            return;
+        }
+        const std::array<std::int64_t, 3> cm = cell(m);
+        self(self, xa, ca, m, cm, depth + 1);
+        self(self, m, cm, xb, cb, depth + 1);
+    };
+    const int n = conventions::kAdaptiveRowSamples;
+    for (std::size_t p = 0; p + 1 < out.size(); ++p) {
+        const double ta = out[p], tb = out[p + 1];
+        all.push_back(ta);
+        const std::size_t first = all.size();
+        double xa = ta;
+        std::array<std::int64_t, 3> ca = cell(ta);
+        for (int k = 1; k <= n; ++k) {
+            const double xb = k == n ? tb : ta + (tb - ta) * double(k) / double(n);
+            const std::array<std::int64_t, 3> cb = cell(xb);
+            find(find, xa, ca, xb, cb, 0);
+            xa = xb;
+            ca = cb;
+        }
+        std::sort(all.begin() + std::ptrdiff_t(first), all.end());
+        while (all.size() > first && !(all.back() < tb)) all.pop_back();
     }
     all.push_back(out.back());
     all.erase(std::unique(all.begin(), all.end()), all.end());

@@ -15,8 +15,10 @@
 //     each piece at kAdaptiveRowSamples + 1 points (a sign change of s - x_k, bisected to rounding).
 //   Cartesian nearest: the faces of the nearest-neighbour regions (u = i + 1/2): the value is constant
 //     between them.
-//   Beam-space grids (shells): the fixed integrator's segment ends (render.step), and the rows' crossings
-//     found by sampling as for tricubic; coordinate surfaces are not located (a weaker guarantee,
+//   Beam-space grids (shells): the fixed integrator's segment ends (render.step), the crossings of the
+//     grid's coordinate surfaces (where the beam-space cell changes between kAdaptiveRowSamples + 1
+//     samples of a piece, halved to rounding) and the rows' crossings found by sampling as for
+//     tricubic (a weaker guarantee: a cell entered and left between two samples is not cut;
 //     docs/accuracy.md).
 //
 // Composite (emission-absorption, conventions section 3 in continuous form): with
@@ -54,6 +56,7 @@
 
 namespace volref {
 
+class ShellGrid;
 class TransferFunction;
 class VolumeSampler;
 
@@ -73,8 +76,11 @@ private:
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;
     // The rows' crossings inside each piece of `out` where the field is not a cubic, found by sampling.
     void sampled_row_cuts(const Ray& ray, std::vector<double>& out) const;
+    // Beam space: the crossings of the grid's coordinate surfaces inside each piece, found by sampling.
+    void sampled_shell_cuts(const Ray& ray, std::vector<double>& out) const;
 
     const VolumeSampler* cartesian_ = nullptr;
+    const ShellGrid* shell_grid_ = nullptr;  // beam-space grid (shell bounds), else null
     double cut_offset_ = 0.0;             // 0: cell faces; 0.5: nearest regions
     bool cut_cells_ = false;              // Cartesian: cut at grid planes
     bool cubic_ = false;                  // Cartesian trilinear: cubic per cell

@@ -35,6 +35,7 @@ public:
     explicit ShellField(const ShellSampler& s) : s_(s) {}
     double value(const glm::dvec3& world) const override { return s_.value(world); }
     glm::dvec3 gradient(const glm::dvec3& world) const override { return s_.gradient(world); }
+    const ShellSampler& shell_sampler() const { return s_; }  // its grid (the adaptive integrator's cuts)
 
 private:
     const ShellSampler& s_;

@@ -11,6 +11,7 @@
 #include "core/MemoryLimit.h"
 #include "core/grid/ProceduralField.h"
 #include "core/io/VolumeReader.h"
+#include "core/integrate/ProfileIntegrator.h"
 #include "geometry/ShellTessellation.h"
 #include "geometry/TriangleMesh.h"
 
@@ -172,7 +173,10 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
 
     camera = std::make_unique<Camera>(scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
-    integrator = make_integrator(*context);
+    // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
+    integrator = scene.render.profile == ProfileId::Reference
+                     ? make_integrator(*context)
+                     : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume);
 }
 
 PreparedScene::~PreparedScene() = default;

@@ -145,6 +145,8 @@ enum class StepUnits { Voxel, World };
 // How a ray's integral is computed: `Fixed` steps of render.step (conventions section 4), or
 // `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
 enum class IntegrationMethod { Fixed, Adaptive };
+// render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9).
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray };
 
 struct RenderSpec {
     Projection projection = Projection::Composite;
@@ -156,6 +158,7 @@ struct RenderSpec {
     double gain = 1.0;                    // xray: the line integral is multiplied by this
     IntegrationMethod integrator = IntegrationMethod::Fixed;
     double tolerance = 1e-6;              // adaptive: absolute error per channel, > 0
+    ProfileId profile = ProfileId::Reference;
 };
 
 struct Scene {

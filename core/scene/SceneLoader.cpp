@@ -692,8 +692,12 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                                 {"midpoint", IntegrationMethod::Fixed},
                                                 {"adaptive", IntegrationMethod::Adaptive}});
     s.tolerance = r.number("tolerance", conventions::kAdaptiveDefaultTolerance, Range::positive());
-    if (const std::optional<std::string> p = r.optional_string("profile"); p && *p != "reference")
-        r.fail("profile", "profile " + describe(Json(*p)) + " is not implemented yet (implemented: \"reference\")");
+    s.profile = r.choice<ProfileId>("profile", ProfileId::Reference,
+                                    {{"reference", ProfileId::Reference},
+                                     {"vtk-gpu", ProfileId::VtkGpu},
+                                     {"glsl-basic", ProfileId::GlslBasic},
+                                     {"ospray", ProfileId::Ospray}},
+                                    {"vtk-cpu", "cuda-curvilinear"});
     s.gain = r.number("gain", 1.0, Range::positive());
     if (s.projection == Projection::FirstHit && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
     return s;

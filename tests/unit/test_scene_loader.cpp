@@ -888,8 +888,10 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
     EXPECT_EQ(parse(scene_with(R"("render": {})")).render.tolerance, 1e-6);
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"tolerance": 0})"), "render.tolerance", "expected a number > 0"));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"integrator": "exact"})"), "render.integrator", "\"adaptive\""));
-    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk"})"), "render.profile",
-                           "profile \"vtk\" is not implemented yet"));
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk"})"), "render.profile", "\"vtk-gpu\""));
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-cpu"})"), "render.profile", "not implemented yet"));
+    EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-gpu"})")).render.profile, ProfileId::VtkGpu);
+    EXPECT_EQ(parse(scene_with(R"("render": {})")).render.profile, ProfileId::Reference);
     EXPECT_TRUE(fails_with(R"({"volumes": [{"source": "a.nrrd"}, {"source": "b.nrrd"}]})", "volumes",
                            "several volumes are not implemented yet"));
 }

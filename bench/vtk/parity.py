@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+"""VTK parity: renders small scenes with VTK's volume mappers and with volref's mirror profiles and
+compares them with `volref compare` (the 8-bit rule: each VTK pixel is within its quantisation).
+
+    xvfb-run -a -s "-screen 0 640x480x24" /usr/bin/python3 bench/vtk/parity.py VOLREF OUT_DIR [CASE ...]
+
+scripts/vtk-parity.sh runs it (and tests/CMakeLists.txt's vtk_parity test calls that script).
+The volume (a 24^3 float NRRD of a smooth field, written here with numpy) and one scene per case are
+written to OUT_DIR; each case is rendered by VTK (render_scene_with_vtk.py) and by volref with the
+profile that mirrors the mapper (EXR) and with the reference profile. Prints one line per
+comparison and exits 1 when a mirror profile is not within the tolerance of its case, 0 otherwise.
+
+Cases: composite, shaded, mip, minip, average (vtkGPUVolumeRayCastMapper against render.profile
+"vtk-gpu").
+"""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+N = 24
+SIZE = 64
+
+# The measured tolerance of each case (added to compare's 8-bit quantisation bound); see
+# docs/gpu-checking.md for the measured differences behind each number.
+TOLERANCE = {"composite": 0.0, "shaded": 0.0, "mip": 0.0, "minip": 0.0, "average": 0.0}
+
+
+def field():
+    """A smooth blob with a ripple, values in [0, 1]: f = exp(-r^2 / 60) (0.75 + 0.25 cos(x / 2.5))."""
+    c = (np.arange(N, dtype=np.float64) - (N - 1) / 2.0)
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    r2 = x * x + y * y + z * z
+    return (np.exp(-r2 / 60.0) * (0.75 + 0.25 * np.cos(x / 2.5))).astype(np.float32)
+
+
+def write_nrrd(path, values):
+    nz, ny, nx = values.shape
+    with open(path, "wb") as f:
+        f.write(f"NRRD0004\ntype: float\ndimension: 3\nsizes: {nx} {ny} {nz}\nencoding: raw\nendian: little\n\n"
+                .encode("ascii"))
+        f.write(values.astype("<f4").tobytes())
+
+
+def scene(projection, shaded=False):
+    h = (N - 1) / 2.0
+    volume = {
+        "source": "volume.nrrd",
+        "origin": [-h, -h, -h],
+        "spacing": [1, 1, 1],
+        "interpolation": "trilinear",
+        "transfer": {"domain": "data",
+                     "color": [[0.0, 0.1, 0.2, 0.9], [0.4, 0.2, 0.8, 0.3], [0.7, 1.0, 0.6, 0.1], [1.0, 1.0, 1.0, 1.0]],
+                     "opacity": [[0.0, 0.0], [0.2, 0.0], [0.5, 0.08], [0.8, 0.3], [1.0, 0.5]],
+                     "opacity_unit_distance": 1.0},
+    }
+    if projection in ("mip", "minip"):
+        volume["transfer"]["opacity"] = [[0.0, 0.2], [1.0, 1.0]]
+    if projection == "average":
+        volume["transfer"]["opacity"] = [[0.0, 1.0], [1.0, 1.0]]
+    if shaded:
+        volume["shading"] = {"ka": 0.2, "kd": 0.7, "ks": 0.3, "n": 10, "two_sided": True}
+    return {
+        "description": f"VTK parity: {projection}{' shaded' if shaded else ''}",
+        "volume": volume,
+        "lights": [{"type": "headlight", "color": [1, 1, 1]}],
+        "camera": {"type": "perspective", "eye": [30.0, 18.0, 62.0], "target": [0, 0, 0], "up": [0, 1, 0],
+                   "fov_y": 30},
+        "image": {"width": SIZE, "height": SIZE, "background": [0, 0, 0, 1]},
+        "render": {"projection": projection, "step": 0.5, "step_units": "voxel"},
+    }
+
+
+CASES = {"composite": ("composite", False), "shaded": ("composite", True), "mip": ("mip", False),
+         "minip": ("minip", False), "average": ("average", False)}
+
+
+def run(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode not in (0, 1):
+        sys.exit(f"parity.py: {' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}")
+    return p
+
+
+def compare(volref, a, b, tolerance):
+    p = run([volref, "compare", a, b, "--background", "0,0,0,1", "--tolerance", str(tolerance), "--json"])
+    m = json.loads(p.stdout)
+    return p.returncode, m
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit("usage: parity.py VOLREF OUT_DIR [CASE ...]")
+    volref, out = sys.argv[1], sys.argv[2]
+    cases = sys.argv[3:] or list(CASES)
+    os.makedirs(out, exist_ok=True)
+    write_nrrd(os.path.join(out, "volume.nrrd"), field())
+    failed = []
+    for name in cases:
+        projection, shaded = CASES[name]
+        path = os.path.join(out, f"{name}.json")
+        with open(path, "w") as f:
+            json.dump(scene(projection, shaded), f, indent=1)
+        vtk_png = os.path.join(out, f"{name}-vtk-gpu.png")
+        run(["/usr/bin/python3", os.path.join(HERE, "render_scene_with_vtk.py"), path, "--mapper", "gpu", "-o", vtk_png])
+        for profile in ("vtk-gpu", "reference"):
+            exr = os.path.join(out, f"{name}-{profile}.exr")
+            run([volref, "render", path, "-o", exr, "--set", f"render.profile={profile}"])
+        status, m = compare(volref, vtk_png, os.path.join(out, f"{name}-vtk-gpu.exr"), TOLERANCE[name])
+        _, r = compare(volref, vtk_png, os.path.join(out, f"{name}-reference.exr"), TOLERANCE[name])
+        print(f"{name:10s} vtk-gpu profile: {summary(m)} | reference: {summary(r)}")
+        if status != 0:
+            failed.append(name)
+    if failed:
+        print("parity.py: not within tolerance: " + ", ".join(failed))
+        sys.exit(1)
+
+
+def summary(m):
+    o = m.get("overall", m)
+    return json.dumps({k: o.get(k) for k in ("max_abs", "mean_abs", "over", "over_fraction") if k in o})
+
+
+if __name__ == "__main__":
+    main()

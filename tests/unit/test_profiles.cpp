@@ -1,0 +1,113 @@
+// Mirror profiles (render.profile, core/integrate/Profile.h) against hand calculations: a constant or
+// linear box seen along -z by one orthographic pixel, each profile's formula worked out below.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "TestScenes.h"
+#include "core/Error.h"
+
+using namespace volref;
+using namespace volref::test;
+
+namespace {
+
+// A box [0, n-1]^3 of value v, one pixel looking along -z at (cx, cy): the chord is n - 1 long.
+Scene box_scene(ProfileId profile, double value, double opacity, std::int64_t n, double step) {
+    Scene s = field_scene(constant_field(value, {n, n, n}));
+    s.volume.transfer.color = {{0, 0.2, 0.4, 0.6}, {1, 0.2, 0.4, 0.6}};
+    s.volume.transfer.opacity = {{0, opacity}, {1, opacity}};
+    s.volume.transfer.opacity_unit_distance = 1.0;
+    const double c = 0.5 * double(n - 1);
+    s.camera = ortho_down_z(c, c, double(n) + 10.0, 1.0);
+    s.image.width = s.image.height = 1;
+    s.render.step = step;
+    s.render.step_units = StepUnits::World;
+    s.render.profile = profile;
+    return s;
+}
+
+double alpha_of(ProfileId profile, double value, double opacity, std::int64_t n, double step) {
+    return rgba(render_scene(box_scene(profile, value, opacity, n, step), {1, false}), 0, 0).a;
+}
+
+// f = z on [0, 4]^3 (data range [0, 4]); colour white, opacity a(v) = v / 4.
+Scene ramp_scene(ProfileId profile, Projection projection) {
+    Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
+    s.volume.transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
+    s.volume.transfer.opacity = {{0, 0}, {4, 1}};
+    s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
+    s.image.width = s.image.height = 1;
+    s.render.projection = projection;
+    s.render.step = 0.5;
+    s.render.step_units = StepUnits::World;
+    s.render.profile = profile;
+    return s;
+}
+
+}  // namespace
+
+// Chord 4, step 0.5, a = 0.1 per unit distance.
+//   vtk-gpu: samples at 0.5, 1.0, ..., 4.0 (8; the first one step inside), each 1 - 0.9^0.5
+//            (the table entry corrected for the step): A = 1 - 0.9^4.
+//   glsl-basic: samples at 0, 0.5, ..., 4.0 (9), each alpha 0.1 uncorrected: A = 1 - 0.9^9.
+//   ospray: 8 midpoints, each 1 - exp(-0.1 * 0.5): A = 1 - exp(-0.4).
+//   reference: 8 segments, each 1 - 0.9^0.5: A = 1 - 0.9^4.
+TEST(Profiles, ConstantBoxCompositeByHand) {
+    EXPECT_NEAR(alpha_of(ProfileId::VtkGpu, 0.5, 0.1, 5, 0.5), 1.0 - std::pow(0.9, 4), 1e-12);
+    EXPECT_NEAR(alpha_of(ProfileId::GlslBasic, 0.5, 0.1, 5, 0.5), 1.0 - std::pow(0.9, 9), 1e-12);
+    EXPECT_NEAR(alpha_of(ProfileId::Ospray, 0.5, 0.1, 5, 0.5), 1.0 - std::exp(-0.4), 1e-12);
+    EXPECT_NEAR(alpha_of(ProfileId::Reference, 0.5, 0.1, 5, 0.5), 1.0 - std::pow(0.9, 4), 1e-12);
+    // The colour is premultiplied: C = A c.
+    const glm::dvec4 p = rgba(render_scene(box_scene(ProfileId::GlslBasic, 0.5, 0.1, 5, 0.5), {1, false}), 0, 0);
+    EXPECT_NEAR(p.g, 0.4 * (1.0 - std::pow(0.9, 9)), 1e-12);
+}
+
+// Termination. vtk-gpu, a = 0.9, step 0.5: each sample 1 - 0.1^0.5, A_k = 1 - 0.1^(k/2); A_4 = 0.99 <=
+// 1 - 1/255 = 0.99608 < A_5 = 1 - 0.1^2.5: it stops after 5 samples (the chord of 4 holds 8).
+// ospray, a = 1, step 0.5, chord 16: T_k = exp(-k / 2) <= 0.001 first at k = 14: A = 1 - exp(-7).
+// glsl-basic, a = 1: the first sample is opaque: A = 1.
+TEST(Profiles, TerminationThresholdsByHand) {
+    EXPECT_NEAR(alpha_of(ProfileId::VtkGpu, 0.5, 0.9, 5, 0.5), 1.0 - std::pow(0.1, 2.5), 1e-12);
+    EXPECT_NEAR(alpha_of(ProfileId::Ospray, 0.5, 1.0, 17, 0.5), 1.0 - std::exp(-7.0), 1e-12);
+    EXPECT_EQ(alpha_of(ProfileId::GlslBasic, 0.5, 1.0, 5, 0.5), 1.0);
+}
+
+// vtk-gpu's MIP on f = z seen from above: the first sample is one step inside, at z = 3.5 (the
+// reference's first midpoint is at z = 3.75). Its opacity is read from the 1024-entry table built at
+// v_j = 4 j / 1023 (a_j = j / 1023) at texel position s 1024 - 0.5, s = 3.5 / 4: a = 895.5 / 1023,
+// uncorrected (MIP). MinIP: the last sample at z = 0 (s = 0, texel -0.5 clamped to 0): a = 0.
+TEST(Profiles, VtkGpuMipReadsTheTableAtTexelCentres) {
+    const glm::dvec4 mip = rgba(render_scene(ramp_scene(ProfileId::VtkGpu, Projection::Mip), {1, false}), 0, 0);
+    EXPECT_NEAR(mip.a, (0.875 * 1024.0 - 0.5) / 1023.0, 1e-12);
+    EXPECT_NEAR(mip.r, mip.a, 1e-12);
+    const glm::dvec4 minip = rgba(render_scene(ramp_scene(ProfileId::VtkGpu, Projection::Minip), {1, false}), 0, 0);
+    EXPECT_NEAR(minip.a, 0.0, 1e-12);
+    const glm::dvec4 ref = rgba(render_scene(ramp_scene(ProfileId::Reference, Projection::Mip), {1, false}), 0, 0);
+    EXPECT_NEAR(ref.a, 3.75 / 4.0, 1e-12);
+}
+
+// vtk-gpu's average: the mean over its 8 samples (z = 3.5, 3.0, ..., 0) of a(v) s, with s = v / 4
+// and a(v) the table read at s 1024 - 0.5 (clamped at 0): grey, alpha 1.
+TEST(Profiles, VtkGpuAverageIsOpacityWeightedByHand) {
+    double sum = 0.0;
+    for (int k = 1; k <= 8; ++k) {
+        const double s = (4.0 - 0.5 * k) / 4.0;
+        const double a = std::max(0.0, s * 1024.0 - 0.5) / 1023.0;
+        sum += a * s;
+    }
+    const glm::dvec4 p = rgba(render_scene(ramp_scene(ProfileId::VtkGpu, Projection::Average), {1, false}), 0, 0);
+    EXPECT_NEAR(p.r, sum / 8.0, 1e-12);
+    EXPECT_EQ(p.a, 1.0);
+}
+
+TEST(Profiles, UnsupportedCombinationsNameTheKey) {
+    Scene s = ramp_scene(ProfileId::VtkGpu, Projection::FirstHit);
+    s.render.isovalue = 1.0;
+    try {
+        render_scene(s, {1, false});
+        FAIL() << "first-hit with a profile rendered";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("render.profile"), std::string::npos) << e.what();
+    }
+}

@@ -80,9 +80,7 @@ private:
             detail->gradient = g;
             detail->classified = true;
             detail->classified_color = c.color;
-            detail->opacity = c.opacity;
             detail->shaded = shade;
-            detail->color = s.color;
         } else {
             s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
         }
@@ -91,6 +89,10 @@ private:
         if (!std::isfinite(s.value) || !std::isfinite(s.opacity) || !std::isfinite(s.color.r + s.color.g + s.color.b)) {
             s.opacity = 0.0;
             s.color = glm::dvec3(0.0);
+        }
+        if constexpr (kDetail) {  // what the integrator uses (after the non-finite rule)
+            detail->opacity = s.opacity;
+            detail->color = s.color;
         }
         return s;
     }

@@ -40,7 +40,7 @@ struct SampleDetail {
     glm::dvec3 gradient{0.0};           // world units
     bool classified = false;            // the classification was evaluated
     glm::dvec3 classified_color{0.0};   // not premultiplied
-    double opacity = 0.0;               // per unit distance
+    double opacity = 0.0;               // per unit distance (0 for a non-finite value or colour)
     bool shaded = false;                // the shader ran (shaded scene, opacity > 0)
     ShadeTerms shading;                 // valid when shaded
     glm::dvec3 color{0.0};              // the colour the integrator used (shaded or classified)

@@ -91,6 +91,8 @@ std::array<int, 2> parse_pixel(const std::string& text, int width, int height) {
 PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     const RenderSpec& r = scene.scene.render;
     if (r.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+    if (r.integrator == IntegrationMethod::Adaptive)
+        throw Error("trace: render.integrator \"adaptive\" is not supported yet (trace the fixed-step integrator)");
     if (x < 0 || x >= scene.scene.image.width || y < 0 || y >= scene.scene.image.height)
         throw Error("--pixel: (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
                     std::to_string(scene.scene.image.width) + " x " + std::to_string(scene.scene.image.height) + " image");

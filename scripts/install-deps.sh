@@ -14,6 +14,9 @@ packages=(
   libceres-dev gnuplot-nox
   # scripts/sanitize.sh and scripts/fuzz.sh: clang with AddressSanitizer, UBSan and libFuzzer (docs/robustness.md)
   clang libclang-rt-14-dev
+  # the VTK parity test (scripts/vtk-parity.sh): VTK 9.1's mappers under Debian's /usr/bin/python3 on Mesa
+  # llvmpipe (libgl1-mesa-dri comes as a dependency) in Xvfb; xauth is only a recommendation of xvfb
+  python3-vtk9 python3-numpy xvfb xauth
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -8,7 +8,9 @@ scripts/vtk-parity.sh runs it (and tests/CMakeLists.txt's vtk_parity test calls 
 The volume (a 24^3 float NRRD of a smooth field, written here with numpy) and one scene per case are
 written to OUT_DIR; each case is rendered by VTK (render_scene_with_vtk.py) and by volref with the
 profile that mirrors the mapper (EXR) and with the reference profile. Prints one line per
-comparison and exits 1 when a mirror profile is not within the tolerance of its case, 0 otherwise.
+comparison and exits 1 when a mirror profile is not within the tolerance of its case (or is further
+from VTK, by RMSE, than the reference profile), 0 otherwise. The reference profile's comparison is
+run with --fit and its verdict printed: what explains the reference's difference from VTK.
 
 Cases: composite, shaded, mip, minip, average (vtkGPUVolumeRayCastMapper against render.profile
 "vtk-gpu").
@@ -26,7 +28,11 @@ SIZE = 64
 
 # The measured tolerance of each case (added to compare's 8-bit quantisation bound); see
 # docs/gpu-checking.md for the measured differences behind each number.
-TOLERANCE = {"composite": 0.0, "shaded": 0.0, "mip": 0.0, "minip": 0.0, "average": 0.0}
+# composite, mip, minip, average: 1e-5 for VTK's float32 arithmetic (a pixel was measured 5e-7 past
+# the 8-bit bound). shaded: 0.0015; measured 4.1e-4 (this camera) and 1.07e-3 (eye (30, 18, 62)) past
+# the 8-bit bound on 1% of the pixels, in the opaque centre; the cause is not isolated (a gradient
+# offset of 0.5 voxel instead of 1 makes it 4 times worse).
+TOLERANCE = {"composite": 1e-5, "shaded": 0.0015, "mip": 1e-5, "minip": 1e-5, "average": 1e-5}
 
 
 def field():
@@ -67,7 +73,7 @@ def scene(projection, shaded=False):
         "description": f"VTK parity: {projection}{' shaded' if shaded else ''}",
         "volume": volume,
         "lights": [{"type": "headlight", "color": [1, 1, 1]}],
-        "camera": {"type": "perspective", "eye": [30.0, 18.0, 62.0], "target": [0, 0, 0], "up": [0, 1, 0],
+        "camera": {"type": "perspective", "eye": [29.0, 17.0, 63.0], "target": [0, 0, 0], "up": [0, 1, 0],
                    "fov_y": 30},
         "image": {"width": SIZE, "height": SIZE, "background": [0, 0, 0, 1]},
         "render": {"projection": projection, "step": 0.5, "step_units": "voxel"},
@@ -85,8 +91,9 @@ def run(cmd):
     return p
 
 
-def compare(volref, a, b, tolerance):
-    p = run([volref, "compare", a, b, "--background", "0,0,0,1", "--tolerance", str(tolerance), "--json"])
+def compare(volref, a, b, tolerance, fit=False):
+    p = run([volref, "compare", a, b, "--background", "0,0,0,1", "--tolerance", str(tolerance), "--json"]
+            + (["--fit"] if fit else []))
     m = json.loads(p.stdout)
     return p.returncode, m
 
@@ -110,18 +117,23 @@ def main():
             exr = os.path.join(out, f"{name}-{profile}.exr")
             run([volref, "render", path, "-o", exr, "--set", f"render.profile={profile}"])
         status, m = compare(volref, vtk_png, os.path.join(out, f"{name}-vtk-gpu.exr"), TOLERANCE[name])
-        _, r = compare(volref, vtk_png, os.path.join(out, f"{name}-reference.exr"), TOLERANCE[name])
-        print(f"{name:10s} vtk-gpu profile: {summary(m)} | reference: {summary(r)}")
+        _, r = compare(volref, vtk_png, os.path.join(out, f"{name}-reference.exr"), TOLERANCE[name], fit=True)
+        print(f"{name:8s} vtk-gpu profile: {summary(m)}")
+        print(f"{'':8s} reference:       {summary(r)}")
+        print(f"{'':8s} reference --fit: {r['fit']['verdict']}")
         if status != 0:
-            failed.append(name)
+            failed.append(f"{name} (vtk-gpu profile not within tolerance)")
+        elif m["overall"]["rmse"] > r["overall"]["rmse"]:
+            failed.append(f"{name} (the reference profile is closer to VTK than the vtk-gpu profile)")
     if failed:
         print("parity.py: not within tolerance: " + ", ".join(failed))
         sys.exit(1)
 
 
 def summary(m):
-    o = m.get("overall", m)
-    return json.dumps({k: o.get(k) for k in ("max_abs", "mean_abs", "over", "over_fraction") if k in o})
+    o = m["overall"]
+    return (f"max abs {o['max_abs']:.3e}  RMSE {o['rmse']:.3e}  pixels over tolerance {m['pixels_over']}"
+            f" of {m['pixels']} (tolerance {m['tolerance']})")
 
 
 if __name__ == "__main__":

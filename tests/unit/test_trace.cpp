@@ -251,6 +251,15 @@ TEST(Trace, FirstHitAndBadPixelsAreErrors) {
     } catch (const Error& e) {
         EXPECT_STREQ(e.what(), "trace: first-hit is not supported yet");
     }
+    Scene adaptive = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, false);
+    adaptive.render.integrator = IntegrationMethod::Adaptive;
+    const PreparedScene pa(adaptive, {});
+    try {
+        explain::trace_pixel(pa, 8, 8);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("trace: render.integrator \"adaptive\" is not supported yet", 0), 0u) << e.what();
+    }
     EXPECT_THROW(explain::parse_pixel("16,3", 16, 16), Error);
     EXPECT_THROW(explain::parse_pixel("3", 16, 16), Error);
     EXPECT_THROW(explain::parse_pixel("3,x", 16, 16), Error);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -111,35 +113,88 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
 }
 
 PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    NoRecording rec;
+    return integrate_impl(ray, intervals, rec);
+}
+
+PixelValue ProfileIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                               SampleRecorder& recorder) const {
+    Recording rec{recorder};
+    return integrate_impl(ray, intervals, rec);
+}
+
+namespace {
+
+// Starts a record for a sample at t standing for length d.
+template <class Rec>
+void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, double d, double v) {
+    rec.begin(r, t - 0.5 * d, t + 0.5 * d);
+    r.t = t;
+    r.length = d;
+    r.sample.position = x;
+    r.sample.value = v;
+}
+
+}  // namespace
+
+template <class Rec>
+PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     switch (ctx_.render.projection) {
-        case Projection::Composite: return composite(ray, intervals);
-        case Projection::Mip: return extremum(ray, intervals, true);
-        case Projection::Minip: return extremum(ray, intervals, false);
-        case Projection::Average: return line_integral(ray, intervals, true);
-        case Projection::Xray: return line_integral(ray, intervals, false);
+        case Projection::Composite: return composite(ray, intervals, rec);
+        case Projection::Mip: return extremum(ray, intervals, true, rec);
+        case Projection::Minip: return extremum(ray, intervals, false, rec);
+        case Projection::Average: return line_integral(ray, intervals, true, rec);
+        case Projection::Xray: return line_integral(ray, intervals, false, rec);
         case Projection::FirstHit: break;
     }
     return {};
 }
 
-PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals) const {
+template <class Rec>
+PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     glm::dvec3 C(0.0);
     double A = 0.0;
     const Shader* shader = ctx_.pipeline.shader();
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
         const double v = value(x);
-        if (!std::isfinite(v)) return true;
-        const Lookup k = lookup(v, d);
-        if (!(k.alpha > 0.0)) return true;
-        glm::dvec3 c = k.color;
-        if (shader) {
-            const glm::dvec3 g = gradient(x);
-            c = shader->shade(c, p_.normal_along_gradient ? -g : g, -ray.direction, t);
-            if (p_.clamp_shaded) c = glm::clamp(c, 0.0, 1.0);
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        if constexpr (Rec::kOn) begin_record(rec, r, x, t, d, v);
+        const Lookup k = std::isfinite(v) ? lookup(v, d) : Lookup{};
+        const double A_before = A;
+        if (k.alpha > 0.0) {
+            glm::dvec3 c = k.color;
+            if (shader) {
+                const glm::dvec3 g = gradient(x);
+                const glm::dvec3 n = p_.normal_along_gradient ? -g : g;
+                if constexpr (Rec::kOn) {
+                    c = shader->shade(c, n, -ray.direction, t, r.sample.shading);
+                    r.sample.has_gradient = true;
+                    r.sample.gradient = g;
+                    r.sample.shaded = true;
+                } else {
+                    c = shader->shade(c, n, -ray.direction, t);
+                }
+                if (p_.clamp_shaded) c = glm::clamp(c, 0.0, 1.0);
+            }
+            C += (1.0 - A) * k.alpha * c;
+            A += (1.0 - A) * k.alpha;
+            if constexpr (Rec::kOn) r.sample.color = c;
+        } else if constexpr (Rec::kOn) {
+            r.sample.color = k.color;
         }
-        C += (1.0 - A) * k.alpha * c;
-        A += (1.0 - A) * k.alpha;
+        if constexpr (Rec::kOn) {
+            r.sample.classified = std::isfinite(v);
+            r.sample.classified_color = k.color;
+            r.sample.opacity = k.opacity;
+            r.composited = true;
+            r.alpha = k.alpha;
+            r.tau = k.alpha < 1.0 ? -std::log1p(-k.alpha) : std::numeric_limits<double>::infinity();
+            r.transmittance_before = 1.0 - A_before;
+            r.transmittance_after = 1.0 - A;
+            r.accumulated = glm::dvec4(C, A);
+            rec.recorder.record(r);
+        }
         return !(A > p_.terminate_above || A >= p_.terminate_at);
     });
     PixelValue out;
@@ -147,41 +202,71 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
     return out;
 }
 
-PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum) const {
+template <class Rec>
+PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum,
+                                       Rec& rec) const {
     bool any = false;
     double best = 0.0;
-    for_each_sample(intervals, [&](double t, double) {
-        const double v = value(ray.at(t));
+    auto pixel = [&](double v) {
+        const Lookup k = lookup(v, ctx_.step);
+        return glm::dvec4(k.opacity * k.color, k.opacity);
+    };
+    for_each_sample(intervals, [&](double t, double d) {
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
         if (std::isfinite(v) && (!any || (maximum ? v > best : v < best))) best = v;
         any = any || std::isfinite(v);
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            if (std::isfinite(v)) {
+                const Lookup k = lookup(v, d);
+                r.sample.classified = true;
+                r.sample.classified_color = k.color;
+                r.sample.opacity = k.opacity;
+                r.sample.color = k.color;
+            }
+            r.running = best;
+            r.accumulated = any ? pixel(best) : glm::dvec4(0.0);
+            rec.recorder.record(r);
+        }
+        (void)d;
         return true;
     });
     PixelValue out;
-    if (any) {
-        const Lookup k = lookup(best, ctx_.step);
-        out.rgba = glm::dvec4(k.opacity * k.color, k.opacity);
-    }
+    if (any) out.rgba = pixel(best);
     return out;
 }
 
-PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean) const {
+template <class Rec>
+PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean,
+                                            Rec& rec) const {
     double sum = 0.0, length = 0.0;
     const Classifier& c = ctx_.pipeline.classifier();
+    const bool weighted = mean && p_.average_opacity_weighted;
+    auto result = [&]() { return mean ? (length > 0.0 ? sum / length : 0.0) : ctx_.render.gain * sum; };
     for_each_sample(intervals, [&](double t, double d) {
-        const double v = value(ray.at(t));
-        if (!std::isfinite(v)) return true;
-        if (mean && p_.average_opacity_weighted) {
-            sum += lookup(v, d).opacity * normalised(v);
-            length += 1.0;
-        } else {
-            sum += c.coordinate(v) * d;
-            length += d;
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        [[maybe_unused]] double s = 0.0;
+        if (std::isfinite(v)) {
+            s = weighted ? lookup(v, d).opacity * normalised(v) : c.coordinate(v);
+            sum += weighted ? s : s * d;
+            length += weighted ? 1.0 : d;
+        }
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            r.coordinate = s;
+            r.running = result();
+            r.accumulated = glm::dvec4(r.running, r.running, r.running, 1.0);
+            rec.recorder.record(r);
         }
         return true;
     });
     PixelValue out;
     if (intervals.empty()) return out;
-    const double g = mean ? (length > 0.0 ? sum / length : 0.0) : ctx_.render.gain * sum;
+    const double g = result();
     out.rgba = glm::dvec4(g, g, g, 1.0);
     return out;
 }

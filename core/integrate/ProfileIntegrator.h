@@ -19,6 +19,7 @@
 #include "core/grid/Volume.h"
 #include "core/integrate/Integrator.h"
 #include "core/integrate/Profile.h"
+#include "core/integrate/SampleRecorder.h"
 
 namespace volref {
 
@@ -27,6 +28,11 @@ public:
     // Throws volref::Error naming render.profile for what the profile cannot render.
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    // The same loops, recording every sample (SampleRecorder.h): the record's segment is the length
+    // the sample stands for centred on it, `t` the sample's own position, `alpha` its alpha,
+    // `opacity` the (table's) uncorrected opacity, transmittance 1 - A before and after it.
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
 
 private:
     struct Lookup {
@@ -43,9 +49,14 @@ private:
     glm::dvec3 gradient(const glm::dvec3& x) const;
     double normalised(double v) const { return width_ > 0.0 ? (v - lo_) / width_ : 0.0; }
 
-    PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
-    PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum) const;
-    PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean) const;
+    template <class Rec>
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum, Rec& rec) const;
+    template <class Rec>
+    PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean, Rec& rec) const;
 
     const Profile& p_;
     glm::dvec3 domain_lo_, domain_hi_;

@@ -6,6 +6,8 @@
 
 #include "TestScenes.h"
 #include "core/Error.h"
+#include "core/integrate/SampleRecorder.h"
+#include "core/render/PreparedScene.h"
 
 using namespace volref;
 using namespace volref::test;
@@ -110,4 +112,23 @@ TEST(Profiles, UnsupportedCombinationsNameTheKey) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("render.profile"), std::string::npos) << e.what();
     }
+}
+
+// `volref trace` with a profile: the glsl-basic box of ConstantBoxCompositeByHand has 9 samples at
+// t0, t0 + 0.5, ..., each alpha 0.1; after sample k, A = 1 - 0.9^(k+1); the last row is the pixel.
+TEST(Profiles, TraceRecordsTheProfilesSamples) {
+    const Scene s = box_scene(ProfileId::GlslBasic, 0.5, 0.1, 5, 0.5);
+    const PreparedScene prepared(s, {1, false});
+    SampleList list;
+    const PixelValue traced = prepared.trace_pixel(0, 0, list);
+    ASSERT_EQ(list.rows.size(), 9u);
+    for (std::size_t k = 0; k < list.rows.size(); ++k) {
+        EXPECT_NEAR(list.rows[k].t - list.rows[0].t, 0.5 * double(k), 1e-12);
+        EXPECT_NEAR(list.rows[k].alpha, 0.1, 1e-15);
+        EXPECT_NEAR(list.rows[k].accumulated.a, 1.0 - std::pow(0.9, double(k + 1)), 1e-12);
+    }
+    EXPECT_NEAR(list.rows[0].sample.position.z, 4.0, 1e-12);  // the first sample at the entry (z = 4)
+    const PixelValue rendered = prepared.render_pixel(0, 0);
+    EXPECT_EQ(traced.rgba, rendered.rgba);
+    EXPECT_EQ(list.rows.back().accumulated, rendered.rgba);
 }

@@ -62,16 +62,39 @@ Profile make_ospray() {
     return p;
 }
 
+// A CUDA ray caster for cylindrical and spherical data (issue 7, shared spec section 9): samples from
+// the entry point on at a step of size / n voxels, composited back to front by
+// sum = lerp(sum, col, col.a * density) over the samples with s >= the iso threshold, the transfer
+// function read from a 9-entry linearly filtered table over [0, 1] at s * transfer scale (texel position
+// 9 u - 0.5, as CUDA's normalised linear texture fetch), x-ray = max s times brightness; unshaded.
+Profile make_cuda_curvilinear() {
+    Profile p;
+    p.id = ProfileId::CudaCurvilinear;
+    p.name = "cuda-curvilinear";
+    p.placement = Profile::Placement::FromEntry;
+    p.first = 0.0;
+    p.correction = Profile::Correction::None;
+    p.table_entries = 9;
+    p.lerp_back_to_front = true;
+    p.scaled_table = true;
+    p.iso_skip = true;
+    p.xray_maximum = true;
+    p.step_size_over_n = true;
+    p.shells = true;
+    return p;
+}
+
 }  // namespace
 
 const Profile& profile(ProfileId id) {
     static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), glsl_basic = make_glsl_basic(),
-                         ospray = make_ospray();
+                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear();
     switch (id) {
         case ProfileId::Reference: return reference;
         case ProfileId::VtkGpu: return vtk_gpu;
         case ProfileId::GlslBasic: return glsl_basic;
         case ProfileId::Ospray: return ospray;
+        case ProfileId::CudaCurvilinear: return cuda_curvilinear;
     }
     throw Error("render.profile: unknown profile");
 }

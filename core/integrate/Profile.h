@@ -59,6 +59,22 @@ struct Profile {
     bool normal_along_gradient = false;
     bool clamp_shaded = false;
 
+    // Back to front with sum = lerp(sum, col, col.a * density) (RGBA, col = (c, a) from the table;
+    // render.profile_options.density) instead of front-to-back compositing; no termination.
+    bool lerp_back_to_front = false;
+    // Tables read at s * render.profile_options.transfer_scale instead of s.
+    bool scaled_table = false;
+    // Composite skips samples with s < render.profile_options.iso_threshold.
+    bool iso_skip = false;
+    // X-ray: g = brightness * max_k s_k instead of the line integral.
+    bool xray_maximum = false;
+    // step_units "voxel": a voxel is size / n (extent over the sample count) rather than the spacing
+    // size / (n - 1): the step is multiplied by (n - 1) / n, n the dims of the grid's axis of smallest
+    // spacing (Cartesian) or the largest dims (shells).
+    bool step_size_over_n = false;
+    // The profile renders beam-space (shell) grids too: no domain clamping, no gradients.
+    bool shells = false;
+
     // Average projection: VTK's GPU shader averages opacity(v) * s (s the value normalised over the
     // data range, opacity the uncorrected table) over the samples and writes it as grey, alpha 1.
     bool average_opacity_weighted = false;

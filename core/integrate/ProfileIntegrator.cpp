@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -22,12 +24,24 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     if (r.integrator != IntegrationMethod::Fixed) throw Error(where + "needs render.integrator \"fixed\"");
     if (r.order != CompositeOrder::FrontToBack) throw Error(where + "composites front to back (render.order)");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
-    if (!ctx.pipeline.cartesian_sampler()) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
+    const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
+    if (!cartesian && !p_.shells) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
+    if (p_.shells && ctx.pipeline.shaded() && r.projection == Projection::Composite)
+        throw Error(where + "does not shade (remove volume.shading)");
     if (ctx.pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
     if (ctx.pipeline.classifier().needs_gradient())
         throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
-    domain_lo_ = volume.domain_min();
-    domain_hi_ = volume.domain_max();
+    const double inf = std::numeric_limits<double>::infinity();
+    domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
+    domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
+    step_ = ctx.step;
+    if (p_.step_size_over_n && r.step_units == StepUnits::Voxel) {
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (cartesian ? volume.spacing[a] < volume.spacing[axis] : volume.dims[a] > volume.dims[axis]) axis = a;
+        const double n = double(volume.dims[std::size_t(axis)]);
+        if (n > 1.0) step_ = ctx.step * (n - 1.0) / n;
+    }
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
                                                : p_.gradient_offset * volume.spacing;
     const auto [vmin, vmax] = volume.value_range();
@@ -44,7 +58,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
             const Classified k = c.classify(x, 0.0);
             table_[std::size_t(j)] = glm::dvec4(k.color, k.opacity);
             // VTK corrects the table entries (not the interpolated opacity) for the sample distance.
-            table_alpha_[std::size_t(j)] = alpha(k.opacity, ctx.step);
+            table_alpha_[std::size_t(j)] = alpha(k.opacity, step_);
             (void)l;
         }
     }
@@ -77,7 +91,9 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
     }
     // GL_LINEAR over N texels with CLAMP_TO_EDGE: texel position s N - 0.5.
     const int n = p_.table_entries;
-    const double pos = std::clamp(normalised(v) * double(n) - 0.5, 0.0, double(n - 1));
+    const double u = p_.scaled_table ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
+                                     : normalised(v);
+    const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
     const int i = std::min(int(pos), n - 2);
     const double w = pos - double(i);
     const glm::dvec4 e = table_[std::size_t(i)] + w * (table_[std::size_t(i) + 1] - table_[std::size_t(i)]);
@@ -100,7 +116,7 @@ glm::dvec3 ProfileIntegrator::gradient(const glm::dvec3& x) const {
 
 template <class Fn>
 void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const {
-    const double h = ctx_.step;
+    const double h = step_;
     if (p_.placement == Profile::Placement::Midpoints) {
         for_each_segment(intervals, h, [&](const Segment& s) { return fn(s.midpoint(), s.length()); });
         return;
@@ -152,6 +168,7 @@ PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<I
 
 template <class Rec>
 PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    if (p_.lerp_back_to_front) return composite_lerp(ray, intervals, rec);
     glm::dvec3 C(0.0);
     double A = 0.0;
     const Shader* shader = ctx_.pipeline.shader();
@@ -202,13 +219,49 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
     return out;
 }
 
+// sum = lerp(sum, col, col.a density) from the far end; samples with s < the iso threshold skipped.
+template <class Rec>
+PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    std::vector<std::pair<double, double>> samples;
+    for_each_sample(intervals, [&](double t, double d) {
+        samples.emplace_back(t, d);
+        return true;
+    });
+    const ProfileOptions& o = ctx_.render.profile_options;
+    glm::dvec4 sum(0.0);
+    for (auto it = samples.rbegin(); it != samples.rend(); ++it) {
+        const auto [t, d] = *it;
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        const bool used = std::isfinite(v) && !(p_.iso_skip && normalised(v) < o.iso_threshold);
+        const Lookup k = used ? lookup(v, d) : Lookup{};
+        const double w = k.opacity * o.density;
+        if (used) sum += (glm::dvec4(k.color, k.opacity) - sum) * w;
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            r.sample.classified = used;
+            r.sample.classified_color = k.color;
+            r.sample.opacity = k.opacity;
+            r.sample.color = k.color;
+            r.composited = true;
+            r.alpha = used ? w : 0.0;
+            r.accumulated = sum;
+            rec.recorder.record(r);
+        }
+    }
+    PixelValue out;
+    out.rgba = sum;
+    return out;
+}
+
 template <class Rec>
 PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum,
                                        Rec& rec) const {
     bool any = false;
     double best = 0.0;
     auto pixel = [&](double v) {
-        const Lookup k = lookup(v, ctx_.step);
+        const Lookup k = lookup(v, step_);
         return glm::dvec4(k.opacity * k.color, k.opacity);
     };
     for_each_sample(intervals, [&](double t, double d) {
@@ -244,7 +297,11 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
     double sum = 0.0, length = 0.0;
     const Classifier& c = ctx_.pipeline.classifier();
     const bool weighted = mean && p_.average_opacity_weighted;
-    auto result = [&]() { return mean ? (length > 0.0 ? sum / length : 0.0) : ctx_.render.gain * sum; };
+    double maximum = -std::numeric_limits<double>::infinity();
+    auto result = [&]() {
+        if (!mean && p_.xray_maximum) return ctx_.render.profile_options.brightness * (length > 0.0 ? maximum : 0.0);
+        return mean ? (length > 0.0 ? sum / length : 0.0) : ctx_.render.gain * sum;
+    };
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
         const double v = value(x);
@@ -252,6 +309,7 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
         if (std::isfinite(v)) {
             s = weighted ? lookup(v, d).opacity * normalised(v) : c.coordinate(v);
             sum += weighted ? s : s * d;
+            maximum = std::max(maximum, normalised(v));
             length += weighted ? 1.0 : d;
         }
         if constexpr (Rec::kOn) {

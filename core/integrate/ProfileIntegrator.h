@@ -10,7 +10,8 @@
 //   mip/minip: v* = max/min v_k, pixel (a(v*) c(v*), a(v*)) with the uncorrected opacity;
 //   average:   profile.average_opacity_weighted: g = mean_k a(v_k) s_k; otherwise g = the weighted
 //              mean of the transfer function's coordinate; pixel (g, g, g, 1);
-//   xray:      g = gain * sum_k coordinate(v_k) d_k; pixel (g, g, g, 1).
+//   xray:      g = gain * sum_k coordinate(v_k) d_k (xray_maximum: brightness * max_k s_k); pixel (g, g, g, 1).
+//   composite with lerp_back_to_front: sum = lerp(sum, (c, a), a density) from the far end, pixel sum.
 #pragma once
 #include <vector>
 
@@ -54,6 +55,8 @@ private:
     template <class Rec>
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>
+    PixelValue composite_lerp(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum, Rec& rec) const;
     template <class Rec>
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean, Rec& rec) const;
@@ -61,6 +64,7 @@ private:
     const Profile& p_;
     glm::dvec3 domain_lo_, domain_hi_;
     glm::dvec3 offset_;  // per-axis gradient offset, world units
+    double step_ = 0.0;  // the profile's step, world units
     double lo_ = 0.0, width_ = 0.0;  // the data range [lo, lo + width]
     std::vector<glm::dvec4> table_;  // rgb + uncorrected opacity
     std::vector<double> table_alpha_;  // corrected for the step (composite)

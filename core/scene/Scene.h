@@ -146,7 +146,14 @@ enum class StepUnits { Voxel, World };
 // `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
 enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray };
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear };
+// render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
+struct ProfileOptions {
+    double density = 1.0;         // the lerp weight is col.a * density
+    double transfer_scale = 1.0;  // the table is read at s * transfer_scale
+    double iso_threshold = 0.0;   // samples with s below it are skipped (s: value normalised over the data range)
+    double brightness = 1.0;      // x-ray: the maximum of s times this
+};
 
 struct RenderSpec {
     Projection projection = Projection::Composite;
@@ -159,6 +166,7 @@ struct RenderSpec {
     IntegrationMethod integrator = IntegrationMethod::Fixed;
     double tolerance = 1e-6;              // adaptive: absolute error per channel, > 0
     ProfileId profile = ProfileId::Reference;
+    ProfileOptions profile_options;
 };
 
 struct Scene {

@@ -669,7 +669,7 @@ ImageSpec read_image(const Json& v, const std::string& path, const Context& ctx)
 RenderSpec read_render(const Json& v, const std::string& path, const Context& ctx) {
     ObjectReader r(v, path, ctx);
     r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
-             "profile", "gain"});
+             "profile", "profile_options", "gain"});
     RenderSpec s;
     s.projection = r.choice<Projection>("projection", Projection::Composite,
                                         {{"composite", Projection::Composite},
@@ -696,8 +696,18 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                     {{"reference", ProfileId::Reference},
                                      {"vtk-gpu", ProfileId::VtkGpu},
                                      {"glsl-basic", ProfileId::GlslBasic},
-                                     {"ospray", ProfileId::Ospray}},
-                                    {"vtk-cpu", "cuda-curvilinear"});
+                                     {"ospray", ProfileId::Ospray},
+                                     {"cuda-curvilinear", ProfileId::CudaCurvilinear}},
+                                    {"vtk-cpu"});
+    if (const Json* o = r.find("profile_options")) {
+        if (s.profile != ProfileId::CudaCurvilinear) r.fail("profile_options", "only the cuda-curvilinear profile has options");
+        ObjectReader po(*o, r.path("profile_options"), ctx);
+        po.allow({"density", "transfer_scale", "iso_threshold", "brightness"});
+        s.profile_options.density = po.number("density", 1.0, Range::non_negative());
+        s.profile_options.transfer_scale = po.number("transfer_scale", 1.0, Range::non_negative());
+        s.profile_options.iso_threshold = po.number("iso_threshold", 0.0);
+        s.profile_options.brightness = po.number("brightness", 1.0, Range::non_negative());
+    }
     s.gain = r.number("gain", 1.0, Range::positive());
     if (s.projection == Projection::FirstHit && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
     return s;

@@ -132,3 +132,39 @@ TEST(Profiles, TraceRecordsTheProfilesSamples) {
     EXPECT_EQ(traced.rgba, rendered.rgba);
     EXPECT_EQ(list.rows.back().accumulated, rendered.rgba);
 }
+
+// cuda-curvilinear on the constant box (dims 5, chord 4), step 0.5625 voxel: a voxel is size / n =
+// 4 / 5, so h = 0.45 and the samples lie at 0, 0.45, ..., 3.6 (9). Each lerps sum towards
+// col = (0.2, 0.4, 0.6, 0.1) by w = 0.1 * density = 0.2: sum = col (1 - 0.8^9).
+TEST(Profiles, CudaCurvilinearConstantBoxByHand) {
+    Scene s = box_scene(ProfileId::CudaCurvilinear, 0.5, 0.1, 5, 0.5625);
+    s.render.step_units = StepUnits::Voxel;
+    s.render.profile_options.density = 2.0;
+    const glm::dvec4 p = rgba(render_scene(s, {1, false}), 0, 0);
+    const double f = 1.0 - std::pow(0.8, 9);
+    EXPECT_NEAR(p.r, 0.2 * f, 1e-12);
+    EXPECT_NEAR(p.b, 0.6 * f, 1e-12);
+    EXPECT_NEAR(p.a, 0.1 * f, 1e-12);
+}
+
+// cuda-curvilinear on f = z (opacity a = v / 4 = s), step 0.5 world: samples at z = 4, 3.5, ..., 0.
+// Iso threshold 0.5 keeps s = 1, 0.875, 0.75, 0.625, 0.5. The 9-entry table holds a_j = j / 8 and is
+// read at 9 s - 0.5 (clamped to [0, 8]): a = 1, 0.921875, 0.78125, 0.640625, 0.5. Back to front
+// (from s = 0.5), density 0.5: w = a / 2, R = lerp(R, 1, w) (white), A = lerp(A, a, w).
+// X-ray: brightness times the largest s (1, at the entry).
+TEST(Profiles, CudaCurvilinearIsoThresholdAndXrayByHand) {
+    Scene s = ramp_scene(ProfileId::CudaCurvilinear, Projection::Composite);
+    s.render.profile_options.iso_threshold = 0.5;
+    s.render.profile_options.density = 0.5;
+    const glm::dvec4 p = rgba(render_scene(s, {1, false}), 0, 0);
+    double R = 0.0, A = 0.0;
+    for (double a : {0.5, 0.640625, 0.78125, 0.921875, 1.0}) {
+        R = R + (1.0 - R) * (0.5 * a);
+        A = A + (a - A) * (0.5 * a);
+    }
+    EXPECT_NEAR(p.r, R, 1e-12);
+    EXPECT_NEAR(p.a, A, 1e-12);
+    Scene x = ramp_scene(ProfileId::CudaCurvilinear, Projection::Xray);
+    x.render.profile_options.brightness = 0.7;
+    EXPECT_NEAR(rgba(render_scene(x, {1, false}), 0, 0).r, 0.7, 1e-12);
+}

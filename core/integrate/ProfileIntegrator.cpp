@@ -22,7 +22,8 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     const RenderSpec& r = ctx.render;
     if (r.projection == Projection::FirstHit) throw Error(where + "does not render the first-hit projection");
     if (r.integrator != IntegrationMethod::Fixed) throw Error(where + "needs render.integrator \"fixed\"");
-    if (r.order != CompositeOrder::FrontToBack) throw Error(where + "composites front to back (render.order)");
+    if (r.order != CompositeOrder::FrontToBack)
+        throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
     const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
     if (!cartesian && !p_.shells) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");

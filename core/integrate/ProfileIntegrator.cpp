@@ -51,7 +51,6 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     if (p_.table_entries > 1) {
         const int n = p_.table_entries;
         const Classifier& c = ctx.pipeline.classifier();
-        const double l = c.unit_distance();
         table_.resize(std::size_t(n));
         table_alpha_.resize(std::size_t(n));
         for (int j = 0; j < n; ++j) {
@@ -60,7 +59,6 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
             table_[std::size_t(j)] = glm::dvec4(k.color, k.opacity);
             // VTK corrects the table entries (not the interpolated opacity) for the sample distance.
             table_alpha_[std::size_t(j)] = alpha(k.opacity, step_);
-            (void)l;
         }
     }
 }

@@ -892,6 +892,13 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-cpu"})"), "render.profile", "not implemented yet"));
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-gpu"})")).render.profile, ProfileId::VtkGpu);
     EXPECT_EQ(parse(scene_with(R"("render": {})")).render.profile, ProfileId::Reference);
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-gpu", "profile_options": {}})"),
+                           "render.profile_options", "only the cuda-curvilinear profile"));
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "cuda-curvilinear", "profile_options": {"gain": 1}})"),
+                           "render.profile_options.gain", "unknown key"));
+    EXPECT_EQ(parse(scene_with(R"("render": {"profile": "cuda-curvilinear", "profile_options": {"density": 0.25}})"))
+                  .render.profile_options.density,
+              0.25);
     EXPECT_TRUE(fails_with(R"({"volumes": [{"source": "a.nrrd"}, {"source": "b.nrrd"}]})", "volumes",
                            "several volumes are not implemented yet"));
 }

@@ -12,10 +12,10 @@
 #include "cli/Commands.h"
 #include "cli/ExplainCommand.h"
 #include "cli/TraceCommand.h"
-#include "cli/CompareCommand.h"
-#include "cli/SweepCommand.h"
 #include "cli/ConvertCommand.h"
 #include "cli/InfoCommand.h"
+#include "cli/CompareCommand.h"
+#include "cli/SweepCommand.h"
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
@@ -73,21 +73,6 @@ int main(int argc, char** argv) {
     rs->add_option("--encoding", resample.encoding, "Output encoding: raw (default) or gzip");
     rs->add_option("--format", resample.format, "Input format: nrrd or raw (default: from the extension)");
 
-    volref::cli::InfoArgs info;
-    CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");
-    ic->add_option("file", info.input, "Volume file (.nrrd .nhdr .raw .nii .nii.gz .mhd .mha .vtk .vti .den)")->required();
-    ic->add_option("--format", info.format, "nrrd, raw, nifti, metaimage, vtk, vti or den (default: from the extension)");
-    ic->add_flag("--json", info.json, "Print JSON instead of text");
-    ic->add_option("--bins", info.bins, "Histogram bins (default 16)");
-
-    volref::cli::ConvertArgs convert;
-    CLI::App* cv = app.add_subcommand("convert", "Convert a volume file to NRRD (.nrrd) or raw + JSON sidecar (.raw)");
-    cv->add_option("input", convert.input, "Input volume (any format `volref info` reads)")->required();
-    cv->add_option("output", convert.output, "Output volume: .nrrd or .raw (+ .raw.json)")->required();
-    cv->add_option("--format", convert.format, "Input format (default: from the extension)");
-    cv->add_option("--type", convert.type, "Output type: f64 (NRRD default) or f32; raw: u8..f64 (default: the input's)");
-    cv->add_option("--encoding", convert.encoding, "raw (default) or gzip");
-
     volref::cli::CompareArgs compare;
     CLI::App* cmp = app.add_subcommand(
         "compare", "Compare two images: max abs, mean abs, RMSE, PSNR, SSIM, pixels over a tolerance; exit 0 within "
@@ -106,6 +91,21 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     cmp->add_flag("--fit", compare.fit, "Fit a gain, an opacity exponent and a sub-pixel shift; name the likely cause");
     cmp->add_flag("--json", compare.json, "Print the report as JSON");
+
+    volref::cli::InfoArgs info;
+    CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");
+    ic->add_option("file", info.input, "Volume file (.nrrd .nhdr .raw .nii .nii.gz .mhd .mha .vtk .vti .den)")->required();
+    ic->add_option("--format", info.format, "nrrd, raw, nifti, metaimage, vtk, vti or den (default: from the extension)");
+    ic->add_flag("--json", info.json, "Print JSON instead of text");
+    ic->add_option("--bins", info.bins, "Histogram bins (default 16)");
+
+    volref::cli::ConvertArgs convert;
+    CLI::App* cv = app.add_subcommand("convert", "Convert a volume file to NRRD (.nrrd) or raw + JSON sidecar (.raw)");
+    cv->add_option("input", convert.input, "Input volume (any format `volref info` reads)")->required();
+    cv->add_option("output", convert.output, "Output volume: .nrrd or .raw (+ .raw.json)")->required();
+    cv->add_option("--format", convert.format, "Input format (default: from the extension)");
+    cv->add_option("--type", convert.type, "Output type: f64 (NRRD default) or f32; raw: u8..f64 (default: the input's)");
+    cv->add_option("--encoding", convert.encoding, "raw (default) or gzip");
 
     volref::cli::TraceArgs trace;
     CLI::App* tc = app.add_subcommand("trace", "Every sample along one pixel's ray, as CSV or JSON (docs/trace.md)");
@@ -156,8 +156,6 @@ int main(int argc, char** argv) {
         if (!max_memory.empty()) volref::set_memory_limit(volref::parse_memory_size(max_memory, "--max-memory"));
         if (rc->parsed()) return volref::cli::run_render(render);
         if (rs->parsed()) return volref::cli::run_resample(resample);
-        if (ic->parsed()) return volref::cli::run_info(info);
-        if (cv->parsed()) return volref::cli::run_convert(convert);
         if (cmp->parsed()) {
             // compare's exit status 1 means "differs": bad input exits 2 (docs/compare.md).
             try {
@@ -169,6 +167,8 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
+        if (ic->parsed()) return volref::cli::run_info(info);
+        if (cv->parsed()) return volref::cli::run_convert(convert);
         if (tc->parsed()) return volref::cli::run_trace(trace);
         if (ex->parsed()) {
             explain.args = ex->remaining();

@@ -81,7 +81,10 @@ TriangleMesh read_obj(const std::string& path) {
 TriangleMesh read_ply(const std::string& path) {
     if (!std::filesystem::is_regular_file(path)) throw Error(path + ": cannot read the PLY file (no such file)");
     Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate);
+    // No post-processing: assimp's Triangulate step aborts the process on a face with an out-of-range
+    // vertex index (found by fuzz_ply; tests/fuzz/regressions/fuzz_ply/). Polygons are fanned below,
+    // after every index has been checked.
+    const aiScene* scene = importer.ReadFile(path, 0u);
     if (!scene || !scene->mRootNode) {
         const std::string why = first_line(importer.GetErrorString());
         throw Error(path + ": cannot read the PLY file" + (why.empty() ? "" : " (" + why + ")"));
@@ -95,14 +98,15 @@ TriangleMesh read_ply(const std::string& path) {
         for (unsigned f = 0; f < am->mNumFaces; ++f) {
             const aiFace& face = am->mFaces[f];
             if (face.mNumIndices < 3) continue;  // points and lines bound nothing
-            if (face.mNumIndices != 3) throw Error(path + ": the PLY file has a face assimp did not triangulate");
-            std::array<std::uint32_t, 3> t{};
-            for (int k = 0; k < 3; ++k) {
-                const unsigned vi = face.mIndices[k];
-                if (vi >= am->mNumVertices) throw Error(path + ": the PLY file has a face with an invalid vertex index");
-                t[std::size_t(k)] = base + vi;
-            }
-            mesh.triangles.push_back(t);
+            for (unsigned k = 0; k < face.mNumIndices; ++k)
+                if (face.mIndices[k] >= am->mNumVertices)
+                    throw Error(path + ": the PLY file's face " + std::to_string(f) + " has an invalid vertex index " +
+                                std::to_string(face.mIndices[k]) + " (" + std::to_string(am->mNumVertices) +
+                                " vertices)");
+            // A polygon v0 v1 ... v(n-1) becomes the fan (v0, vk, vk+1): exact for the planar convex faces
+            // of a bounding mesh; the closedness check rejects anything the fan leaves open.
+            for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+                mesh.triangles.push_back({base + face.mIndices[0], base + face.mIndices[k], base + face.mIndices[k + 1]});
         }
     }
     return mesh;

@@ -21,7 +21,7 @@ for t in "${targets[@]}"; do
   mkdir -p "$scratch/$t" "tests/fuzz/regressions/$t"
   echo "fuzz.sh: $t for ${seconds} s" >&2
   # -rss_limit_mb: the targets run under a 256 MiB volref memory limit (tests/fuzz/FuzzTarget.h).
-  if ! ASAN_OPTIONS=detect_leaks=1 "$build/tests/fuzz/$t" "$scratch/$t" "tests/fuzz/corpus/$t" \
+  if ! ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp" "$build/tests/fuzz/$t" "$scratch/$t" "tests/fuzz/corpus/$t" \
        -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=20 -print_final_stats=1 \
        -artifact_prefix="tests/fuzz/regressions/$t/" >"$scratch/$t.log" 2>&1; then
     echo "fuzz.sh: $t found a failure (input saved in tests/fuzz/regressions/$t/):" >&2

@@ -21,6 +21,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/render/Renderer.h"
+#include "geometry/TriangleMesh.h"
 
 namespace fs = std::filesystem;
 using namespace volref;
@@ -288,4 +289,13 @@ TEST(Determinism, ThreadsTilesAndRuns) {
                     EXPECT_TRUE(bitwise_equal(im, first)) << "threads " << threads << " tile " << tile << " simd " << simd;
                 }
         }
+}
+
+// Fuzzing found that assimp's triangulation step aborts the process on this PLY file (a face whose
+// index list was cut by garbage); volref now reads PLY without assimp's post-processing and reports
+// the broken mesh as an error (docs/robustness.md, findings).
+TEST(FuzzRegressions, PlyThatAbortedAssimpIsAnError) {
+    const std::string path = std::string(VOLREF_SOURCE_DIR) + "/tests/fuzz/regressions/fuzz_ply/assimp-triangulate-abort.ply";
+    const std::string e = error_of([&] { read_closed_mesh(path); });
+    EXPECT_NE(e.find("assimp-triangulate-abort.ply"), std::string::npos) << e;
 }

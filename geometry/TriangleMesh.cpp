@@ -12,12 +12,10 @@
 #include <tuple>
 
 #include <glm/common.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <tiny_obj_loader.h>  // TINYOBJLOADER_USE_DOUBLE comes with the tinyobjloader_double target
 
 #include "core/Error.h"
+#include "geometry/PlyReader.h"
 
 namespace volref {
 
@@ -80,136 +78,6 @@ TriangleMesh read_obj(const std::string& path) {
     return mesh;
 }
 
-// The PLY header, checked by volref before assimp sees the file: assimp 5.2 (Debian 12) loops forever
-// or aborts on some malformed headers (found by fuzz_ply; tests/fuzz/regressions/fuzz_ply/). Accepted:
-//   ply / format ascii|binary_little_endian|binary_big_endian 1.0 / comment ... / obj_info ...
-//   element vertex N   with scalar properties only, among them x, y and z
-//   element face M     with exactly one list property (vertex_indices or vertex_index) and scalars
-//   other elements     with scalar properties only
-//   end_header
-// Types: char uchar short ushort int uint float double and int8 .. float64; counts <= 2^31 - 1.
-void check_ply_header(const std::string& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw Error(path + ": cannot read the PLY file");
-    std::string header;
-    int c = 0;
-    while (header.size() < (1u << 16) && (c = std::fgetc(f)) != EOF) {
-        header.push_back(char(c));
-        if (header.size() >= 11 && header.compare(header.size() - 11, 11, "end_header\n") == 0) break;
-        if (header.size() >= 12 && header.compare(header.size() - 12, 12, "end_header\r\n") == 0) break;
-    }
-    std::fclose(f);
-    auto fail = [&](int line, const std::string& why) {
-        throw Error(path + ": PLY header line " + std::to_string(line) + ": " + why);
-    };
-    static const char* kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8",
-                                   "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-    auto is_type = [](const std::string& t) { return std::find(std::begin(kTypes), std::end(kTypes), t) != std::end(kTypes); };
-    std::vector<std::string> lines;
-    std::string cur;
-    for (char ch : header) {
-        if (ch == '\n') {
-            if (!cur.empty() && cur.back() == '\r') cur.pop_back();
-            lines.push_back(cur);
-            cur.clear();
-        } else {
-            cur.push_back(ch);
-        }
-    }
-    if (lines.empty() || lines[0] != "ply") fail(1, "expected \"ply\"");
-    if (lines.back() != "end_header") fail(int(lines.size()), "no end_header within the first 64 KiB");
-    std::string element;
-    bool have_format = false, have_vertex = false, have_face = false, face_list = false;
-    bool x = false, y = false, z = false;
-    for (std::size_t i = 1; i + 1 < lines.size(); ++i) {
-        const int n = int(i) + 1;
-        std::vector<std::string> w;
-        std::string word;
-        for (char ch : lines[i]) {
-            if (ch == ' ' || ch == '\t') {
-                if (!word.empty()) w.push_back(word);
-                word.clear();
-            } else {
-                word.push_back(ch);
-            }
-        }
-        if (!word.empty()) w.push_back(word);
-        if (w.empty()) fail(n, "empty line");
-        if (w[0] == "comment" || w[0] == "obj_info") continue;
-        if (w[0] == "format") {
-            if (have_format || w.size() != 3 || w[2] != "1.0" ||
-                (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
-                fail(n, "expected one \"format ascii|binary_little_endian|binary_big_endian 1.0\"");
-            have_format = true;
-        } else if (w[0] == "element") {
-            if (w.size() != 3 || w[2].empty() || w[2].size() > 10 ||
-                w[2].find_first_not_of("0123456789") != std::string::npos || std::stoll(w[2]) > 0x7fffffffLL)
-                fail(n, "expected \"element NAME COUNT\" with 0 <= COUNT < 2^31");
-            if (element == "face" && !face_list) fail(n, "the face element has no list property");
-            element = w[1];
-            if ((element == "vertex" && have_vertex) || (element == "face" && have_face)) fail(n, "a second " + element + " element");
-            have_vertex = have_vertex || element == "vertex";
-            have_face = have_face || element == "face";
-        } else if (w[0] == "property") {
-            if (element.empty()) fail(n, "a property before any element");
-            if (w.size() == 5 && w[1] == "list") {
-                if (element != "face" || face_list || !is_type(w[2]) || !is_type(w[3]) ||
-                    (w[4] != "vertex_indices" && w[4] != "vertex_index"))
-                    fail(n, "only the face element may have a list property, one: vertex_indices");
-                face_list = true;
-            } else if (w.size() == 3 && is_type(w[1])) {
-                if (element == "vertex") {
-                    x = x || w[2] == "x";
-                    y = y || w[2] == "y";
-                    z = z || w[2] == "z";
-                }
-            } else {
-                fail(n, "expected \"property TYPE NAME\" or \"property list TYPE TYPE vertex_indices\"");
-            }
-        } else {
-            fail(n, "unknown keyword \"" + w[0].substr(0, 32) + "\"");
-        }
-    }
-    if (!have_format) fail(2, "no format line");
-    if (!have_vertex || !(x && y && z)) fail(int(lines.size()), "no vertex element with x, y and z");
-    if (!have_face || !face_list) fail(int(lines.size()), "no face element with a vertex_indices list");
-}
-
-TriangleMesh read_ply(const std::string& path) {
-    if (!std::filesystem::is_regular_file(path)) throw Error(path + ": cannot read the PLY file (no such file)");
-    check_ply_header(path);
-    Assimp::Importer importer;
-    // No post-processing: assimp's Triangulate step aborts the process on a face with an out-of-range
-    // vertex index (found by fuzz_ply; tests/fuzz/regressions/fuzz_ply/). Polygons are fanned below,
-    // after every index has been checked.
-    const aiScene* scene = importer.ReadFile(path, 0u);
-    if (!scene || !scene->mRootNode) {
-        const std::string why = first_line(importer.GetErrorString());
-        throw Error(path + ": cannot read the PLY file" + (why.empty() ? "" : " (" + why + ")"));
-    }
-    TriangleMesh mesh;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-        const aiMesh* am = scene->mMeshes[m];
-        const std::uint32_t base = std::uint32_t(mesh.vertices.size());
-        for (unsigned i = 0; i < am->mNumVertices; ++i)
-            mesh.vertices.emplace_back(am->mVertices[i].x, am->mVertices[i].y, am->mVertices[i].z);
-        for (unsigned f = 0; f < am->mNumFaces; ++f) {
-            const aiFace& face = am->mFaces[f];
-            if (face.mNumIndices < 3) continue;  // points and lines bound nothing
-            for (unsigned k = 0; k < face.mNumIndices; ++k)
-                if (face.mIndices[k] >= am->mNumVertices)
-                    throw Error(path + ": the PLY file's face " + std::to_string(f) + " has an invalid vertex index " +
-                                std::to_string(face.mIndices[k]) + " (" + std::to_string(am->mNumVertices) +
-                                " vertices)");
-            // A polygon v0 v1 ... v(n-1) becomes the fan (v0, vk, vk+1): exact for the planar convex faces
-            // of a bounding mesh; the closedness check rejects anything the fan leaves open.
-            for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
-                mesh.triangles.push_back({base + face.mIndices[0], base + face.mIndices[k], base + face.mIndices[k + 1]});
-        }
-    }
-    return mesh;
-}
-
 }  // namespace
 
 void merge_coincident_vertices(TriangleMesh& mesh) {
@@ -245,7 +113,7 @@ TriangleMesh read_mesh(const std::string& path) {
     if (ext == ".obj")
         mesh = read_obj(path);
     else if (ext == ".ply")
-        mesh = read_ply(path);
+        mesh = read_ply_mesh(path);
     else
         throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj or .ply)");
     for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {

@@ -1,9 +1,9 @@
 // TriangleMesh: a closed triangle mesh bounding a volume (scene key volume.bounds with type "mesh").
 //
 // Loading (read_mesh): .obj through tinyobjloader (its double-precision build: coordinates are read
-// as double; polygons are triangulated by tinyobjloader), .ply through assimp (ASCII and binary;
-// assimp reads coordinates as float, so PLY vertices are exact for float PLY files and rounded to
-// float otherwise; polygons are triangulated by assimp). Vertices at exactly the same position are
+// as double; polygons are triangulated by tinyobjloader), .ply by volref's own reader (geometry/PlyReader.h:
+// ASCII and binary, coordinates exact as double, polygons fanned; assimp was replaced after fuzzing
+// found it aborting, hanging and exhausting memory on malformed files). Vertices at exactly the same position are
 // merged, so files that repeat a vertex per face (as many exporters do) still form closed meshes.
 // Points and lines in the file are ignored. Errors are volref::Error one-liners naming the file.
 //

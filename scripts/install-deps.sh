@@ -6,8 +6,8 @@ packages=(
   libembree-dev libtbb-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev zlib1g-dev
   # openimageio-tools: OpenImageIO's CMake package lists its command-line tools and fails without them
   libhwy-dev libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  # bounding meshes: OBJ (tinyobjloader, its double-precision build) and PLY (assimp)
-  libtinyobjloader-dev libassimp-dev
+  # bounding meshes: OBJ (tinyobjloader, its double-precision build); PLY is read by volref itself
+  libtinyobjloader-dev
   # volume formats: NIfTI-1/2 (nifti_clib) and VTK XML ImageData headers (expat)
   libnifti2-dev libexpat1-dev
   # volref compare --fit and volref sweep: least-squares fits (Ceres) and the error-against-time plot (gnuplot)

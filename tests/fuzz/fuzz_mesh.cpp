@@ -1,4 +1,4 @@
-// libFuzzer target for a bounding-mesh reader (OBJ through tinyobjloader, PLY through assimp): the
+// libFuzzer target for a bounding-mesh reader (OBJ through tinyobjloader, PLY by geometry/PlyReader): the
 // input is a whole mesh file named "input" + VOLREF_FUZZ_EXTENSION, read and checked for closedness
 // as a scene's bounds.mesh is.
 #include "core/Error.h"

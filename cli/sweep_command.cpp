@@ -308,10 +308,8 @@ int run_sweep(const SweepArgs& args) {
         plot.series.push_back(std::move(s));
     }
     plot_error_against_time(plot, work.path, png_tmp, svg_tmp);
-    for (const auto& [from, to] : {std::pair{csv_tmp, csv_path}, {png_tmp, png_path}, {svg_tmp, svg_path}}) {
-        fs::rename(from, to, ec);
-        if (ec) throw Error(to.string() + ": cannot move the finished file into place: " + ec.message());
-    }
+    for (const auto& [from, to] : {std::pair{csv_tmp, csv_path}, {png_tmp, png_path}, {svg_tmp, svg_path}})
+        commit_output(from, to);
     std::printf("wrote %s, %s, %s\n", csv_path.string().c_str(), png_path.string().c_str(), svg_path.string().c_str());
     return 0;
 }

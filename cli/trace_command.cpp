@@ -45,7 +45,7 @@ int run_trace(const TraceArgs& args) {
             throw Error(args.output.string() + ": cannot write");
         }
     }
-    std::filesystem::rename(tmp, args.output);
+    commit_output(tmp, args.output);
     std::fprintf(stderr, "volref: traced pixel (%d, %d): %zu samples\n", pixel[0], pixel[1], trace.samples.size());
     return 0;
 }

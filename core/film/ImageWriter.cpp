@@ -9,7 +9,6 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
 
@@ -98,15 +97,7 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
         fs::remove(tmp, ec);
         throw Error(path.string() + ": cannot write the image: " + why);
     }
-    if (cancel_requested()) {  // interrupted while writing: the finished file is not put in place
-        fs::remove(tmp, ec);
-        throw_if_cancelled();
-    }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error(path.string() + ": cannot move the finished image into place: " + ec.message());
-    }
+    commit_output(tmp, path);
 }
 
 }  // namespace volref

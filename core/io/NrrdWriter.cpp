@@ -16,7 +16,6 @@
 
 #include <zlib.h>
 
-#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
 
@@ -233,16 +232,7 @@ void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptio
         fs::remove(tmp, ec);
         throw;
     }
-    if (cancel_requested()) {  // interrupted while writing: the finished file is not put in place
-        fs::remove(tmp, ec);
-        throw_if_cancelled();
-    }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        std::error_code ignored;
-        fs::remove(tmp, ignored);
-        throw Error(at + "cannot move the finished file into place: " + ec.message());
-    }
+    commit_output(tmp, path);
 }
 
 }  // namespace volref

@@ -9,6 +9,7 @@
 #include <string>
 #include <system_error>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace volref {
@@ -33,6 +34,20 @@ void check_output_folder(const fs::path& path) {
     } else {
         ::close(fd);
         fs::remove(probe, ec);
+    }
+}
+
+void commit_output(const fs::path& tmp, const fs::path& path) {
+    std::error_code ec;
+    if (cancel_requested()) {
+        fs::remove(tmp, ec);
+        throw_if_cancelled();
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        std::error_code ignored;
+        fs::remove(tmp, ignored);
+        throw Error(path.string() + ": cannot move the finished file into place: " + ec.message());
     }
 }
 

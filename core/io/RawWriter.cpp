@@ -136,8 +136,7 @@ void write_raw(const Volume& volume, const fs::path& path, const RawWriteOptions
     try {
         write_file(tmp_data, data, at);
         write_file(tmp_sidecar, sidecar, at);
-        fs::rename(tmp_data, path, ec);
-        if (ec) throw Error(at + "cannot move the finished file into place: " + ec.message());
+        commit_output(tmp_data, path);
         fs::rename(tmp_sidecar, sidecar_path, ec);
         if (ec) {
             std::error_code ignored;

@@ -101,7 +101,10 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
                         (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
     // Memory (core/MemoryLimit.h): what is held (the volume) plus what is about to be allocated.
     const std::size_t voxels = volume.values.size(), volume_bytes = voxels * sizeof(double);
-    const std::size_t image_bytes = std::size_t(scene.image.width) * std::size_t(scene.image.height) * 6 * sizeof(double);
+    // At most 6 channels (R G B A, Z for first-hit, error) of doubles (docs/conventions.md section 13).
+    constexpr std::size_t kMaxImageChannels = 6;
+    const std::size_t image_bytes =
+        std::size_t(scene.image.width) * std::size_t(scene.image.height) * kMaxImageChannels * sizeof(double);
     check_memory(volume_bytes + image_bytes, "image: " + std::to_string(scene.image.width) + " x " +
                                                  std::to_string(scene.image.height) + " pixels with the volume");
     if (shades || classifier->needs_gradient()) {

@@ -72,7 +72,7 @@ Scene reference_scene(const std::string& name) {
 
 Scene ml256(int size) {
     Scene s = reference_scene("default");
-    s.volume.source.field->dims = {256, 256, 256};
+    s.volume().source.field->dims = {256, 256, 256};
     s.camera = volref::CameraSpec{};  // the default camera: looking along -z, bounding sphere in view
     s.image.width = s.image.height = size;
     return s;
@@ -85,7 +85,7 @@ Scene default_shaded() {
     shading.kd = 0.7;
     shading.ks = 0.3;
     shading.n = 10.0;
-    s.volume.shading = shading;
+    s.volume().shading = shading;
     return s;
 }
 
@@ -106,11 +106,11 @@ struct SampleCount {
 
 // The segments every pixel's ray is cut into, as render_scene places them (see the header comment).
 SampleCount count_samples(const Scene& scene) {
-    const volref::Volume volume = volref::load_volume(scene.volume);
+    const volref::Volume volume = volref::load_volume(scene.volume());
     const double step = volref::world_step(scene.render, volume);
     const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
-    const glm::dvec3 box_lo = scene.volume.bounds.min.value_or(domain_lo);
-    const glm::dvec3 box_hi = scene.volume.bounds.max.value_or(domain_hi);
+    const glm::dvec3 box_lo = scene.volume().bounds.min.value_or(domain_lo);
+    const glm::dvec3 box_hi = scene.volume().bounds.max.value_or(domain_hi);
     volref::BoundingGeometry geometry;
     const int id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
     geometry.commit();

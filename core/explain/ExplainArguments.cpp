@@ -146,7 +146,7 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
             const glm::dvec3 at = vec3("--at", o.one("--at"));
             const Scene scene = scene_of(o);
             VolumeModel model;
-            build_volume_model(scene.volume, model);
+            build_volume_model(scene.volume(), model);
             if (!model.cartesian) throw Error("--scene: explain trilinear --at needs a Cartesian grid (box or mesh bounds)");
             return trilinear_at(*model.cartesian, at);
         }

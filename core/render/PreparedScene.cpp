@@ -31,7 +31,7 @@ bool is_shell(const BoundsSpec& b) {
 // away the spacing, or forward differences on an axis of two voxels (one-sided over x - lo, which can
 // be tiny).
 bool skipping_applies(const Scene& scene, const Classifier& classifier, const Volume& volume) {
-    const VolumeSpec& vs = scene.volume;
+    const VolumeSpec& vs = scene.volume();
     if (is_shell(vs.bounds)) return false;  // macrocells are Cartesian
     if (scene.render.projection != Projection::Composite) return false;
     if (vs.classification && vs.classification->type == ClassificationSpec::Type::Isovalue) return false;
@@ -83,7 +83,7 @@ void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
 }
 
 PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) : scene(scene_) {
-    const VolumeSpec& vs = scene.volume;
+    const VolumeSpec& vs = scene.volume();
     build_volume_model(vs, model);
     const Volume& volume = model.volume;
     const FieldSampler& sampler = *model.sampler;

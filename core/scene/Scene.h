@@ -171,7 +171,11 @@ struct RenderSpec {
 
 struct Scene {
     std::filesystem::path file;  // the scene file (for messages); empty for scenes built in code
-    VolumeSpec volume;
+    // `volumes` in the file (at least one); `volume` is the shorthand for a list of one.
+    std::vector<VolumeSpec> volumes{VolumeSpec{}};
+    // The first (for most scenes the only) volume.
+    VolumeSpec& volume() { return volumes.front(); }
+    const VolumeSpec& volume() const { return volumes.front(); }
     std::vector<LightSpec> lights{LightSpec{}};
     CameraSpec camera;
     ImageSpec image;

@@ -722,7 +722,7 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     r.allow({"description", "volume", "volumes", "lights", "camera", "image", "render"});
     r.optional_string("description");  // a note for humans; ignored
     Scene scene;
-    scene.volume = read_volume_key(r, base_dir);
+    scene.volume() = read_volume_key(r, base_dir);
     if (const Json* v = r.find("lights")) scene.lights = read_lights(*v, r.path("lights"), ctx);
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);

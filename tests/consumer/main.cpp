@@ -11,8 +11,8 @@ int main() {
     f.kind = volref::FieldSpec::Kind::Constant;
     f.value = 1.0;
     f.dims = {3, 3, 3};
-    s.volume.source.field = f;
-    s.volume.transfer.opacity = {{0.0, 0.5}};
+    s.volume().source.field = f;
+    s.volume().transfer.opacity = {{0.0, 0.5}};
     s.camera.type = volref::CameraSpec::Type::Orthographic;
     s.camera.eye = {1, 1, 5};
     s.camera.target = {1, 1, 0};

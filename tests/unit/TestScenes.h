@@ -18,9 +18,9 @@ inline CameraSpec ortho_down_z(double cx, double cy, double eye_z, double h) {
 
 inline Scene field_scene(FieldSpec field, glm::dvec3 origin = glm::dvec3(0.0), glm::dvec3 spacing = glm::dvec3(1.0)) {
     Scene s;
-    s.volume.source.field = std::move(field);
-    s.volume.origin = origin;
-    s.volume.spacing = spacing;
+    s.volume().source.field = std::move(field);
+    s.volume().origin = origin;
+    s.volume().spacing = spacing;
     return s;
 }
 

@@ -160,9 +160,9 @@ namespace {
 // whose rows fall inside cells, seen by one orthographic ray along `dir` through `target`.
 Scene linear_scene(glm::dvec3 dir, glm::dvec3 target) {
     Scene s = field_scene(linear_field({0.3, 0.2, 0.5, 0.0}, {5, 5, 5}));
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.7, 0.3}, {1.9, 0.05}, {2.6, 0.8}, {4.0, 0.1}};
-    s.volume.transfer.color = {{0.0, 1.0, 0.0, 0.2}, {1.3, 0.2, 1.0, 0.0}, {3.1, 0.0, 0.4, 1.0}};
-    s.volume.transfer.opacity_unit_distance = 1.5;
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.7, 0.3}, {1.9, 0.05}, {2.6, 0.8}, {4.0, 0.1}};
+    s.volume().transfer.color = {{0.0, 1.0, 0.0, 0.2}, {1.3, 0.2, 1.0, 0.0}, {3.1, 0.0, 0.4, 1.0}};
+    s.volume().transfer.opacity_unit_distance = 1.5;
     s.camera.type = CameraSpec::Type::Orthographic;
     s.camera.eye = target - 20.0 * glm::normalize(dir);
     s.camera.target = target;
@@ -192,8 +192,8 @@ TEST(Adaptive, LinearFieldPiecewiseLinearTransferMatchesQuadrature) {
         const glm::dvec3 x0 = ray.at(ivs[0].t0);
         const double f0 = 0.3 * x0.x + 0.2 * x0.y + 0.5 * x0.z;
         const double g = 0.3 * ray.direction.x + 0.2 * ray.direction.y + 0.5 * ray.direction.z;
-        const glm::dvec4 want = reference_emission_absorption(f0, g, ivs[0].t0, ivs[0].t1, s.volume.transfer.opacity,
-                                                              s.volume.transfer.color, 1.5);
+        const glm::dvec4 want = reference_emission_absorption(f0, g, ivs[0].t0, ivs[0].t1, s.volume().transfer.opacity,
+                                                              s.volume().transfer.color, 1.5);
         EXPECT_LT(max_abs_diff(got.rgba, want), 1e-9) << "dir " << dir.x << "," << dir.y << "," << dir.z;
         EXPECT_GT(want.a, 0.3);  // not a trivial ray
         EXPECT_LE(got.error, 1e-9);
@@ -208,11 +208,11 @@ TEST(Adaptive, ConstantFieldChordsClosedForm) {
         for (double l : {0.5, 1.0, 2.5})
             for (double a : {0.35, 0.999, 1e-9}) {
                 Scene s = field_scene(constant_field(2.0, {5, 5, 5}));
-                s.volume.bounds.min = glm::dvec3(0.0, 0.0, 0.2);
-                s.volume.bounds.max = glm::dvec3(4.0, 4.0, 0.2 + L);
-                s.volume.transfer.opacity = {{0.0, a}};
-                s.volume.transfer.color = {{0.0, 0.2, 0.6, 0.9}};
-                s.volume.transfer.opacity_unit_distance = l;
+                s.volume().bounds.min = glm::dvec3(0.0, 0.0, 0.2);
+                s.volume().bounds.max = glm::dvec3(4.0, 4.0, 0.2 + L);
+                s.volume().transfer.opacity = {{0.0, a}};
+                s.volume().transfer.color = {{0.0, 0.2, 0.6, 0.9}};
+                s.volume().transfer.opacity_unit_distance = l;
                 s.camera = ortho_down_z(2.1, 1.3, 10.0, 1.0);
                 s.image.width = s.image.height = 1;
                 s.render.integrator = IntegrationMethod::Adaptive;
@@ -255,8 +255,8 @@ TEST(Adaptive, MipIsTheCubicsMaximum) {
         f.dims = {2, 2, 2};
         f.values = {0, sgn, sgn, 0, sgn, 0, 0, 0};  // i fastest: (0,0,0) (1,0,0) (0,1,0) (1,1,0) (0,0,1) ...
         Scene s = field_scene(f);
-        s.volume.transfer.opacity = {{-1.0, 1.0}, {1.0, 1.0}};
-        s.volume.transfer.color = {{-1.0, 0.0, 0.0, 0.0}, {1.0, 1.0, 1.0, 1.0}};  // colour (v + 1) / 2
+        s.volume().transfer.opacity = {{-1.0, 1.0}, {1.0, 1.0}};
+        s.volume().transfer.color = {{-1.0, 0.0, 0.0, 0.0}, {1.0, 1.0, 1.0, 1.0}};  // colour (v + 1) / 2
         s.camera.type = CameraSpec::Type::Orthographic;
         s.camera.eye = {-5.0, -5.0, -5.0};
         s.camera.target = {0.5, 0.5, 0.5};
@@ -276,8 +276,8 @@ TEST(Adaptive, MipIsTheCubicsMaximum) {
 // A jump (two rows at one value) inside a cell: the adaptive result still matches the quadrature.
 TEST(Adaptive, TransferFunctionWithAJump) {
     Scene s = linear_scene({0.3, -0.8, 0.52}, {1.9, 2.1, 2.3});
-    s.volume.transfer.opacity = {{0.0, 0.05}, {1.7, 0.1}, {1.7, 0.9}, {4.0, 0.6}};
-    s.volume.transfer.color = {{0.0, 1, 0, 0}, {2.2, 0, 1, 0}, {2.2, 0, 0, 1}};
+    s.volume().transfer.opacity = {{0.0, 0.05}, {1.7, 0.1}, {1.7, 0.9}, {4.0, 0.6}};
+    s.volume().transfer.color = {{0.0, 1, 0, 0}, {2.2, 0, 1, 0}, {2.2, 0, 0, 1}};
     const PreparedScene p(s, {1, false});
     const Ray ray = p.pixel_ray(0, 0);
     const std::vector<Interval> ivs = p.intervals(ray);
@@ -285,8 +285,8 @@ TEST(Adaptive, TransferFunctionWithAJump) {
     const glm::dvec3 x0 = ray.at(ivs[0].t0);
     const double f0 = 0.3 * x0.x + 0.2 * x0.y + 0.5 * x0.z;
     const double g = 0.3 * ray.direction.x + 0.2 * ray.direction.y + 0.5 * ray.direction.z;
-    const glm::dvec4 want = reference_emission_absorption(f0, g, ivs[0].t0, ivs[0].t1, s.volume.transfer.opacity,
-                                                          s.volume.transfer.color, 1.5);
+    const glm::dvec4 want = reference_emission_absorption(f0, g, ivs[0].t0, ivs[0].t1, s.volume().transfer.opacity,
+                                                          s.volume().transfer.color, 1.5);
     EXPECT_LT(max_abs_diff(got.rgba, want), 1e-9);
 }
 
@@ -301,7 +301,7 @@ TEST(Adaptive, UnsupportedIsAnError) {
         EXPECT_NE(std::string(e.what()).find("render.integrator"), std::string::npos) << e.what();
     }
     s.render.early_termination.reset();
-    s.volume.interpolation = Interpolation::TricubicBSpline;
+    s.volume().interpolation = Interpolation::TricubicBSpline;
     s.render.projection = Projection::Mip;
     try {
         one_pixel(s);
@@ -319,9 +319,9 @@ Scene marschner_lobb_scene() {
     f.kind = FieldSpec::Kind::MarschnerLobb;
     f.dims = {17, 17, 17};
     Scene s = field_scene(f);
-    s.volume.transfer.color = {{0.0, 0.05, 0.15, 0.55}, {1.0, 1.0, 0.3, 0.1}};
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.35, 0.0}, {1.0, 0.9}};
-    s.volume.transfer.opacity_unit_distance = 2.0;
+    s.volume().transfer.color = {{0.0, 0.05, 0.15, 0.55}, {1.0, 1.0, 0.3, 0.1}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.35, 0.0}, {1.0, 0.9}};
+    s.volume().transfer.opacity_unit_distance = 2.0;
     s.camera.type = CameraSpec::Type::Perspective;
     s.camera.eye = {30.0, -14.0, 36.0};
     s.camera.target = {8.0, 8.0, 8.0};

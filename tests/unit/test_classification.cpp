@@ -93,7 +93,7 @@ TEST(Classification, IsovalueTentAlongTheGradient) {
     c.isovalues = {{5.0, 0.8, 2.0, {0.2, 0.4, 0.9}}};
     c.opacity_unit_distance = 1.5;
     Scene s = along_x(linear_field({1, 0, 0, 0}, {11, 3, 3}), 0.01);
-    s.volume.classification = c;
+    s.volume().classification = c;
     const glm::dvec4 p = rgba(render_scene(s, {1, false}), 0, 0);
     const double alpha = -std::expm1(2.0 * integral_log_transparency(0.0, 0.8, 2.0) / 1.5);
     EXPECT_NEAR(p.a, alpha, 5e-5);
@@ -109,7 +109,7 @@ TEST(Classification, RegionBoundariesOnALinearField) {
     c.type = ClassificationSpec::Type::Boundary;
     c.regions = {{4.0, 0.05, {1, 1, 1}}, {10.0, 0.3, {1, 1, 1}}, {16.0, 0.1, {1, 1, 1}}};
     Scene s = along_x(linear_field({2, 0, 0, 0}, {11, 3, 3}), 0.01);
-    s.volume.classification = c;
+    s.volume().classification = c;
     const glm::dvec4 p = rgba(render_scene(s, {1, false}), 0, 0);
     // x in [2, 5]: a from 0.1 to 0.6; x in [5, 8]: a from 0.6 to 0.2; 0 elsewhere.
     const double tau = -(integral_log_transparency(0.1, 0.6, 3.0) + integral_log_transparency(0.6, 0.2, 3.0));
@@ -127,10 +127,10 @@ TEST(Classification, PreAndPostAgreeOnlyForLinearTransferFunctions) {
     g.sigma = 2.0;
     Scene s = field_scene(g);
     s.image.width = s.image.height = 12;
-    s.volume.transfer.color = {{0, 0.3, 0.6, 0.9}};
-    s.volume.transfer.opacity = {{0, 0.0}, {1, 0.8}};
+    s.volume().transfer.color = {{0, 0.3, 0.6, 0.9}};
+    s.volume().transfer.opacity = {{0, 0.0}, {1, 0.8}};
     const Image post = render_scene(s, {1, false});
-    s.volume.classify = VolumeSpec::Classify::Pre;
+    s.volume().classify = VolumeSpec::Classify::Pre;
     const Image pre = render_scene(s, {1, false});
     double max_alpha = 0.0;
     for (std::size_t i = 0; i < post.pixels.size(); ++i) {
@@ -139,9 +139,9 @@ TEST(Classification, PreAndPostAgreeOnlyForLinearTransferFunctions) {
     }
     EXPECT_GT(max_alpha, 0.2);
     // A kinked opacity (0 below 0.5, then a ramp): pre and post differ.
-    s.volume.transfer.opacity = {{0, 0.0}, {0.5, 0.0}, {1, 0.8}};
+    s.volume().transfer.opacity = {{0, 0.0}, {0.5, 0.0}, {1, 0.8}};
     const Image pre2 = render_scene(s, {1, false});
-    s.volume.classify = VolumeSpec::Classify::Post;
+    s.volume().classify = VolumeSpec::Classify::Post;
     const Image post2 = render_scene(s, {1, false});
     double max_diff = 0.0;
     for (std::size_t i = 0; i < post2.pixels.size(); ++i)

@@ -17,12 +17,12 @@ TEST(Composite, ConstantFieldClosedForm) {
             for (double h : {0.1, 0.25, 0.3, 0.7, 5.0})
                 for (auto order : {CompositeOrder::FrontToBack, CompositeOrder::BackToFront}) {
                     Scene s = field_scene(constant_field(2.0, {5, 5, 5}));  // domain [0, 4]^3
-                    s.volume.bounds.min = glm::dvec3(0.0, 0.0, 0.2);
-                    s.volume.bounds.max = glm::dvec3(4.0, 4.0, 0.2 + L);
+                    s.volume().bounds.min = glm::dvec3(0.0, 0.0, 0.2);
+                    s.volume().bounds.max = glm::dvec3(4.0, 4.0, 0.2 + L);
                     const double a = 0.35;
-                    s.volume.transfer.opacity = {{0.0, a}};
-                    s.volume.transfer.color = {{0.0, 0.2, 0.6, 0.9}};
-                    s.volume.transfer.opacity_unit_distance = l;
+                    s.volume().transfer.opacity = {{0.0, a}};
+                    s.volume().transfer.color = {{0.0, 0.2, 0.6, 0.9}};
+                    s.volume().transfer.opacity_unit_distance = l;
                     s.camera = ortho_down_z(2.0, 2.0, 10.0, 1.0);
                     s.image.width = s.image.height = 1;
                     s.render.step = h;
@@ -41,8 +41,8 @@ TEST(Composite, ConstantFieldClosedForm) {
 // Opacity 1 is opaque: the pixel is the colour of the first segment, alpha exactly 1.
 TEST(Composite, OpaqueSegment) {
     Scene s = field_scene(linear_field({0, 0, 1, 0}, {3, 3, 5}));  // f = z on [0, 4]
-    s.volume.transfer.opacity = {{0.0, 0.0}, {3.0, 0.0}, {3.0, 1.0}};  // opaque where f >= 3
-    s.volume.transfer.color = {{0.0, 0, 0, 0}, {4.0, 1, 1, 1}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {3.0, 0.0}, {3.0, 1.0}};  // opaque where f >= 3
+    s.volume().transfer.color = {{0.0, 0, 0, 0}, {4.0, 1, 1, 1}};
     s.camera = ortho_down_z(1.0, 1.0, 10.0, 1.0);
     s.image.width = s.image.height = 1;
     s.render.step = 0.5;
@@ -66,9 +66,9 @@ Scene smooth_scene(double step) {
     g.sigma = 4.0;
     g.amplitude = 1.0;
     Scene s = field_scene(g, glm::dvec3(0.0), glm::dvec3(0.25));
-    s.volume.transfer.opacity = {{0.0, 0.0}, {1.0, 0.6}};
-    s.volume.transfer.color = {{0.0, 0.2, 0.3, 1.0}, {1.0, 1.0, 0.8, 0.1}};
-    s.volume.transfer.opacity_unit_distance = 4.0;
+    s.volume().transfer.opacity = {{0.0, 0.0}, {1.0, 0.6}};
+    s.volume().transfer.color = {{0.0, 0.2, 0.3, 1.0}, {1.0, 1.0, 0.8, 0.1}};
+    s.volume().transfer.opacity_unit_distance = 4.0;
     s.camera.type = CameraSpec::Type::Perspective;
     s.camera.eye = {8.0, 3.0, 40.0};
     s.camera.target = {8.0, 8.0, 8.0};
@@ -128,7 +128,7 @@ TEST(Composite, ConvergesWithOrderTwo) {
 // Early termination stops once alpha exceeds the threshold (front to back).
 TEST(Composite, EarlyTermination) {
     Scene s = field_scene(constant_field(1.0, {3, 3, 11}));  // z in [0, 10]
-    s.volume.transfer.opacity = {{0.0, 0.5}};
+    s.volume().transfer.opacity = {{0.0, 0.5}};
     s.camera = ortho_down_z(1.0, 1.0, 20.0, 1.0);
     s.image.width = s.image.height = 1;
     s.render.step = 1.0;

@@ -33,11 +33,11 @@ Image render(const Scene& s, bool skipping) {
 
 // The number of empty macrocells of the grid the renderer builds for `s`.
 std::int64_t empty_macrocells(const Scene& s) {
-    const Volume volume = load_volume(s.volume);
-    const VolumeSampler sampler(volume, s.volume.interpolation);
-    const auto classifier = make_classifier(s.volume, volume);
+    const Volume volume = load_volume(s.volume());
+    const VolumeSampler sampler(volume, s.volume().interpolation);
+    const auto classifier = make_classifier(s.volume(), volume);
     const MacrocellGrid grid(sampler, *classifier,
-                             s.volume.classify == VolumeSpec::Classify::Pre ? MacrocellGrid::Classification::Pre
+                             s.volume().classify == VolumeSpec::Classify::Pre ? MacrocellGrid::Classification::Pre
                                                                             : MacrocellGrid::Classification::Post);
     return grid.empty_count();
 }
@@ -91,8 +91,8 @@ Scene marschner_lobb_scene() {
     f.kind = FieldSpec::Kind::MarschnerLobb;
     f.dims = {45, 45, 45};
     Scene s = field_scene(f);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.8, 0.0}, {0.9, 0.6}, {1.0, 0.9}};
-    s.volume.transfer.color = {{0.0, 0.1, 0.2, 0.6}, {0.85, 1.0, 0.8, 0.3}, {1.0, 0.9, 0.1, 0.05}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.8, 0.0}, {0.9, 0.6}, {1.0, 0.9}};
+    s.volume().transfer.color = {{0.0, 0.1, 0.2, 0.6}, {0.85, 1.0, 0.8, 0.3}, {1.0, 0.9, 0.1, 0.05}};
     s.camera = perspective({110, -70, 95}, {22, 22, 22});
     s.image.width = s.image.height = 20;
     set_step(s, 0.5, StepUnits::Voxel);
@@ -108,9 +108,9 @@ Scene gaussian_scene() {
     g.center = {-3.3 + 18 * 0.7, 1.7 + 14 * 1.3, 0.1 + 16 * 0.9};
     g.sigma = 6.0;
     Scene s = field_scene(g, {-3.3, 1.7, 0.1}, {0.7, 1.3, 0.9});
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.55, 0.0}, {0.6, 0.8}, {0.65, 0.0}};
-    s.volume.transfer.color = {{0.0, 0.2, 0.3, 1.0}, {1.0, 1.0, 0.8, 0.1}};
-    s.volume.transfer.opacity_unit_distance = 2.0;
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.55, 0.0}, {0.6, 0.8}, {0.65, 0.0}};
+    s.volume().transfer.color = {{0.0, 0.2, 0.3, 1.0}, {1.0, 1.0, 0.8, 0.1}};
+    s.volume().transfer.opacity_unit_distance = 2.0;
     s.camera = perspective({60, -40, 50}, g.center, {0, 0, 1}, 45.0);
     s.image.width = s.image.height = 20;
     set_step(s, 0.37);
@@ -492,11 +492,11 @@ TEST(EmptySpace, Interpolations) {
                             Interpolation::TricubicCatmullRom})
         for (auto order : {CompositeOrder::FrontToBack, CompositeOrder::BackToFront}) {
             Scene s = gaussian_scene();
-            s.volume.interpolation = i;
+            s.volume().interpolation = i;
             s.render.order = order;
             expect_bitwise_equal(s, "interpolation " + std::to_string(int(i)));
             Scene m = marschner_lobb_scene();
-            m.volume.interpolation = i;
+            m.volume().interpolation = i;
             m.render.order = order;
             set_step(m, 0.61);
             expect_bitwise_equal(m, "ML interpolation " + std::to_string(int(i)));
@@ -505,28 +505,28 @@ TEST(EmptySpace, Interpolations) {
 
 TEST(EmptySpace, EarlyTerminationShadingGradientOpacity) {
     Scene s = gaussian_scene();
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.55, 0.0}, {0.6, 1.0}, {0.65, 0.9}, {0.8, 0.0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.55, 0.0}, {0.6, 1.0}, {0.65, 0.9}, {0.8, 0.0}};
     s.render.early_termination = 0.5;
     expect_bitwise_equal(s, "early termination");
     s.render.early_termination.reset();
-    s.volume.shading = ShadingSpec{};
+    s.volume().shading = ShadingSpec{};
     for (Interpolation i : {Interpolation::Trilinear, Interpolation::TricubicBSpline}) {
-        s.volume.interpolation = i;
+        s.volume().interpolation = i;
         expect_bitwise_equal(s, "shaded");
     }
-    s.volume.transfer.gradient_opacity = {{0.0, 0.0}, {0.2, 1.0}};
+    s.volume().transfer.gradient_opacity = {{0.0, 0.0}, {0.2, 1.0}};
     expect_bitwise_equal(s, "gradient opacity");
-    s.volume.gradient.cache = true;
+    s.volume().gradient.cache = true;
     expect_bitwise_equal(s, "cached gradient");
-    s.volume.gradient.cache = false;
-    s.volume.interpolation = Interpolation::Trilinear;
-    s.volume.gradient.scheme = GradientSpec::Scheme::Forward;
+    s.volume().gradient.cache = false;
+    s.volume().interpolation = Interpolation::Trilinear;
+    s.volume().gradient.scheme = GradientSpec::Scheme::Forward;
     expect_bitwise_equal(s, "forward gradient");
     // The normalised domain.
     Scene n = gaussian_scene();
-    n.volume.transfer.domain = TransferSpec::Domain::Normalized;
-    n.volume.transfer.window = std::array<double, 2>{-1.0, 3.0};
-    n.volume.transfer.opacity = {{0.0, 0.0}, {0.38, 0.0}, {0.4, 0.7}, {0.42, 0.0}};
+    n.volume().transfer.domain = TransferSpec::Domain::Normalized;
+    n.volume().transfer.window = std::array<double, 2>{-1.0, 3.0};
+    n.volume().transfer.opacity = {{0.0, 0.0}, {0.38, 0.0}, {0.4, 0.7}, {0.42, 0.0}};
     expect_bitwise_equal(n, "normalized");
 }
 
@@ -535,12 +535,12 @@ TEST(EmptySpace, PreClassification) {
                             Interpolation::TricubicCatmullRom})
         for (auto order : {CompositeOrder::FrontToBack, CompositeOrder::BackToFront}) {
             Scene s = gaussian_scene();
-            s.volume.classify = VolumeSpec::Classify::Pre;
-            s.volume.interpolation = i;
+            s.volume().classify = VolumeSpec::Classify::Pre;
+            s.volume().interpolation = i;
             s.render.order = order;
             expect_bitwise_equal(s, "pre " + std::to_string(int(i)));
-            s.volume.shading = ShadingSpec{};
-            s.volume.transfer.gradient_opacity = {{0.0, 0.0}, {0.2, 1.0}};
+            s.volume().shading = ShadingSpec{};
+            s.volume().transfer.gradient_opacity = {{0.0, 0.0}, {0.2, 1.0}};
             expect_bitwise_equal(s, "pre, shaded, gradient opacity " + std::to_string(int(i)));
         }
 }
@@ -554,11 +554,11 @@ TEST(EmptySpace, BoundaryClassification) {
             c.regions = {{0.0, 0.0, {0.1, 0.1, 0.1}}, {0.5, 0.0, {0.2, 0.4, 0.9}}, {0.6, 0.8, {1.0, 0.6, 0.2}},
                          {0.7, 0.0, {1.0, 1.0, 1.0}}};
             c.opacity_unit_distance = 0.5;
-            s.volume.classification = c;
-            s.volume.classify = classify;
-            s.volume.interpolation = i;
+            s.volume().classification = c;
+            s.volume().classify = classify;
+            s.volume().interpolation = i;
             expect_bitwise_equal(s, "boundary");
-            s.volume.shading = ShadingSpec{};
+            s.volume().shading = ShadingSpec{};
             s.render.order = CompositeOrder::BackToFront;
             expect_bitwise_equal(s, "boundary, shaded, back to front");
         }
@@ -587,8 +587,8 @@ TEST(EmptySpace, AxisParallelRaysOnFacesAndEdges) {
         for (double h : {1.0, 3.2, 16.0 / 7.0, 0.5})
             for (const View& v : views) {
                 Scene s = field_scene(g);
-                s.volume.transfer.opacity = {{0.0, 0.0}, {0.6, 0.0}, {0.7, 0.9}, {0.8, 0.2}};
-                s.volume.interpolation = i;
+                s.volume().transfer.opacity = {{0.0, 0.0}, {0.6, 0.0}, {0.7, 0.9}, {0.8, 0.2}};
+                s.volume().interpolation = i;
                 s.camera = orthographic(v.eye, v.target, v.up, 16.0);
                 s.image.width = s.image.height = 16;
                 set_step(s, h);
@@ -597,7 +597,7 @@ TEST(EmptySpace, AxisParallelRaysOnFacesAndEdges) {
             }
     // A perspective camera whose centre ray (odd image) runs along the edge x = y = 16.
     Scene s = field_scene(g);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.6, 0.0}, {0.7, 0.9}, {0.8, 0.2}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.6, 0.0}, {0.7, 0.9}, {0.8, 0.2}};
     s.camera = perspective({16.0, 16.0, 80.0}, {16.0, 16.0, 0.0}, {0, 1, 0}, 30.0);
     s.image.width = s.image.height = 17;
     set_step(s, 1.0);
@@ -608,8 +608,8 @@ TEST(EmptySpace, AxisParallelRaysOnFacesAndEdges) {
         expect_bitwise_equal(s, "inside");
     }
     // A box smaller than the domain: intervals start and end inside macrocells.
-    s.volume.bounds.min = glm::dvec3(3.3, 2.1, 5.7);
-    s.volume.bounds.max = glm::dvec3(29.9, 30.2, 27.1);
+    s.volume().bounds.min = glm::dvec3(3.3, 2.1, 5.7);
+    s.volume().bounds.max = glm::dvec3(29.9, 30.2, 27.1);
     s.camera = perspective({60, -40, 50}, {16, 16, 16}, {0, 0, 1}, 40.0);
     expect_bitwise_equal(s, "bounds");
 }
@@ -626,7 +626,7 @@ TEST(EmptySpace, OddDimsAndRandomCameras) {
         g.center = {0.45 * double(d[0] - 1), 0.5 * double(d[1] - 1), 0.55 * double(d[2] - 1)};
         g.sigma = 5.0;
         Scene s = field_scene(g);
-        s.volume.transfer.opacity = {{0.0, 0.0}, {0.5, 0.0}, {0.55, 0.8}, {0.6, 0.0}};
+        s.volume().transfer.opacity = {{0.0, 0.0}, {0.5, 0.0}, {0.55, 0.8}, {0.6, 0.0}};
         s.image.width = s.image.height = 12;
         double max_alpha = 0.0;
         for (int n = 0; n < 6; ++n) {
@@ -634,7 +634,7 @@ TEST(EmptySpace, OddDimsAndRandomCameras) {
             const glm::dvec3 eye = g.center + r * glm::dvec3(std::cos(a) * std::cos(e), std::sin(a) * std::cos(e), std::sin(e));
             s.camera = n % 2 ? perspective(eye, g.center, {0, 0, 1}, 35.0) : orthographic(eye, g.center, {0, 0, 1}, 30.0);
             set_step(s, 0.3 + 0.2 * n);
-            s.volume.interpolation = n % 3 == 0 ? Interpolation::TricubicBSpline : Interpolation::Trilinear;
+            s.volume().interpolation = n % 3 == 0 ? Interpolation::TricubicBSpline : Interpolation::Trilinear;
             s.render.order = n % 2 ? CompositeOrder::BackToFront : CompositeOrder::FrontToBack;
             max_alpha = std::max(max_alpha, expect_bitwise_equal(s, "dims " + std::to_string(d[0]) + "x" +
                                                                         std::to_string(d[1]) + "x" + std::to_string(d[2]) +
@@ -649,7 +649,7 @@ TEST(EmptySpace, OddDimsAndRandomCameras) {
     f.dims = {30, 25, 1};
     f.center = {14.0, 12.0, 0.0};
     Scene s = field_scene(f);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {6.0, 0.0}, {7.0, 0.5}, {8.0, 0.0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {6.0, 0.0}, {7.0, 0.5}, {8.0, 0.0}};
     s.camera = orthographic({14.0, -50.0, 0.0}, {14.0, 0.0, 0.0}, {0, 0, 1}, 2.0);  // 30 wide
     s.image.width = 15;
     s.image.height = 1;
@@ -677,11 +677,11 @@ TEST(EmptySpace, SpotsNextToEmptyMacrocells) {
                                  Interpolation::TricubicCatmullRom})
         for (int n = 0; n < 8; ++n) {
             Scene s = field_scene(f, {0.25, -0.5, 0.125}, {1.0, 0.75, 1.25});
-            s.volume.interpolation = interp;
-            s.volume.transfer.opacity = {{0.0, 0.0}, {1.0, 0.9}};
-            s.volume.transfer.color = {{0.0, 1.0, 0.5, 0.25}, {1.0, 0.25, 0.5, 1.0}};
+            s.volume().interpolation = interp;
+            s.volume().transfer.opacity = {{0.0, 0.0}, {1.0, 0.9}};
+            s.volume().transfer.color = {{0.0, 1.0, 0.5, 0.25}, {1.0, 0.25, 0.5, 1.0}};
             if (interp == Interpolation::TricubicCatmullRom)  // overshoot below 0 is transparent too
-                s.volume.transfer.opacity = {{-1.0, 0.0}, {0.0, 0.0}, {1.0, 0.9}};
+                s.volume().transfer.opacity = {{-1.0, 0.0}, {0.0, 0.0}, {1.0, 0.9}};
             const glm::dvec3 c(16.75, 12.0, 20.75);
             if (n < 3) {  // axis-parallel, pixel centres on voxel columns
                 const glm::dvec3 axis = n == 0 ? glm::dvec3(0, 0, 1) : n == 1 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);

@@ -115,7 +115,7 @@ TEST(Explain, TrilinearAtLevoysSamplePoints) {
 TEST(Explain, TrilinearAtAWorldPointOfTheLectureScene) {
     const Scene scene = load_scene(kLevoyScene);
     VolumeModel model;
-    build_volume_model(scene.volume, model);
+    build_volume_model(scene.volume(), model);
     const Explanation e = explain::trilinear_at(*model.cartesian, {0.2, 0.3, 0.8});
     EXPECT_EQ(vec(e, "grid", "cell"), (std::vector<double>{0, 0, 0}));
     const std::vector<double> local = vec(e, "grid", "(p, q, r)");

@@ -17,9 +17,9 @@ namespace {
 // A box [0, n-1]^3 of value v, one pixel looking along -z at (cx, cy): the chord is n - 1 long.
 Scene box_scene(ProfileId profile, double value, double opacity, std::int64_t n, double step) {
     Scene s = field_scene(constant_field(value, {n, n, n}));
-    s.volume.transfer.color = {{0, 0.2, 0.4, 0.6}, {1, 0.2, 0.4, 0.6}};
-    s.volume.transfer.opacity = {{0, opacity}, {1, opacity}};
-    s.volume.transfer.opacity_unit_distance = 1.0;
+    s.volume().transfer.color = {{0, 0.2, 0.4, 0.6}, {1, 0.2, 0.4, 0.6}};
+    s.volume().transfer.opacity = {{0, opacity}, {1, opacity}};
+    s.volume().transfer.opacity_unit_distance = 1.0;
     const double c = 0.5 * double(n - 1);
     s.camera = ortho_down_z(c, c, double(n) + 10.0, 1.0);
     s.image.width = s.image.height = 1;
@@ -36,8 +36,8 @@ double alpha_of(ProfileId profile, double value, double opacity, std::int64_t n,
 // f = z on [0, 4]^3 (data range [0, 4]); colour white, opacity a(v) = v / 4.
 Scene ramp_scene(ProfileId profile, Projection projection) {
     Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
-    s.volume.transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
-    s.volume.transfer.opacity = {{0, 0}, {4, 1}};
+    s.volume().transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
+    s.volume().transfer.opacity = {{0, 0}, {4, 1}};
     s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
     s.image.width = s.image.height = 1;
     s.render.projection = projection;

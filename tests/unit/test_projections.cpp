@@ -17,8 +17,8 @@ namespace {
 // pixel (px, py) looks along -z at x = 0.5 + px, y = 3.5 - py; the ray enters at z = 4 (t = 6).
 Scene linear_scene(Projection projection, double step) {
     Scene s = field_scene(linear_field({1, 2, 3, 1}, {5, 5, 5}));
-    s.volume.transfer.color = {{0, 0, 0, 0}, {100, 1, 1, 1}};  // c = v / 100
-    s.volume.transfer.opacity = {{0, 0}, {100, 1}};          // a = v / 100
+    s.volume().transfer.color = {{0, 0, 0, 0}, {100, 1, 1, 1}};  // c = v / 100
+    s.volume().transfer.opacity = {{0, 0}, {100, 1}};          // a = v / 100
     s.camera = ortho_down_z(2.0, 2.0, 10.0, 4.0);
     s.image.width = s.image.height = 4;
     s.render.projection = projection;
@@ -65,7 +65,7 @@ TEST(Projections, AverageAndXrayOfLinearField) {
 // First hit on f = z at iso 2.7: the plane z = 2.7 is met at t = 10 - 2.7 = 7.3 by every ray.
 TEST(Projections, FirstHitOnAPlane) {
     Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
-    s.volume.transfer.color = {{0, 0, 0, 0}, {4, 1, 0.5, 0.25}};
+    s.volume().transfer.color = {{0, 0, 0, 0}, {4, 1, 0.5, 0.25}};
     s.camera = ortho_down_z(2.0, 2.0, 10.0, 4.0);
     s.image.width = s.image.height = 4;
     s.render.projection = Projection::FirstHit;

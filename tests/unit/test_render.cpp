@@ -22,8 +22,8 @@ Scene marschner_lobb_scene() {
     ml.kind = FieldSpec::Kind::MarschnerLobb;
     ml.dims = {41, 41, 41};
     Scene s = field_scene(ml);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.5, 0.05}, {1.0, 0.5}};
-    s.volume.transfer.color = {{0.0, 0.1, 0.2, 0.9}, {1.0, 1.0, 0.9, 0.3}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.5, 0.05}, {1.0, 0.5}};
+    s.volume().transfer.color = {{0.0, 0.1, 0.2, 0.9}, {1.0, 1.0, 0.9, 0.3}};
     s.image.width = 61;  // not a multiple of the tile size
     s.image.height = 47;
     return s;

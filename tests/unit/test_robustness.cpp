@@ -114,8 +114,8 @@ Scene ml_scene() {
     ml.kind = FieldSpec::Kind::MarschnerLobb;
     ml.dims = {21, 19, 23};
     Scene s = field_scene(ml);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.4, 0.0}, {0.6, 0.5}, {1.0, 0.9}};
-    s.volume.transfer.color = {{0.0, 1.0, 0.2, 0.1}, {1.0, 0.1, 0.5, 1.0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.4, 0.0}, {0.6, 0.5}, {1.0, 0.9}};
+    s.volume().transfer.color = {{0.0, 1.0, 0.2, 0.1}, {1.0, 0.1, 0.5, 1.0}};
     s.image.width = 37;
     s.image.height = 29;
     return s;
@@ -145,7 +145,7 @@ TEST(MemoryLimit, RefusesAVolumeBeforeAllocating) {
     MemoryLimitGuard guard;
     set_memory_limit(1 << 20);  // 1 MiB: 64^3 doubles need 2 MiB
     Scene s = ml_scene();
-    s.volume.source.field->dims = {64, 64, 64};
+    s.volume().source.field->dims = {64, 64, 64};
     const std::string e = error_of([&] { render_scene(s); });
     EXPECT_NE(e.find("64 x 64 x 64"), std::string::npos) << e;
     EXPECT_NE(e.find("memory limit of 1 MiB"), std::string::npos) << e;
@@ -160,8 +160,8 @@ TEST(MemoryLimit, RefusesAnImageAndAGradientCache) {
     set_memory_limit(40'000'000);
     EXPECT_NE(error_of([&] { render_scene(s); }).find("image: 1000 x 1000"), std::string::npos);
     s.image.width = s.image.height = 8;
-    s.volume.shading = ShadingSpec{};
-    s.volume.gradient.cache = true;  // 3 more volumes: 4 x 73416 + image > 200000
+    s.volume().shading = ShadingSpec{};
+    s.volume().gradient.cache = true;  // 3 more volumes: 4 x 73416 + image > 200000
     set_memory_limit(200'000);
     EXPECT_NE(error_of([&] { render_scene(s); }).find("volume.gradient.cache"), std::string::npos);
     set_memory_limit(400'000);
@@ -268,7 +268,7 @@ TEST(Determinism, ThreadsTilesAndRuns) {
     std::vector<Scene> scenes;
     scenes.push_back(ml_scene());
     Scene shaded = ml_scene();
-    shaded.volume.shading = ShadingSpec{};
+    shaded.volume().shading = ShadingSpec{};
     scenes.push_back(shaded);
     Scene mip = ml_scene();
     mip.render.projection = Projection::Mip;

@@ -110,27 +110,27 @@ TEST(SceneLoaderDefaults, MinimalSceneFillsEveryDefault) {
     EXPECT_EQ(s.file, fs::path("scene.json"));
 
     // volume
-    ASSERT_TRUE(s.volume.source.file.has_value());
-    EXPECT_EQ(*s.volume.source.file, kBase / "head.nrrd");
-    EXPECT_EQ(s.volume.source.format, "");
-    EXPECT_FALSE(s.volume.source.field.has_value());
-    EXPECT_FALSE(s.volume.origin.has_value());
-    EXPECT_FALSE(s.volume.spacing.has_value());
-    EXPECT_EQ(s.volume.interpolation, Interpolation::Trilinear);
-    EXPECT_EQ(s.volume.bounds.type, BoundsSpec::Type::Box);
-    EXPECT_FALSE(s.volume.bounds.min.has_value());
-    EXPECT_FALSE(s.volume.bounds.max.has_value());
-    EXPECT_EQ(s.volume.transfer.domain, TransferSpec::Domain::Data);
-    EXPECT_FALSE(s.volume.transfer.window.has_value());
-    EXPECT_TRUE(s.volume.transfer.color.empty());
-    EXPECT_TRUE(s.volume.transfer.opacity.empty());
-    EXPECT_EQ(s.volume.transfer.opacity_unit_distance, 1.0);
-    EXPECT_TRUE(s.volume.transfer.gradient_opacity.empty());
-    EXPECT_FALSE(s.volume.classification.has_value());
-    EXPECT_EQ(s.volume.classify, VolumeSpec::Classify::Post);
-    EXPECT_FALSE(s.volume.shading.has_value());  // unshaded
-    EXPECT_EQ(s.volume.gradient.scheme, GradientSpec::Scheme::Default);
-    EXPECT_FALSE(s.volume.gradient.cache);
+    ASSERT_TRUE(s.volume().source.file.has_value());
+    EXPECT_EQ(*s.volume().source.file, kBase / "head.nrrd");
+    EXPECT_EQ(s.volume().source.format, "");
+    EXPECT_FALSE(s.volume().source.field.has_value());
+    EXPECT_FALSE(s.volume().origin.has_value());
+    EXPECT_FALSE(s.volume().spacing.has_value());
+    EXPECT_EQ(s.volume().interpolation, Interpolation::Trilinear);
+    EXPECT_EQ(s.volume().bounds.type, BoundsSpec::Type::Box);
+    EXPECT_FALSE(s.volume().bounds.min.has_value());
+    EXPECT_FALSE(s.volume().bounds.max.has_value());
+    EXPECT_EQ(s.volume().transfer.domain, TransferSpec::Domain::Data);
+    EXPECT_FALSE(s.volume().transfer.window.has_value());
+    EXPECT_TRUE(s.volume().transfer.color.empty());
+    EXPECT_TRUE(s.volume().transfer.opacity.empty());
+    EXPECT_EQ(s.volume().transfer.opacity_unit_distance, 1.0);
+    EXPECT_TRUE(s.volume().transfer.gradient_opacity.empty());
+    EXPECT_FALSE(s.volume().classification.has_value());
+    EXPECT_EQ(s.volume().classify, VolumeSpec::Classify::Post);
+    EXPECT_FALSE(s.volume().shading.has_value());  // unshaded
+    EXPECT_EQ(s.volume().gradient.scheme, GradientSpec::Scheme::Default);
+    EXPECT_FALSE(s.volume().gradient.cache);
 
     // lights: one white headlight
     ASSERT_EQ(s.lights.size(), 1u);
@@ -164,19 +164,19 @@ TEST(SceneLoaderDefaults, EmptyObjectsKeepDefaults) {
     const Scene s = parse(scene_with(R"("image": {}, "render": {})", R"("transfer": {}, "bounds": {})"));
     EXPECT_EQ(s.image.width, 256);
     EXPECT_EQ(s.render.step, 0.5);
-    EXPECT_EQ(s.volume.transfer.domain, TransferSpec::Domain::Data);
-    EXPECT_TRUE(s.volume.transfer.color.empty());
-    EXPECT_TRUE(s.volume.transfer.opacity.empty());
-    EXPECT_EQ(s.volume.transfer.opacity_unit_distance, 1.0);
+    EXPECT_EQ(s.volume().transfer.domain, TransferSpec::Domain::Data);
+    EXPECT_TRUE(s.volume().transfer.color.empty());
+    EXPECT_TRUE(s.volume().transfer.opacity.empty());
+    EXPECT_EQ(s.volume().transfer.opacity_unit_distance, 1.0);
 }
 
 TEST(SceneLoaderDefaults, TransferWithoutColorOrOpacityLeavesThemEmpty) {
     const Scene a = parse(transfer_with(R"("opacity": [[0, 0], [1, 1]])"));
-    EXPECT_TRUE(a.volume.transfer.color.empty());
-    EXPECT_EQ(a.volume.transfer.opacity.size(), 2u);
+    EXPECT_TRUE(a.volume().transfer.color.empty());
+    EXPECT_EQ(a.volume().transfer.opacity.size(), 2u);
     const Scene b = parse(transfer_with(R"("color": [[0, 1, 1, 1]])"));
-    EXPECT_TRUE(b.volume.transfer.opacity.empty());
-    EXPECT_EQ(b.volume.transfer.color.size(), 1u);
+    EXPECT_TRUE(b.volume().transfer.opacity.empty());
+    EXPECT_EQ(b.volume().transfer.color.size(), 1u);
 }
 
 TEST(SceneLoaderFull, EveryKeyIsRead) {
@@ -207,7 +207,7 @@ TEST(SceneLoaderFull, EveryKeyIsRead) {
                  "isovalue": 42.5, "early_termination": 0.99, "integrator": "midpoint", "profile": "reference",
                  "gain": 3}
     })");
-    const VolumeSpec& v = s.volume;
+    const VolumeSpec& v = s.volume();
     EXPECT_EQ(*v.source.file, kBase / "data" / "head.raw");
     EXPECT_EQ(v.source.format, "raw");
     EXPECT_FALSE(v.source.field.has_value());
@@ -290,56 +290,56 @@ TEST(SceneLoaderFull, MatricesAreColumnMajor) {
 TEST(SceneLoaderFull, ProceduralFields) {
     {
         const Scene s = parse(source_with(R"({"field": "constant", "dims": [3, 4, 5], "value": 7})"));
-        ASSERT_TRUE(s.volume.source.field.has_value());
-        EXPECT_FALSE(s.volume.source.file.has_value());
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::Constant);
-        EXPECT_EQ(s.volume.source.field->dims, (std::array<std::int64_t, 3>{3, 4, 5}));
-        EXPECT_EQ(s.volume.source.field->value, 7.0);
+        ASSERT_TRUE(s.volume().source.field.has_value());
+        EXPECT_FALSE(s.volume().source.file.has_value());
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::Constant);
+        EXPECT_EQ(s.volume().source.field->dims, (std::array<std::int64_t, 3>{3, 4, 5}));
+        EXPECT_EQ(s.volume().source.field->value, 7.0);
     }
     {
         const Scene s = parse(source_with(R"({"field": "constant"})"));
-        EXPECT_EQ(s.volume.source.field->dims, (std::array<std::int64_t, 3>{2, 2, 2}));  // default dims
-        EXPECT_EQ(s.volume.source.field->value, 0.0);
+        EXPECT_EQ(s.volume().source.field->dims, (std::array<std::int64_t, 3>{2, 2, 2}));  // default dims
+        EXPECT_EQ(s.volume().source.field->value, 0.0);
     }
     {
         const Scene s = parse(source_with(R"({"field": "linear", "dims": [2, 2, 2], "coefficients": [1, 2, 3, 4]})"));
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::Linear);
-        EXPECT_EQ(s.volume.source.field->coefficients, (std::array<double, 4>{1, 2, 3, 4}));
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::Linear);
+        EXPECT_EQ(s.volume().source.field->coefficients, (std::array<double, 4>{1, 2, 3, 4}));
         const Scene d = parse(source_with(R"({"field": "linear"})"));
-        EXPECT_EQ(d.volume.source.field->coefficients, (std::array<double, 4>{0, 0, 0, 0}));
+        EXPECT_EQ(d.volume().source.field->coefficients, (std::array<double, 4>{0, 0, 0, 0}));
     }
     {
         const Scene s = parse(source_with(R"({"field": "radial", "dims": [9, 9, 9], "center": [1, 2, 3]})"));
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::Radial);
-        expect_vec(s.volume.source.field->center, 1, 2, 3);
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::Radial);
+        expect_vec(s.volume().source.field->center, 1, 2, 3);
         const Scene d = parse(source_with(R"({"field": "radial"})"));
-        expect_vec(d.volume.source.field->center, 0, 0, 0);
+        expect_vec(d.volume().source.field->center, 0, 0, 0);
     }
     {
         const Scene s = parse(source_with(R"({"field": "marschner-lobb", "dims": [41, 41, 41]})"));
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::MarschnerLobb);
-        EXPECT_EQ(s.volume.source.field->fm, 6.0);
-        EXPECT_EQ(s.volume.source.field->alpha, 0.25);
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::MarschnerLobb);
+        EXPECT_EQ(s.volume().source.field->fm, 6.0);
+        EXPECT_EQ(s.volume().source.field->alpha, 0.25);
         const Scene t = parse(source_with(R"({"field": "marschner-lobb", "fm": 3, "alpha": 0.5})"));
-        EXPECT_EQ(t.volume.source.field->fm, 3.0);
-        EXPECT_EQ(t.volume.source.field->alpha, 0.5);
+        EXPECT_EQ(t.volume().source.field->fm, 3.0);
+        EXPECT_EQ(t.volume().source.field->alpha, 0.5);
     }
     {
         const Scene s = parse(source_with(R"({"field": "gaussian"})"));
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::Gaussian);
-        expect_vec(s.volume.source.field->center, 0, 0, 0);
-        EXPECT_EQ(s.volume.source.field->sigma, 1.0);
-        EXPECT_EQ(s.volume.source.field->amplitude, 1.0);
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::Gaussian);
+        expect_vec(s.volume().source.field->center, 0, 0, 0);
+        EXPECT_EQ(s.volume().source.field->sigma, 1.0);
+        EXPECT_EQ(s.volume().source.field->amplitude, 1.0);
         const Scene t =
             parse(source_with(R"({"field": "gaussian", "center": [1, 1, 1], "sigma": 0.5, "amplitude": -2})"));
-        expect_vec(t.volume.source.field->center, 1, 1, 1);
-        EXPECT_EQ(t.volume.source.field->sigma, 0.5);
-        EXPECT_EQ(t.volume.source.field->amplitude, -2.0);
+        expect_vec(t.volume().source.field->center, 1, 1, 1);
+        EXPECT_EQ(t.volume().source.field->sigma, 0.5);
+        EXPECT_EQ(t.volume().source.field->amplitude, -2.0);
     }
     {
         const Scene s = parse(source_with(R"({"field": "cells", "dims": [2, 1, 2], "values": [1, 2, 3, 4.5]})"));
-        EXPECT_EQ(s.volume.source.field->kind, FieldSpec::Kind::Cells);
-        EXPECT_EQ(s.volume.source.field->values, (std::vector<double>{1, 2, 3, 4.5}));
+        EXPECT_EQ(s.volume().source.field->kind, FieldSpec::Kind::Cells);
+        EXPECT_EQ(s.volume().source.field->values, (std::vector<double>{1, 2, 3, 4.5}));
     }
 }
 
@@ -348,18 +348,18 @@ TEST(SceneLoaderFull, IntegralFloatsAreIntegers) {
     EXPECT_EQ(s.image.width, 512);
     EXPECT_EQ(s.image.height, 300);
     const Scene f = parse(source_with(R"({"field": "constant", "dims": [2.0, 1, 1e1]})"));
-    EXPECT_EQ(f.volume.source.field->dims, (std::array<std::int64_t, 3>{2, 1, 10}));
+    EXPECT_EQ(f.volume().source.field->dims, (std::array<std::int64_t, 3>{2, 1, 10}));
 }
 
 TEST(SceneLoaderFull, DimsAtTheLimitAreAccepted) {
     const Scene s = parse(source_with(R"({"field": "constant", "dims": [2048, 1024, 1024]})"));  // 2^31
-    EXPECT_EQ(s.volume.source.field->dims, (std::array<std::int64_t, 3>{2048, 1024, 1024}));
+    EXPECT_EQ(s.volume().source.field->dims, (std::array<std::int64_t, 3>{2048, 1024, 1024}));
 }
 
 TEST(SceneLoaderFull, SingleElementVolumesIsTheSameAsVolume) {
     const Scene s = parse(R"({"volumes": [{"source": "a.nrrd", "interpolation": "nearest"}]})");
-    EXPECT_EQ(*s.volume.source.file, kBase / "a.nrrd");
-    EXPECT_EQ(s.volume.interpolation, Interpolation::Nearest);
+    EXPECT_EQ(*s.volume().source.file, kBase / "a.nrrd");
+    EXPECT_EQ(s.volume().interpolation, Interpolation::Nearest);
 }
 
 TEST(SceneLoaderFull, EnumValues) {
@@ -369,16 +369,16 @@ TEST(SceneLoaderFull, EnumValues) {
     for (const auto& [name, value] : projections)
         EXPECT_EQ(parse(scene_with(std::string(R"("render": {"projection": ")") + name + "\"}")).render.projection, value)
             << name;
-    EXPECT_EQ(parse(volume_with(R"("interpolation": "trilinear")")).volume.interpolation, Interpolation::Trilinear);
-    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-bspline")")).volume.interpolation,
+    EXPECT_EQ(parse(volume_with(R"("interpolation": "trilinear")")).volume().interpolation, Interpolation::Trilinear);
+    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-bspline")")).volume().interpolation,
               Interpolation::TricubicBSpline);
-    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-catmull-rom")")).volume.interpolation,
+    EXPECT_EQ(parse(volume_with(R"("interpolation": "tricubic-catmull-rom")")).volume().interpolation,
               Interpolation::TricubicCatmullRom);
-    EXPECT_EQ(parse(volume_with(R"("classify": "post")")).volume.classify, VolumeSpec::Classify::Post);
-    EXPECT_EQ(parse(volume_with(R"("classify": "pre")")).volume.classify, VolumeSpec::Classify::Pre);
+    EXPECT_EQ(parse(volume_with(R"("classify": "post")")).volume().classify, VolumeSpec::Classify::Post);
+    EXPECT_EQ(parse(volume_with(R"("classify": "pre")")).volume().classify, VolumeSpec::Classify::Pre);
     EXPECT_EQ(parse(scene_with(R"("render": {"step_units": "voxel"})")).render.step_units, StepUnits::Voxel);
     EXPECT_EQ(parse(scene_with(R"("render": {"order": "front-to-back"})")).render.order, CompositeOrder::FrontToBack);
-    EXPECT_EQ(parse(transfer_with(R"("domain": "data")")).volume.transfer.domain, TransferSpec::Domain::Data);
+    EXPECT_EQ(parse(transfer_with(R"("domain": "data")")).volume().transfer.domain, TransferSpec::Domain::Data);
 }
 
 TEST(SceneLoaderFull, LightsAndBounds) {
@@ -388,8 +388,8 @@ TEST(SceneLoaderFull, LightsAndBounds) {
     EXPECT_EQ(s.lights[0].type, LightSpec::Type::Headlight);  // type defaults to headlight
     expect_vec(s.lights[1].direction, 1, 0, 0);
     const Scene b = parse(volume_with(R"("bounds": {"min": [1, 1, 1]})"));  // min alone is allowed
-    expect_vec(*b.volume.bounds.min, 1, 1, 1);
-    EXPECT_FALSE(b.volume.bounds.max.has_value());
+    expect_vec(*b.volume().bounds.min, 1, 1, 1);
+    EXPECT_FALSE(b.volume().bounds.max.has_value());
 }
 
 TEST(SceneLoaderFull, RangeEndsThatAreIncluded) {
@@ -428,15 +428,15 @@ void expect_shading(const ShadingSpec& s, ShadingSpec::Model model, double ka, d
 TEST(SceneLoaderGradientOpacity, RowsAreRead) {
     // A factor may exceed 1; equal |grad f| make a step.
     const Scene s = parse(transfer_with(R"("gradient_opacity": [[0, 0], [10, 0.5], [10, 2], [100, 3]])"));
-    const auto& g = s.volume.transfer.gradient_opacity;
+    const auto& g = s.volume().transfer.gradient_opacity;
     ASSERT_EQ(g.size(), 4u);
     EXPECT_EQ(g[0], (std::array<double, 2>{0, 0}));
     EXPECT_EQ(g[1], (std::array<double, 2>{10, 0.5}));
     EXPECT_EQ(g[2], (std::array<double, 2>{10, 2}));
     EXPECT_EQ(g[3], (std::array<double, 2>{100, 3}));
-    EXPECT_EQ(parse(transfer_with(R"("gradient_opacity": [[5, 1]])")).volume.transfer.gradient_opacity.size(), 1u);
+    EXPECT_EQ(parse(transfer_with(R"("gradient_opacity": [[5, 1]])")).volume().transfer.gradient_opacity.size(), 1u);
     // Absent: none.
-    EXPECT_TRUE(parse(transfer_with(R"("opacity": [[0, 1]])")).volume.transfer.gradient_opacity.empty());
+    EXPECT_TRUE(parse(transfer_with(R"("opacity": [[0, 1]])")).volume().transfer.gradient_opacity.empty());
 }
 
 TEST(SceneLoaderGradientOpacity, Errors) {
@@ -458,8 +458,8 @@ TEST(SceneLoaderGradientOpacity, Errors) {
 
 TEST(SceneLoaderClassification, IsovalueDefaults) {
     const Scene s = parse(classification_with(R"("type": "isovalue", "isovalues": [{"value": 5}])"));
-    ASSERT_TRUE(s.volume.classification.has_value());
-    const ClassificationSpec& c = *s.volume.classification;
+    ASSERT_TRUE(s.volume().classification.has_value());
+    const ClassificationSpec& c = *s.volume().classification;
     EXPECT_EQ(c.type, ClassificationSpec::Type::Isovalue);
     ASSERT_EQ(c.isovalues.size(), 1u);
     EXPECT_EQ(c.isovalues[0].value, 5.0);
@@ -469,8 +469,8 @@ TEST(SceneLoaderClassification, IsovalueDefaults) {
     EXPECT_TRUE(c.regions.empty());
     EXPECT_EQ(c.opacity_unit_distance, 1.0);
     // The transfer function keeps its defaults (it is not used).
-    EXPECT_TRUE(s.volume.transfer.color.empty());
-    EXPECT_TRUE(s.volume.transfer.opacity.empty());
+    EXPECT_TRUE(s.volume().transfer.color.empty());
+    EXPECT_TRUE(s.volume().transfer.opacity.empty());
 }
 
 TEST(SceneLoaderClassification, IsovalueFull) {
@@ -478,9 +478,9 @@ TEST(SceneLoaderClassification, IsovalueFull) {
         "classification": {"type": "isovalue", "opacity_unit_distance": 2.5, "isovalues": [
             {"value": 0.5, "opacity": 0.8, "thickness": 0.25, "color": [1, 0.5, 0]},
             {"value": -3, "opacity": 0, "thickness": 4, "color": [0, 0, 2]}]})"));
-    EXPECT_EQ(s.volume.interpolation, Interpolation::TricubicBSpline);
-    EXPECT_EQ(s.volume.classify, VolumeSpec::Classify::Pre);
-    const ClassificationSpec& c = *s.volume.classification;
+    EXPECT_EQ(s.volume().interpolation, Interpolation::TricubicBSpline);
+    EXPECT_EQ(s.volume().classify, VolumeSpec::Classify::Pre);
+    const ClassificationSpec& c = *s.volume().classification;
     EXPECT_EQ(c.type, ClassificationSpec::Type::Isovalue);
     EXPECT_EQ(c.opacity_unit_distance, 2.5);
     ASSERT_EQ(c.isovalues.size(), 2u);  // in the given order (they need not be sorted)
@@ -496,7 +496,7 @@ TEST(SceneLoaderClassification, IsovalueFull) {
 
 TEST(SceneLoaderClassification, BoundaryDefaults) {
     const Scene s = parse(classification_with(R"("type": "boundary", "regions": [{"value": 0}, {"value": 1}])"));
-    const ClassificationSpec& c = *s.volume.classification;
+    const ClassificationSpec& c = *s.volume().classification;
     EXPECT_EQ(c.type, ClassificationSpec::Type::Boundary);
     ASSERT_EQ(c.regions.size(), 2u);
     EXPECT_EQ(c.regions[0].value, 0.0);
@@ -514,7 +514,7 @@ TEST(SceneLoaderClassification, BoundaryFull) {
         {"value": -10, "opacity": 0, "color": [0, 0, 0]},
         {"value": 20, "opacity": 0.2, "color": [0.9, 0.8, 0.7]},
         {"value": 80, "opacity": 1, "color": [1, 1, 3]}])"));
-    const ClassificationSpec& c = *s.volume.classification;
+    const ClassificationSpec& c = *s.volume().classification;
     EXPECT_EQ(c.type, ClassificationSpec::Type::Boundary);
     EXPECT_EQ(c.opacity_unit_distance, 0.5);
     ASSERT_EQ(c.regions.size(), 3u);
@@ -599,26 +599,26 @@ TEST(SceneLoaderClassification, Errors) {
 
 TEST(SceneLoaderShading, Defaults) {
     const Scene s = parse(shading_with(""));
-    ASSERT_TRUE(s.volume.shading.has_value());
-    expect_shading(*s.volume.shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0.2, 10, 1, 0, false);
+    ASSERT_TRUE(s.volume().shading.has_value());
+    expect_shading(*s.volume().shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0.2, 10, 1, 0, false);
     const Scene p = parse(shading_with(R"("model": "phong")"));
-    expect_shading(*p.volume.shading, ShadingSpec::Model::Phong, 0.1, 0.7, 0.2, 10, 1, 0, false);
+    expect_shading(*p.volume().shading, ShadingSpec::Model::Phong, 0.1, 0.7, 0.2, 10, 1, 0, false);
     // Nodal: no specular term, ks is stored as 0.
     const Scene n = parse(shading_with(R"("model": "nodal")"));
-    expect_shading(*n.volume.shading, ShadingSpec::Model::Nodal, 0.1, 0.7, 0, 10, 1, 0, false);
+    expect_shading(*n.volume().shading, ShadingSpec::Model::Nodal, 0.1, 0.7, 0, 10, 1, 0, false);
 }
 
 TEST(SceneLoaderShading, Full) {
     const Scene s = parse(scene_with(R"("lights": [{"type": "directional", "direction": [0, 0, 2]}])",
                                      R"("shading": {"model": "phong", "ka": 0, "kd": 1.5, "ks": 0.75, "n": 64,
                                                     "kc": 0.5, "kl": 0.01, "two_sided": true})"));
-    expect_shading(*s.volume.shading, ShadingSpec::Model::Phong, 0, 1.5, 0.75, 64, 0.5, 0.01, true);
+    expect_shading(*s.volume().shading, ShadingSpec::Model::Phong, 0, 1.5, 0.75, 64, 0.5, 0.01, true);
     ASSERT_EQ(s.lights.size(), 1u);
     expect_vec(s.lights[0].direction, 0, 0, 1);
     const Scene b = parse(shading_with(R"("model": "blinn-phong", "ks": 0, "n": 0.5, "two_sided": false)"));
-    expect_shading(*b.volume.shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0, 0.5, 1, 0, false);
+    expect_shading(*b.volume().shading, ShadingSpec::Model::BlinnPhong, 0.1, 0.7, 0, 0.5, 1, 0, false);
     const Scene n = parse(shading_with(R"("model": "nodal", "ka": 0.2, "kd": 0.6, "kc": 0, "kl": 2, "two_sided": true)"));
-    expect_shading(*n.volume.shading, ShadingSpec::Model::Nodal, 0.2, 0.6, 0, 10, 0, 2, true);
+    expect_shading(*n.volume().shading, ShadingSpec::Model::Nodal, 0.2, 0.6, 0, 10, 0, 2, true);
 }
 
 TEST(SceneLoaderShading, Errors) {
@@ -654,26 +654,26 @@ TEST(SceneLoaderShading, Errors) {
 
 TEST(SceneLoaderGradient, DefaultsAndSchemes) {
     const Scene d = parse(volume_with(R"("gradient": {})"));
-    EXPECT_EQ(d.volume.gradient.scheme, GradientSpec::Scheme::Default);
-    EXPECT_FALSE(d.volume.gradient.cache);
+    EXPECT_EQ(d.volume().gradient.scheme, GradientSpec::Scheme::Default);
+    EXPECT_FALSE(d.volume().gradient.cache);
     const Scene c = parse(volume_with(R"("gradient": {"scheme": "central", "cache": true})"));
-    EXPECT_EQ(c.volume.gradient.scheme, GradientSpec::Scheme::Central);
-    EXPECT_TRUE(c.volume.gradient.cache);
+    EXPECT_EQ(c.volume().gradient.scheme, GradientSpec::Scheme::Central);
+    EXPECT_TRUE(c.volume().gradient.cache);
     const Scene f = parse(volume_with(R"("interpolation": "nearest", "gradient": {"scheme": "forward", "cache": false})"));
-    EXPECT_EQ(f.volume.gradient.scheme, GradientSpec::Scheme::Forward);
-    EXPECT_FALSE(f.volume.gradient.cache);
+    EXPECT_EQ(f.volume().gradient.scheme, GradientSpec::Scheme::Forward);
+    EXPECT_FALSE(f.volume().gradient.cache);
     for (const char* interpolation : {"tricubic-bspline", "tricubic-catmull-rom"}) {
         const Scene a = parse(volume_with(std::string(R"("interpolation": ")") + interpolation +
                                           R"(", "gradient": {"scheme": "analytic", "cache": true})"));
-        EXPECT_EQ(a.volume.gradient.scheme, GradientSpec::Scheme::Analytic) << interpolation;
-        EXPECT_TRUE(a.volume.gradient.cache) << interpolation;
+        EXPECT_EQ(a.volume().gradient.scheme, GradientSpec::Scheme::Analytic) << interpolation;
+        EXPECT_TRUE(a.volume().gradient.cache) << interpolation;
     }
     const Scene au = parse(volume_with(R"("gradient": {"cache": "auto"})"));
-    EXPECT_TRUE(au.volume.gradient.cache_auto);
-    EXPECT_FALSE(au.volume.gradient.cache);
+    EXPECT_TRUE(au.volume().gradient.cache_auto);
+    EXPECT_FALSE(au.volume().gradient.cache);
     // Default stays Default whatever the interpolation (the renderer resolves it).
     const Scene t = parse(volume_with(R"("interpolation": "tricubic-bspline", "gradient": {"cache": true})"));
-    EXPECT_EQ(t.volume.gradient.scheme, GradientSpec::Scheme::Default);
+    EXPECT_EQ(t.volume().gradient.scheme, GradientSpec::Scheme::Default);
 }
 
 TEST(SceneLoaderGradient, Errors) {
@@ -696,10 +696,10 @@ TEST(SceneLoaderGradient, OverridesReachTheNewKeys) {
     const std::string base = classification_with(R"("type": "isovalue", "isovalues": [{"value": 1}])");
     const Scene s = parse(base, {"volume.shading.two_sided=true", "volume.shading.model=nodal",
                                  "volume.classification.isovalues[0].opacity=0.5", "volume.gradient.scheme=forward"});
-    EXPECT_TRUE(s.volume.shading->two_sided);
-    EXPECT_EQ(s.volume.shading->model, ShadingSpec::Model::Nodal);
-    EXPECT_EQ(s.volume.classification->isovalues[0].opacity, 0.5);
-    EXPECT_EQ(s.volume.gradient.scheme, GradientSpec::Scheme::Forward);
+    EXPECT_TRUE(s.volume().shading->two_sided);
+    EXPECT_EQ(s.volume().shading->model, ShadingSpec::Model::Nodal);
+    EXPECT_EQ(s.volume().classification->isovalues[0].opacity, 0.5);
+    EXPECT_EQ(s.volume().gradient.scheme, GradientSpec::Scheme::Forward);
     EXPECT_TRUE(fails_with(base, "volume.shading.ks", "no specular term (set by --set volume.shading.ks=0.3)",
                            {"volume.shading.model=nodal", "volume.shading.ks=0.3"}));
 }
@@ -1016,10 +1016,10 @@ TEST(SceneOverrides, CreateAndReplaceValues) {
     EXPECT_EQ(s.render.projection, Projection::Mip);
     EXPECT_EQ(s.render.order, CompositeOrder::BackToFront);
     EXPECT_EQ(s.image.background, glm::dvec4(0, 0.5, 0, 1));
-    EXPECT_EQ(s.volume.transfer.opacity[1], (std::array<double, 2>{1, 0.75}));
+    EXPECT_EQ(s.volume().transfer.opacity[1], (std::array<double, 2>{1, 0.75}));
     EXPECT_EQ(s.camera.type, CameraSpec::Type::Orthographic);
     EXPECT_EQ(s.camera.height, 4.0);
-    EXPECT_EQ(*s.volume.source.file, kBase / "other" / "v.nrrd");
+    EXPECT_EQ(*s.volume().source.file, kBase / "other" / "v.nrrd");
 }
 
 TEST(SceneOverrides, AppliedInOrder) {
@@ -1082,7 +1082,7 @@ TEST(SceneOverrides, IndicesMustExist) {
 
 TEST(SceneOverrides, ValuesThatAreNotJsonAreStrings) {
     const Scene s = parse(scene_with(""), {"volume.source=my file.nrrd", "description="});
-    EXPECT_EQ(*s.volume.source.file, kBase / "my file.nrrd");
+    EXPECT_EQ(*s.volume().source.file, kBase / "my file.nrrd");
     // A value that overflows a double is an error, not the string "1e999".
     EXPECT_EQ(message_of(scene_with(""), {"render.step=1e999"}).rfind("--set render.step=1e999: render.step: ", 0), 0u);
     EXPECT_TRUE(fails_with(scene_with(""), "render.step", "expected a number > 0, got \"fast\"", {"render.step=fast"}));
@@ -1097,15 +1097,15 @@ TEST(SceneLoaderFiles, RelativePathsAreResolvedAgainstTheSceneFolder) {
     const fs::path file = dir.write("scenes/s.json", R"({"volume": {"source": "../data/head.nrrd"}})");
     const Scene s = load_scene(file);
     EXPECT_EQ(s.file, file);
-    EXPECT_EQ(*s.volume.source.file, fs::weakly_canonical(dir.path / "data" / "head.nrrd"));
-    EXPECT_TRUE(s.volume.source.file->is_absolute());
+    EXPECT_EQ(*s.volume().source.file, fs::weakly_canonical(dir.path / "data" / "head.nrrd"));
+    EXPECT_TRUE(s.volume().source.file->is_absolute());
 
     const fs::path abs = dir.write("a.json", R"({"volume": {"source": {"file": "/abs/x.raw"}}})");
-    EXPECT_EQ(*load_scene(abs).volume.source.file, fs::path("/abs/x.raw"));
+    EXPECT_EQ(*load_scene(abs).volume().source.file, fs::path("/abs/x.raw"));
 
     // Overrides are applied by load_scene too.
     const Scene o = load_scene(file, {"volume.source=v2.nrrd", "render.step=2"});
-    EXPECT_EQ(*o.volume.source.file, fs::weakly_canonical(dir.path / "scenes" / "v2.nrrd"));
+    EXPECT_EQ(*o.volume().source.file, fs::weakly_canonical(dir.path / "scenes" / "v2.nrrd"));
     EXPECT_EQ(o.render.step, 2.0);
 }
 
@@ -1118,7 +1118,7 @@ TEST(SceneLoaderFiles, RelativeSceneFileName) {
     } restore;
     fs::current_path(dir.path);
     const Scene s = load_scene("rel.json");
-    EXPECT_EQ(*s.volume.source.file, fs::weakly_canonical(dir.path / "v.nrrd"));
+    EXPECT_EQ(*s.volume().source.file, fs::weakly_canonical(dir.path / "v.nrrd"));
 }
 
 TEST(SceneLoaderFiles, MissingFile) {
@@ -1149,26 +1149,26 @@ TEST(SceneLoaderFiles, ValidationErrorNamesFile) {
 TEST(SceneLoaderBounds, ShellsAndMeshes) {
     const Scene c = parse(volume_with(
         R"("bounds": {"type": "cylindrical", "center": [1, 2, 3], "radius": [0.5, 2], "angle": [300, 420], "height": [-1, 1], "tessellate": 64})"));
-    EXPECT_EQ(c.volume.bounds.type, BoundsSpec::Type::Cylindrical);
-    EXPECT_EQ(c.volume.bounds.cylinder.center, glm::dvec3(1, 2, 3));
-    EXPECT_EQ(c.volume.bounds.cylinder.r0, 0.5);
-    EXPECT_EQ(c.volume.bounds.cylinder.a1, 420.0);
-    EXPECT_EQ(c.volume.bounds.cylinder.h0, -1.0);
-    EXPECT_EQ(c.volume.bounds.tessellate, 64);
+    EXPECT_EQ(c.volume().bounds.type, BoundsSpec::Type::Cylindrical);
+    EXPECT_EQ(c.volume().bounds.cylinder.center, glm::dvec3(1, 2, 3));
+    EXPECT_EQ(c.volume().bounds.cylinder.r0, 0.5);
+    EXPECT_EQ(c.volume().bounds.cylinder.a1, 420.0);
+    EXPECT_EQ(c.volume().bounds.cylinder.h0, -1.0);
+    EXPECT_EQ(c.volume().bounds.tessellate, 64);
     const Scene d = parse(volume_with(R"("bounds": {"type": "cylindrical"})"));
-    EXPECT_EQ(d.volume.bounds.cylinder.r1, 1.0);
-    EXPECT_EQ(d.volume.bounds.cylinder.a1, 360.0);
-    EXPECT_EQ(d.volume.bounds.tessellate, 0);
+    EXPECT_EQ(d.volume().bounds.cylinder.r1, 1.0);
+    EXPECT_EQ(d.volume().bounds.cylinder.a1, 360.0);
+    EXPECT_EQ(d.volume().bounds.tessellate, 0);
     const Scene s = parse(volume_with(
         R"("bounds": {"type": "spherical", "radius": [1, 2], "longitude": [0, 90], "latitude": [-30, 60], "axes": ["radius", "longitude", "latitude"]})"));
-    EXPECT_EQ(s.volume.bounds.type, BoundsSpec::Type::Spherical);
-    EXPECT_EQ(s.volume.bounds.sphere.lat0, -30.0);
-    EXPECT_EQ(s.volume.bounds.sphere.lon1, 90.0);
-    EXPECT_EQ(s.volume.bounds.sphere.axes, (std::array<int, 3>{2, 0, 1}));
+    EXPECT_EQ(s.volume().bounds.type, BoundsSpec::Type::Spherical);
+    EXPECT_EQ(s.volume().bounds.sphere.lat0, -30.0);
+    EXPECT_EQ(s.volume().bounds.sphere.lon1, 90.0);
+    EXPECT_EQ(s.volume().bounds.sphere.axes, (std::array<int, 3>{2, 0, 1}));
     const Scene m = parse(volume_with(R"("bounds": {"type": "mesh", "file": "shape.obj"})"));
-    EXPECT_EQ(m.volume.bounds.type, BoundsSpec::Type::Mesh);
-    EXPECT_EQ(m.volume.bounds.mesh.filename(), "shape.obj");
-    EXPECT_TRUE(m.volume.bounds.mesh.is_absolute());
+    EXPECT_EQ(m.volume().bounds.type, BoundsSpec::Type::Mesh);
+    EXPECT_EQ(m.volume().bounds.mesh.filename(), "shape.obj");
+    EXPECT_TRUE(m.volume().bounds.mesh.is_absolute());
 }
 
 TEST(SceneLoaderBounds, Errors) {

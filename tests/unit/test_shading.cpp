@@ -99,8 +99,8 @@ Scene blob_scene(FieldSpec::Kind kind, double iso) {
     f.sigma = 0.5;
     f.amplitude = 1.0;
     Scene s = field_scene(f, glm::dvec3(-1.0), glm::dvec3(2.0 / 64.0));
-    s.volume.transfer.color = {{0.0, 0.8, 0.6, 0.4}};
-    s.volume.shading = ShadingSpec{};
+    s.volume().transfer.color = {{0.0, 0.8, 0.6, 0.4}};
+    s.volume().shading = ShadingSpec{};
     s.camera = ortho_down_z(0.0, 0.0, 5.0, 2.0);
     s.image.width = s.image.height = 32;
     s.render.projection = Projection::FirstHit;
@@ -147,7 +147,7 @@ TEST(Shading, NormalsPointFromDenseToThin) {
     const Image blob = render_scene(blob_scene(FieldSpec::Kind::Gaussian, 0.5), {0, false});
     Scene dist = blob_scene(FieldSpec::Kind::Radial, 0.5);
     const Image one_sided = render_scene(dist, {0, false});
-    dist.volume.shading->two_sided = true;
+    dist.volume().shading->two_sided = true;
     const Image two_sided = render_scene(dist, {0, false});
     // The centre pixels (15..16): N is (nearly) the view direction for the blob, its opposite for the
     // distance field.
@@ -162,13 +162,13 @@ TEST(Shading, NormalsPointFromDenseToThin) {
 // A constant field has a zero gradient: a shaded render equals the unshaded one bit for bit.
 TEST(Shading, ZeroGradientIsUnshadedExactly) {
     Scene s = field_scene(constant_field(3.0, {5, 5, 5}));
-    s.volume.transfer.opacity = {{0, 0.3}};
-    s.volume.transfer.color = {{0, 0.2, 0.5, 0.7}};
+    s.volume().transfer.opacity = {{0, 0.3}};
+    s.volume().transfer.color = {{0, 0.2, 0.5, 0.7}};
     s.image.width = s.image.height = 8;
     // Both through the scalar path (the unshaded scene would otherwise take the SIMD path, whose
     // exp/log1p differ in the last bits).
     const Image plain = render_scene(s, {.threads = 1, .simd = false});
-    s.volume.shading = ShadingSpec{};
+    s.volume().shading = ShadingSpec{};
     const Image shaded = render_scene(s, {.threads = 1, .simd = false});
     EXPECT_EQ(plain.pixels, shaded.pixels);
 }
@@ -177,11 +177,11 @@ TEST(Shading, ZeroGradientIsUnshadedExactly) {
 // z = 10), normal +z facing the headlight: c = ka m + (kd m + ks) / (kc + kl t).
 TEST(Shading, DepthCueInARender) {
     Scene s = field_scene(linear_field({0, 0, -1, 0}, {5, 5, 5}));  // dense at the bottom: N = +z
-    s.volume.transfer.color = {{-10, 0.5, 0.5, 0.5}};
+    s.volume().transfer.color = {{-10, 0.5, 0.5, 0.5}};
     ShadingSpec spec;
     spec.kc = 1.0;
     spec.kl = 0.5;
-    s.volume.shading = spec;
+    s.volume().shading = spec;
     s.camera = ortho_down_z(2.0, 2.0, 10.0, 2.0);
     s.image.width = s.image.height = 2;
     s.render.projection = Projection::FirstHit;

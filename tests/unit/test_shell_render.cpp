@@ -26,12 +26,12 @@ double chord_alpha(double L) { return 1.0 - std::pow(1.0 - kA, L / kL); }
 // A constant field on a shell grid, seen orthographically along -z over [-1.2, 1.2]^2 (N x N pixels).
 Scene shell_scene(BoundsSpec bounds, int n) {
     Scene s = field_scene(constant_field(1.0, {9, 7, 5}));
-    s.volume.origin.reset();
-    s.volume.spacing.reset();
-    s.volume.bounds = bounds;
-    s.volume.transfer.opacity = {{0.0, kA}};
-    s.volume.transfer.color = {{0.0, 0.5, 0.25, 1.0}};
-    s.volume.transfer.opacity_unit_distance = kL;
+    s.volume().origin.reset();
+    s.volume().spacing.reset();
+    s.volume().bounds = bounds;
+    s.volume().transfer.opacity = {{0.0, kA}};
+    s.volume().transfer.color = {{0.0, 0.5, 0.25, 1.0}};
+    s.volume().transfer.opacity_unit_distance = kL;
     s.camera = ortho_down_z(0.0, 0.0, 5.0, 2.4);
     s.image.width = s.image.height = n;
     s.render.step = 0.07;
@@ -146,10 +146,10 @@ TEST(ShellRender, ConcaveMeshChords) {
     }
     obj.close();
     Scene s = field_scene(constant_field(1.0, {6, 6, 6}), glm::dvec3(-0.5, -0.5, -4.5), glm::dvec3(1.0));
-    s.volume.bounds.type = BoundsSpec::Type::Mesh;
-    s.volume.bounds.mesh = dir / "u.obj";
-    s.volume.transfer.opacity = {{0.0, kA}};
-    s.volume.transfer.opacity_unit_distance = kL;
+    s.volume().bounds.type = BoundsSpec::Type::Mesh;
+    s.volume().bounds.mesh = dir / "u.obj";
+    s.volume().transfer.opacity = {{0.0, kA}};
+    s.volume().transfer.opacity_unit_distance = kL;
     // Looking along -x (from +x) at y in (0, 4): a ray at height z crosses both pillars (2 units)
     // for -4 < z < -1 and the solid base (4 units) for -1 < z < 0.
     s.camera.type = CameraSpec::Type::Orthographic;
@@ -188,19 +188,19 @@ TEST(ShellRender, ResampledCartesianVolumeMatches) {
     write_nrrd(beam, dir / "beam.nrrd");
 
     Scene c = field_scene(g, glm::dvec3(-1.2), glm::dvec3(2.4 / 48.0));
-    c.volume.transfer.opacity = {{0.0, 0.0}, {0.2, 0.0}, {1.0, 0.8}};
-    c.volume.transfer.opacity_unit_distance = 0.5;
+    c.volume().transfer.opacity = {{0.0, 0.0}, {0.2, 0.0}, {1.0, 0.8}};
+    c.volume().transfer.opacity_unit_distance = 0.5;
     c.camera = ortho_down_z(0.0, 0.0, 5.0, 2.4);
     c.image.width = c.image.height = 20;
     c.render.step = 0.01;
     c.render.step_units = StepUnits::World;
     Scene s = c;
-    s.volume.source.field.reset();
-    s.volume.source.file = dir / "beam.nrrd";
-    s.volume.origin.reset();
-    s.volume.spacing.reset();
-    s.volume.bounds.type = BoundsSpec::Type::Spherical;
-    s.volume.bounds.sphere = sh;
+    s.volume().source.field.reset();
+    s.volume().source.file = dir / "beam.nrrd";
+    s.volume().origin.reset();
+    s.volume().spacing.reset();
+    s.volume().bounds.type = BoundsSpec::Type::Spherical;
+    s.volume().bounds.sphere = sh;
     const Image a = render_scene(c, {.threads = 2}), b = render_scene(s, {.threads = 2});
     double max_diff = 0.0, max_alpha = 0.0;
     for (std::size_t i = 3; i < a.pixels.size(); i += 4) {

@@ -20,9 +20,9 @@ Scene ml_scene(int w, int h) {
     ml.kind = FieldSpec::Kind::MarschnerLobb;
     ml.dims = {33, 29, 31};  // not multiples of anything
     Scene s = field_scene(ml, glm::dvec3(-3.0, 1.0, 2.0), glm::dvec3(0.5, 0.7, 0.6));
-    s.volume.transfer.color = {{0.0, 0.1, 0.2, 0.9}, {0.4, 0.3, 0.5, 0.2}, {0.55, 1.0, 0.8, 0.3}, {1.0, 1.0, 0.9, 0.6}};
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {0.5, 0.35}, {0.52, 0.35}, {0.8, 0.9}, {1.0, 1.0}};
-    s.volume.transfer.opacity_unit_distance = 2.0;
+    s.volume().transfer.color = {{0.0, 0.1, 0.2, 0.9}, {0.4, 0.3, 0.5, 0.2}, {0.55, 1.0, 0.8, 0.3}, {1.0, 1.0, 0.9, 0.6}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {0.5, 0.35}, {0.52, 0.35}, {0.8, 0.9}, {1.0, 1.0}};
+    s.volume().transfer.opacity_unit_distance = 2.0;
     s.image.width = w;
     s.image.height = h;
     return s;
@@ -52,11 +52,11 @@ TEST(Simd, CompositeMatchesTheScalarPath) {
     s.render.early_termination = 0.6;
     EXPECT_LT(max_difference(s), 1e-13);
     s.render.early_termination.reset();
-    s.volume.transfer.domain = TransferSpec::Domain::Normalized;
-    s.volume.transfer.window = std::array<double, 2>{-0.2, 1.1};
+    s.volume().transfer.domain = TransferSpec::Domain::Normalized;
+    s.volume().transfer.window = std::array<double, 2>{-0.2, 1.1};
     EXPECT_LT(max_difference(s), 1e-13);
-    s.volume.transfer.color = {{0.5, 0.3, 0.6, 0.9}};  // one row
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.5, 0.0}, {0.5, 1.0}};  // a jump to opaque
+    s.volume().transfer.color = {{0.5, 0.3, 0.6, 0.9}};  // one row
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.5, 0.0}, {0.5, 1.0}};  // a jump to opaque
     EXPECT_LT(max_difference(s), 1e-13);
 }
 
@@ -74,7 +74,7 @@ TEST(Simd, OrthographicAxisAlignedAndFlatVolumes) {
     g.center = {10, 10, 0};
     g.sigma = 4;
     Scene f = field_scene(g);
-    f.volume.transfer.opacity = {{0, 0}, {1, 0.7}};
+    f.volume().transfer.opacity = {{0, 0}, {1, 0.7}};
     f.camera.type = CameraSpec::Type::Perspective;
     f.camera.eye = {10, -30, 0};
     f.camera.target = {10, 10, 0};
@@ -87,8 +87,8 @@ TEST(Simd, OrthographicAxisAlignedAndFlatVolumes) {
 // A constant box through the packet path keeps the closed form alpha = 1 - (1 - a)^(L / l).
 TEST(Simd, ConstantBoxClosedForm) {
     Scene s = field_scene(constant_field(2.0, {5, 5, 5}));
-    s.volume.transfer.opacity = {{0.0, 0.35}};
-    s.volume.transfer.color = {{0.0, 0.2, 0.6, 0.9}};
+    s.volume().transfer.opacity = {{0.0, 0.35}};
+    s.volume().transfer.color = {{0.0, 0.2, 0.6, 0.9}};
     s.camera = ortho_down_z(2.0, 2.0, 10.0, 0.3);  // 19 x 3 pixels over [1.05, 2.95] x [1.85, 2.15]
     s.image.width = 19;
     s.image.height = 3;
@@ -145,7 +145,7 @@ TEST(Simd, MipAndMinipAreBitwiseTheScalarPath) {
         Scene s = ml_scene(37, 23);
         s.render.projection = proj;
         s.render.step = 0.37;
-        s.volume.transfer.opacity = {{0.0, 0.2}, {0.5, 0.1}, {1.0, 0.9}};
+        s.volume().transfer.opacity = {{0.0, 0.2}, {0.5, 0.1}, {1.0, 0.9}};
         const Image a = render_scene(s, {.threads = 1, .simd = true});
         const Image b = render_scene(s, {.threads = 1, .simd = false});
         EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(double)), 0);
@@ -183,7 +183,7 @@ Scene shaded_ml_scene() {
     shading.kd = 0.7;
     shading.ks = 0.3;
     shading.n = 10.0;
-    s.volume.shading = shading;
+    s.volume().shading = shading;
     LightSpec directional;
     directional.type = LightSpec::Type::Directional;
     directional.direction = glm::normalize(glm::dvec3(0.3, -0.5, 0.8));
@@ -208,42 +208,42 @@ TEST(Simd, ShadedCompositeMatchesTheScalarPath) {
     ASSERT_TRUE(takes_packet_path(s));
     // Shading must matter, or the comparison below would prove nothing about it.
     Scene unshaded = s;
-    unshaded.volume.shading.reset();
+    unshaded.volume().shading.reset();
     EXPECT_GT(image_difference(render_scene(s, {.threads = 1}), render_scene(unshaded, {.threads = 1})), 0.05);
     EXPECT_LT(max_difference(s), 1e-13);
 
     Scene phong = s;  // Phong, two-sided, depth cue
-    phong.volume.shading->model = ShadingSpec::Model::Phong;
-    phong.volume.shading->two_sided = true;
-    phong.volume.shading->kl = 0.05;
+    phong.volume().shading->model = ShadingSpec::Model::Phong;
+    phong.volume().shading->two_sided = true;
+    phong.volume().shading->kl = 0.05;
     ASSERT_TRUE(takes_packet_path(phong));
     EXPECT_LT(max_difference(phong), 1e-13);
 
     Scene nodal = s;
-    nodal.volume.shading->model = ShadingSpec::Model::Nodal;
+    nodal.volume().shading->model = ShadingSpec::Model::Nodal;
     nodal.render.step = 0.37;
     nodal.render.early_termination = 0.7;
     EXPECT_LT(max_difference(nodal), 1e-13);
 
     Scene forward = s;
-    forward.volume.gradient.scheme = GradientSpec::Scheme::Forward;
+    forward.volume().gradient.scheme = GradientSpec::Scheme::Forward;
     ASSERT_TRUE(takes_packet_path(forward));
     EXPECT_LT(max_difference(forward), 1e-13);
 
     Scene cached = s;
-    cached.volume.gradient.cache = true;
+    cached.volume().gradient.cache = true;
     ASSERT_TRUE(takes_packet_path(cached));
     EXPECT_LT(max_difference(cached), 1e-13);
 }
 
 TEST(Simd, GradientOpacityMatchesTheScalarPath) {
     Scene s = ml_scene(37, 23);
-    s.volume.transfer.gradient_opacity = {{0.0, 0.1}, {0.5, 0.6}, {2.0, 1.0}};
+    s.volume().transfer.gradient_opacity = {{0.0, 0.1}, {0.5, 0.6}, {2.0, 1.0}};
     ASSERT_TRUE(takes_packet_path(s));
     EXPECT_LT(max_difference(s), 1e-13);
     Scene shaded = shaded_ml_scene();
-    shaded.volume.transfer.gradient_opacity = s.volume.transfer.gradient_opacity;
-    shaded.volume.gradient.scheme = GradientSpec::Scheme::Forward;
+    shaded.volume().transfer.gradient_opacity = s.volume().transfer.gradient_opacity;
+    shaded.volume().gradient.scheme = GradientSpec::Scheme::Forward;
     EXPECT_LT(max_difference(shaded), 1e-13);
     // With skipping on and off the packet path stays bitwise the same.
     const Image on = render_scene(shaded, {.threads = 1, .empty_space_skipping = true, .simd = true});
@@ -257,7 +257,7 @@ TEST(Simd, UnservedScenesTakeTheScalarPath) {
     s.render.order = CompositeOrder::BackToFront;
     EXPECT_FALSE(takes_packet_path(s));
     s = shaded_ml_scene();
-    s.volume.interpolation = Interpolation::TricubicBSpline;
+    s.volume().interpolation = Interpolation::TricubicBSpline;
     EXPECT_FALSE(takes_packet_path(s));
     s = shaded_ml_scene();
     s.lights.assign(9, LightSpec{});  // more than kMaxPacketLights

@@ -29,11 +29,11 @@ namespace {
 Scene chord_scene(double a, double l, double L, double step, glm::dvec3 origin = glm::dvec3(0.0),
                   glm::dvec3 spacing = glm::dvec3(1.0)) {
     Scene s = field_scene(constant_field(2.0, {5, 5, 5}), origin, spacing);
-    s.volume.bounds.min = origin + glm::dvec3(0.0, 0.0, 0.2);
-    s.volume.bounds.max = origin + glm::dvec3(4.0 * spacing.x, 4.0 * spacing.y, 0.2 + L);
-    s.volume.transfer.opacity = {{0.0, a}};
-    s.volume.transfer.color = {{0.0, 0.2, 0.6, 0.9}};
-    s.volume.transfer.opacity_unit_distance = l;
+    s.volume().bounds.min = origin + glm::dvec3(0.0, 0.0, 0.2);
+    s.volume().bounds.max = origin + glm::dvec3(4.0 * spacing.x, 4.0 * spacing.y, 0.2 + L);
+    s.volume().transfer.opacity = {{0.0, a}};
+    s.volume().transfer.color = {{0.0, 0.2, 0.6, 0.9}};
+    s.volume().transfer.opacity_unit_distance = l;
     s.camera = ortho_down_z(origin.x + 2.1 * spacing.x, origin.y + 1.3 * spacing.y, origin.z + 10.0 + L, 1e-3);
     s.image.width = s.image.height = 1;
     s.render.step = step;
@@ -100,8 +100,8 @@ TEST(Stability, OpacityOneMinusTenToTheMinusTwelve) {
 // with order 1 at most (a jump); adaptive is exact to rounding.
 TEST(Stability, TransferFunctionJump) {
     Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
-    s.volume.transfer.opacity = {{0.0, 0.1}, {2.0, 0.1}, {2.0, 0.6}, {4.0, 0.6}};
-    s.volume.transfer.color = {{0.0, 1, 0, 0}, {2.0, 1, 0, 0}, {2.0, 0, 0, 1}, {4.0, 0, 0, 1}};
+    s.volume().transfer.opacity = {{0.0, 0.1}, {2.0, 0.1}, {2.0, 0.6}, {4.0, 0.6}};
+    s.volume().transfer.color = {{0.0, 1, 0, 0}, {2.0, 1, 0, 0}, {2.0, 0, 0, 1}, {4.0, 0, 0, 1}};
     s.camera = ortho_down_z(1.3, 2.7, 10.0, 1e-3);
     s.image.width = s.image.height = 1;
     const double A = 1.0 - 0.16 * 0.81, blue = 1.0 - 0.16, red = 0.16 * (1.0 - 0.81);
@@ -135,8 +135,8 @@ TEST(Stability, OriginsAtAMillion) {
     }
     // A linear field f = z - 1e6 + 1 there: adaptive and a fine fixed step agree.
     Scene s = field_scene(linear_field({0, 0, 1, -1e6 + 1}, {5, 5, 5}), glm::dvec3(1e6));
-    s.volume.transfer.opacity = {{0.0, 0.0}, {5.0, 0.8}};
-    s.volume.transfer.color = {{0.0, 1, 0, 0}, {5.0, 0, 1, 0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {5.0, 0.8}};
+    s.volume().transfer.color = {{0.0, 1, 0, 0}, {5.0, 0, 1, 0}};
     s.camera = ortho_down_z(1e6 + 1.3, 1e6 + 2.7, 1e6 + 10.0, 1e-3);
     s.image.width = s.image.height = 1;
     s.render.integrator = IntegrationMethod::Adaptive;
@@ -164,8 +164,8 @@ TEST(Stability, AnisotropicSpacingThousandToOne) {
         EXPECT_NEAR(p.rgba.a, alpha, 1e-13);
     }
     Scene s = field_scene(linear_field({1e-3, 0, 0, 0}, {5, 5, 5}), glm::dvec3(0.0), glm::dvec3(1000.0, 1.0, 1.0));
-    s.volume.transfer.opacity = {{0.0, 0.0}, {4.0, 0.5}};
-    s.volume.transfer.opacity_unit_distance = 1000.0;
+    s.volume().transfer.opacity = {{0.0, 0.0}, {4.0, 0.5}};
+    s.volume().transfer.opacity_unit_distance = 1000.0;
     s.camera.type = CameraSpec::Type::Orthographic;
     s.camera.eye = {-100.0, 1.3, 2.7};
     s.camera.target = {0.0, 1.3, 2.7};
@@ -188,8 +188,8 @@ TEST(Stability, AnisotropicSpacingThousandToOne) {
 TEST(Stability, RayAlongACellFaceOrEdge) {
     for (glm::dvec2 xy : {glm::dvec2(2.0, 2.5), glm::dvec2(2.0, 3.0), glm::dvec2(2.3, 3.0)}) {
         Scene s = field_scene(linear_field({0.1, 0.1, 1.0, 0.0}, {5, 5, 5}));
-        s.volume.transfer.opacity = {{0.0, 0.0}, {10.0, 1.0}};
-        s.volume.transfer.color = {{0.0, 1, 1, 1}};
+        s.volume().transfer.opacity = {{0.0, 0.0}, {10.0, 1.0}};
+        s.volume().transfer.color = {{0.0, 1, 1, 1}};
         s.camera = ortho_down_z(xy.x, xy.y, 10.0, 1e-9);
         s.image.width = s.image.height = 1;
         // u = 1 - 0.1 (z + c), c = 0.1 (x + y), dz = -10 du: integral_0^4 -log u dz = 10 [F(u(4)) - F(u(0))]
@@ -221,8 +221,8 @@ TEST(Stability, NonFiniteVoxelsAreTransparentAndCounted) {
     f.values[42] = inf;   // (2, 2, 2)
     f.values[5] = -inf;   // (1, 1, 0)
     Scene s = field_scene(f);
-    s.volume.transfer.opacity = {{0.0, 0.2}, {1.0, 0.9}};
-    s.volume.transfer.color = {{0.0, 1, 0, 0}, {1.0, 0, 0, 1}};
+    s.volume().transfer.opacity = {{0.0, 0.2}, {1.0, 0.9}};
+    s.volume().transfer.color = {{0.0, 1, 0, 0}, {1.0, 0, 0, 1}};
     s.camera.type = CameraSpec::Type::Perspective;
     s.camera.eye = {8.0, 6.0, 9.0};
     s.camera.target = {1.5, 1.5, 1.5};
@@ -258,8 +258,8 @@ TEST(Stability, NonFiniteCellIsTransparentClosedForm) {
                 f.values.assign(20, 2.0);
                 f.values[16] = bad;  // (0, 0, 4)
                 Scene s = field_scene(f);
-                s.volume.transfer.opacity = {{0.0, 0.3}};
-                s.volume.transfer.color = {{0.0, 0.5, 0.5, 0.5}};
+                s.volume().transfer.opacity = {{0.0, 0.3}};
+                s.volume().transfer.color = {{0.0, 0.5, 0.5, 0.5}};
                 s.camera = ortho_down_z(0.5, 0.5, 10.0, 1e-3);
                 s.image.width = s.image.height = 1;
                 s.render.integrator = m;

@@ -33,11 +33,11 @@ Scene blob_scene(Projection projection, CompositeOrder order, bool shaded) {
     f.center = {16.0, 16.0, 16.0};
     f.sigma = 5.0;
     Scene s = test::field_scene(f);
-    s.volume.transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {1.0, 0.6}};
-    s.volume.transfer.color = {{0.0, 0.1, 0.2, 0.9}, {1.0, 1.0, 0.8, 0.2}};
-    s.volume.transfer.opacity_unit_distance = 2.0;
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {1.0, 0.6}};
+    s.volume().transfer.color = {{0.0, 0.1, 0.2, 0.9}, {1.0, 1.0, 0.8, 0.2}};
+    s.volume().transfer.opacity_unit_distance = 2.0;
     if (shaded) {
-        s.volume.shading = ShadingSpec{};
+        s.volume().shading = ShadingSpec{};
         LightSpec d;
         d.type = LightSpec::Type::Directional;
         d.direction = glm::normalize(glm::dvec3(1.0, 1.0, 1.0));
@@ -93,14 +93,14 @@ TEST(Trace, LastRowIsTheRenderedPixelComposite) {
 // Pre-classification, tricubic reconstruction and early termination go through the same loop.
 TEST(Trace, LastRowIsTheRenderedPixelForOtherPipelines) {
     Scene pre = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, true);
-    pre.volume.classify = VolumeSpec::Classify::Pre;
+    pre.volume().classify = VolumeSpec::Classify::Pre;
     expect_last_row_is_pixel(pre, true, 8, 8);
     Scene cubic = blob_scene(Projection::Composite, CompositeOrder::BackToFront, true);
-    cubic.volume.interpolation = Interpolation::TricubicCatmullRom;
+    cubic.volume().interpolation = Interpolation::TricubicCatmullRom;
     expect_last_row_is_pixel(cubic, true, 7, 8);
     Scene early = blob_scene(Projection::Composite, CompositeOrder::FrontToBack, false);
     early.render.early_termination = 0.3;
-    early.volume.transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {1.0, 1.0}};
+    early.volume().transfer.opacity = {{0.0, 0.0}, {0.3, 0.0}, {1.0, 1.0}};
     expect_last_row_is_pixel(early, true, 8, 8);
     const PreparedScene p(early, {});
     const explain::PixelTrace t = explain::trace_pixel(p, 8, 8);
@@ -136,7 +136,7 @@ TEST(Trace, LastRowIsTheRenderedPixelOtherProjections) {
         SCOPED_TRACE(explain::projection_name(p));
         Scene s = blob_scene(p, CompositeOrder::FrontToBack, false);
         s.render.gain = 0.25;
-        s.volume.transfer.opacity = {{0.0, 0.1}, {1.0, 0.6}};  // minip's minimum has opacity > 0 too
+        s.volume().transfer.opacity = {{0.0, 0.1}, {1.0, 0.6}};  // minip's minimum has opacity > 0 too
         expect_last_row_is_pixel(s, true, 8, 8);
         expect_last_row_is_pixel(s, true, 3, 12);
     }
@@ -168,8 +168,8 @@ TEST(Trace, RunningValuesOfMipAndXray) {
 // and the last 6.928 - 6.5 = 0.428. After the segments up to t, T = 0.8^(t - sqrt(3)).
 TEST(Trace, RowsFollowTheClosedFormsOfABox) {
     Scene s = test::field_scene(test::constant_field(1.0, {5, 5, 5}));
-    s.volume.transfer.opacity = {{0.0, 0.2}};
-    s.volume.transfer.color = {{0.0, 0.5, 0.25, 1.0}};
+    s.volume().transfer.opacity = {{0.0, 0.2}};
+    s.volume().transfer.color = {{0.0, 0.5, 0.25, 1.0}};
     s.camera.type = CameraSpec::Type::Orthographic;
     s.camera.eye = {-1.0, -1.0, -1.0};
     s.camera.target = {2.0, 2.0, 2.0};
@@ -363,12 +363,12 @@ TEST(Trace, CommandLineErrorsAreOneLine) {
 // seam back to sample 0), the local coordinates u - cell.
 TEST(Trace, GridColumnsOnACylindricalShell) {
     Scene s = test::field_scene(test::constant_field(1.0, {11, 36, 4}));
-    s.volume.origin.reset();
-    s.volume.spacing.reset();
-    s.volume.bounds.type = BoundsSpec::Type::Cylindrical;
-    s.volume.bounds.cylinder.r1 = 10.0;
-    s.volume.bounds.cylinder.h1 = 3.0;
-    s.volume.transfer.opacity = {{0.0, 0.05}};
+    s.volume().origin.reset();
+    s.volume().spacing.reset();
+    s.volume().bounds.type = BoundsSpec::Type::Cylindrical;
+    s.volume().bounds.cylinder.r1 = 10.0;
+    s.volume().bounds.cylinder.h1 = 3.0;
+    s.volume().transfer.opacity = {{0.0, 0.05}};
     s.image.width = s.image.height = 16;
     const PreparedScene p(s, {});
     for (const auto& px : {std::array<int, 2>{5, 8}, std::array<int, 2>{11, 7}}) {

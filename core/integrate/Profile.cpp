@@ -28,6 +28,17 @@ Profile make_vtk_gpu() {
     return p;
 }
 
+// vtkFixedPointVolumeRayCastMapper of VTK 9.1, its CPU mapper: 15-bit fixed point throughout, on an
+// internal image drawn as a stretched texture. Too much for the fields above: VtkCpuProfile.h has it
+// (conventions section 9 states each formula).
+Profile make_vtk_cpu() {
+    Profile p;
+    p.id = ProfileId::VtkCpu;
+    p.name = "vtk-cpu";
+    p.vtk_fixed_point = true;
+    return p;
+}
+
 // A textbook GLSL ray caster (issue 7): samples from the entry point on, acc += (1 - acc.a) col.a col
 // with the transfer function's opacity used as the sample's alpha (no correction), stop at alpha >= 1,
 // central differences at +-0.1 in texture coordinates ([0, 1] over the volume's domain).
@@ -87,11 +98,13 @@ Profile make_cuda_curvilinear() {
 }  // namespace
 
 const Profile& profile(ProfileId id) {
-    static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), glsl_basic = make_glsl_basic(),
+    static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), vtk_cpu = make_vtk_cpu(),
+                         glsl_basic = make_glsl_basic(),
                          ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear();
     switch (id) {
         case ProfileId::Reference: return reference;
         case ProfileId::VtkGpu: return vtk_gpu;
+        case ProfileId::VtkCpu: return vtk_cpu;
         case ProfileId::GlslBasic: return glsl_basic;
         case ProfileId::Ospray: return ospray;
         case ProfileId::CudaCurvilinear: return cuda_curvilinear;

@@ -75,6 +75,10 @@ struct Profile {
     // The profile renders beam-space (shell) grids too: no domain clamping, no gradients.
     bool shells = false;
 
+    // vtkFixedPointVolumeRayCastMapper (VtkCpuProfile.h): the whole discretisation (internal image,
+    // 15-bit fixed-point ray casting, texture display) is that file's; the fields above are unused.
+    bool vtk_fixed_point = false;
+
     // Average projection: VTK's GPU shader averages opacity(v) * s (s the value normalised over the
     // data range, opacity the uncorrected table) over the samples and writes it as grey, alpha 1.
     bool average_opacity_weighted = false;

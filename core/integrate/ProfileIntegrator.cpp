@@ -16,7 +16,8 @@
 
 namespace volref {
 
-ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume)
+ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                                     const Scene* scene)
     : Integrator(ctx), p_(profile) {
     const std::string where = std::string("render.profile: \"") + p_.name + "\" ";
     const RenderSpec& r = ctx.render;
@@ -32,6 +33,16 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     if (ctx.pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
     if (ctx.pipeline.classifier().needs_gradient())
         throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
+    if (p_.vtk_fixed_point) {
+        if (!scene) throw Error(where + "needs the scene's camera and image (construct ProfileIntegrator with the scene)");
+        if (scene->volumes.size() != 1) throw Error(where + "renders one volume: volumes");
+        const BoundsSpec& b = scene->volume().bounds;
+        if (b.type != BoundsSpec::Type::Box || b.min || b.max)
+            throw Error(where + "casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
+        vtk_cpu_ = std::make_unique<vtkcpu::Caster>(volume, ctx.pipeline.classifier(), ctx.pipeline.shader(), r.projection,
+                                                    ctx.step, scene->camera, scene->image, scene->volume().interpolation);
+        return;
+    }
     const double inf = std::numeric_limits<double>::infinity();
     domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
     domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
@@ -62,6 +73,8 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         }
     }
 }
+
+ProfileIntegrator::~ProfileIntegrator() = default;
 
 double ProfileIntegrator::alpha(double a, double d) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
@@ -128,6 +141,12 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
 }
 
 PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    if (vtk_cpu_) {  // the pixel this ray belongs to, as VTK draws it (its own clipping: intervals unused)
+        const auto [x, y] = vtk_cpu_->pixel_of(ray);
+        PixelValue out;
+        out.rgba = vtk_cpu_->display(x, y, nullptr);
+        return out;
+    }
     NoRecording rec;
     return integrate_impl(ray, intervals, rec);
 }
@@ -135,6 +154,12 @@ PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interv
 PixelValue ProfileIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                SampleRecorder& recorder) const {
     Recording rec{recorder};
+    if (vtk_cpu_) {
+        const auto [x, y] = vtk_cpu_->pixel_of(ray);
+        PixelValue out;
+        out.rgba = vtk_cpu_->display(x, y, &rec);
+        return out;
+    }
     return integrate_impl(ray, intervals, rec);
 }
 

@@ -12,7 +12,10 @@
 //              mean of the transfer function's coordinate; pixel (g, g, g, 1);
 //   xray:      g = gain * sum_k coordinate(v_k) d_k (xray_maximum: brightness * max_k s_k); pixel (g, g, g, 1).
 //   composite with lerp_back_to_front: sum = lerp(sum, (c, a), a density) from the far end, pixel sum.
+//   vtk-cpu (profile.vtk_fixed_point): VtkCpuProfile.h's caster renders the pixel the ray belongs to
+//              (its internal rays, then the texture display); needs the scene's camera and image.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -21,13 +24,17 @@
 #include "core/integrate/Integrator.h"
 #include "core/integrate/Profile.h"
 #include "core/integrate/SampleRecorder.h"
+#include "core/integrate/VtkCpuProfile.h"
 
 namespace volref {
 
 class ProfileIntegrator final : public Integrator {
 public:
-    // Throws volref::Error naming render.profile for what the profile cannot render.
-    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
+    // Throws volref::Error naming render.profile for what the profile cannot render. `scene`: the
+    // scene being rendered (its camera and image size), required by vtk-cpu.
+    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                      const Scene* scene = nullptr);
+    ~ProfileIntegrator() override;
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     // The same loops, recording every sample (SampleRecorder.h): the record's segment is the length
     // the sample stands for centred on it, `t` the sample's own position, `alpha` its alpha,
@@ -68,6 +75,7 @@ private:
     double lo_ = 0.0, width_ = 0.0;  // the data range [lo, lo + width]
     std::vector<glm::dvec4> table_;  // rgb + uncorrected opacity
     std::vector<double> table_alpha_;  // corrected for the step (composite)
+    std::unique_ptr<vtkcpu::Caster> vtk_cpu_;  // vtk-cpu only
 };
 
 }  // namespace volref

@@ -146,7 +146,7 @@ enum class StepUnits { Voxel, World };
 // `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
 enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear };
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu };
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {
     double density = 1.0;         // the lerp weight is col.a * density

@@ -889,7 +889,7 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"tolerance": 0})"), "render.tolerance", "expected a number > 0"));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"integrator": "exact"})"), "render.integrator", "\"adaptive\""));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk"})"), "render.profile", "\"vtk-gpu\""));
-    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-cpu"})"), "render.profile", "not implemented yet"));
+    EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-cpu"})")).render.profile, ProfileId::VtkCpu);
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-gpu"})")).render.profile, ProfileId::VtkGpu);
     EXPECT_EQ(parse(scene_with(R"("render": {})")).render.profile, ProfileId::Reference);
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-gpu", "profile_options": {}})"),

@@ -1,8 +1,10 @@
 #!/bin/sh
 # VTK parity: volref's vtk-gpu profile against VTK 9.1's vtkGPUVolumeRayCastMapper (Debian's
 # python3-vtk9 on Mesa llvmpipe under Xvfb) on small composite (unshaded and shaded), MIP, MinIP and
-# average scenes, each within 8-bit quantisation (plus the measured tolerance bench/vtk/parity.py
-# states per case); the reference profile's difference is reported with `volref compare --fit`.
+# average scenes, and its vtk-cpu profile against vtkFixedPointVolumeRayCastMapper on the same
+# composite, shaded, MIP and MinIP scenes, each within 8-bit quantisation (plus the measured
+# tolerance bench/vtk/parity.py states per case); the reference profile's difference is reported
+# with `volref compare --fit`.
 #
 #   scripts/vtk-parity.sh VOLREF [OUT_DIR] [CASE ...]
 #

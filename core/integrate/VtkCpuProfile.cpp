@@ -6,6 +6,8 @@
 #include <string>
 
 #include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
 
 #include "core/Error.h"
 #include "transfer/Classifier.h"
@@ -155,6 +157,7 @@ Caster::Caster(const Volume& volume, const Classifier& classifier, const Shader*
     const auto range = clipping_range(eye_, forward_, camera.fov_y, lo, hi);
     near_ = range[0];
     far_ = range[1];
+    build_view_to_voxels();
 
     // Scalars to table indices (UpdateColorTable): float data (and integer data whose range exceeds
     // 32767) use 32768 entries, shift = -min, scale = 32767 / (max - min); narrower integer data use
@@ -412,8 +415,34 @@ void Caster::build_shading(const Shader& shader) {
     }
 }
 
-glm::dvec3 Caster::film_direction(double ndc_x, double ndc_y) const {
-    return forward_ + ndc_x * tan_half_ * aspect_ * right_ + ndc_y * tan_half_ * up_;
+// ComputeMatrices: ViewToVoxels = (P V VoxelsToWorld)^-1 in double, copied to float. V: the camera's
+// view transform (rows r, u, (eye - target) / |eye - target|, translation -R eye); P:
+// Perspective(fov_y, aspect, n, F) (Frustum with x_max = tan(fov_y / 2) n aspect, y_max =
+// tan(fov_y / 2) n) after AdjustZBuffer(-1, 1, 0, 1) (view depth 0 at the near plane, 1 at the far).
+void Caster::build_view_to_voxels() {
+    using M4 = std::array<double, 16>;  // row-major
+    auto mul = [](const M4& a, const M4& b) {
+        M4 c{};
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j)
+                for (int k = 0; k < 4; ++k) c[std::size_t(4 * i + j)] += a[std::size_t(4 * i + k)] * b[std::size_t(4 * k + j)];
+        return c;
+    };
+    const double n = near_, f = far_, ymax = tan_half_ * n, xmax = ymax * aspect_;
+    const M4 frustum = {n / xmax, 0, 0, 0, 0, n / ymax, 0, 0, 0, 0, -(f + n) / (f - n), -2.0 * f * n / (f - n), 0, 0, -1, 0};
+    const M4 adjust = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0.5, 0.5, 0, 0, 0, 1};
+    const glm::dvec3 z = -forward_;
+    const M4 view = {right_.x, right_.y, right_.z, -glm::dot(right_, eye_), up_.x, up_.y, up_.z, -glm::dot(up_, eye_),
+                     z.x, z.y, z.z, -glm::dot(z, eye_), 0, 0, 0, 1};
+    const M4 voxels_to_world = {spacing_.x, 0, 0, origin_.x, 0, spacing_.y, 0, origin_.y, 0, 0, spacing_.z, origin_.z,
+                                0, 0, 0, 1};
+    const M4 m = mul(mul(mul(adjust, frustum), view), voxels_to_world);
+    glm::dmat4 g;  // column-major copy for the inverse
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) g[j][i] = m[std::size_t(4 * i + j)];
+    const glm::dmat4 inv = glm::inverse(g);
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) view_to_voxels_[4 * i + j] = float(inv[j][i]);
 }
 
 std::array<int, 2> Caster::pixel_of(const Ray& ray) const {
@@ -483,11 +512,21 @@ bool clip_ray(float s[3], float e[3], const float dir[3], const double b[6]) {
 // the axes of 1 + (end - start) / step in fixed point.
 Caster::RayInfo Caster::ray_info(int i, int j) const {
     RayInfo info;
-    const double ndc_x = 2.0 * (double(i + layout_.origin[0]) + 0.5) / double(width_) - 1.0;
-    const double ndc_y = 2.0 * (double(j + layout_.origin[1]) + 0.5) / double(height_) - 1.0;
-    const glm::dvec3 d = film_direction(ndc_x, ndc_y);
-    const glm::dvec3 vs = voxel(eye_ + near_ * d), ve = voxel(eye_ + far_ * d);
-    float start[3] = {float(vs.x), float(vs.y), float(vs.z)}, end[3] = {float(ve.x), float(ve.y), float(ve.z)};
+    // viewRay in float as the mapper computes it; start at view depth 0, end at depth 1 (no z-buffer).
+    const float offset_x = float(1.0 / double(float(width_))), offset_y = float(1.0 / double(float(height_)));
+    const float view_x = float(double((float(i) + float(layout_.origin[0])) / float(width_)) * 2.0 - 1.0 + double(offset_x));
+    const float view_y = float(double((float(j) + float(layout_.origin[1])) / float(height_)) * 2.0 - 1.0 + double(offset_y));
+    auto transform = [&](float view_z, float out[3]) {  // vtkVRCMultiplyPointMacro, in float
+        const float* M = view_to_voxels_;
+        float b[4];
+        for (int k = 0; k < 4; ++k) b[k] = view_x * M[4 * k] + view_y * M[4 * k + 1] + view_z * M[4 * k + 2] + M[4 * k + 3];
+        if (b[3] != 1.0f)
+            for (int k = 0; k < 3; ++k) b[k] /= b[3];
+        for (int k = 0; k < 3; ++k) out[k] = b[k];
+    };
+    float start[3], end[3];
+    transform(0.0f, start);
+    transform(1.0f, end);
     float dir[3] = {end[0] - start[0], end[1] - start[1], end[2] - start[2]};
     const float original[3] = {start[0], start[1], start[2]};
     const double bounds[6] = {0.0, double(dims_[0] - 1), 0.0, double(dims_[1] - 1), 0.0, double(dims_[2] - 1)};

@@ -131,7 +131,7 @@ private:
     void build_shading(const Shader& shader);
     glm::dvec3 world(const glm::dvec3& voxel) const { return origin_ + voxel * spacing_; }
     glm::dvec3 voxel(const glm::dvec3& w) const { return (w - origin_) / spacing_; }
-    glm::dvec3 film_direction(double ndc_x, double ndc_y) const;  // f + ndc_x t a r + ndc_y t u
+    void build_view_to_voxels();
 
     std::array<std::int64_t, 3> dims_{};
     glm::dvec3 origin_{0.0}, spacing_{1.0};
@@ -141,6 +141,7 @@ private:
     int width_ = 0, height_ = 0;
     glm::dvec3 eye_{0.0}, forward_{0.0}, right_{0.0}, up_{0.0};
     double tan_half_ = 0.0, aspect_ = 1.0, near_ = 0.0, far_ = 0.0;
+    float view_to_voxels_[16] = {};  // ViewToVoxelsArray: row-major, as the mapper copies it to float
     float shift_ = 0.0f, scale_ = 1.0f;
     std::vector<unsigned> scalars_;          // per voxel: unsigned(scale (v + shift))
     std::vector<float> data_;                // shaded: the data cast to float (the gradient's input)

@@ -15,7 +15,8 @@ run with --fit and its verdict printed: what explains the reference's difference
 Cases: composite, shaded, mip, minip, average, each rendered by vtkGPUVolumeRayCastMapper and
 compared with render.profile "vtk-gpu"; composite, shaded, mip and minip also by
 vtkFixedPointVolumeRayCastMapper and compared with render.profile "vtk-cpu" (the fixed-point mapper
-renders no average in VTK 9.1).
+renders no average in VTK 9.1); composite-u8, shaded-u8, composite-u16 and shaded-u16 render the field
+stored as 8- and 16-bit integers with the fixed-point mapper only (its integer table paths).
 
 Options (for measuring, not used by the test): --eye X,Y,Z and --size W,H change the camera's eye and
 the image size of every case.
@@ -38,9 +39,12 @@ SIZE = [64, 64]
 # the 8-bit bound on 1% of the pixels, in the opaque centre; the cause is not isolated (a gradient
 # offset of 0.5 voxel instead of 1 makes it 4 times worse).
 TOLERANCE = {"composite": 1e-5, "shaded": 0.0015, "mip": 1e-5, "minip": 1e-5, "average": 1e-5}
-# vtk-cpu against vtkFixedPointVolumeRayCastMapper: 1e-5 in every case; measured (this camera) at most
-# 3.3e-6 past the 8-bit bound (one composite pixel), the others within it (docs/gpu-checking.md).
-TOLERANCE_CPU = {"composite": 1e-5, "shaded": 1e-5, "mip": 1e-5, "minip": 1e-5}
+# vtk-cpu against vtkFixedPointVolumeRayCastMapper, float data: 1e-5 in every case; measured (this
+# camera) within the 8-bit bound in all four (docs/gpu-checking.md).
+# Integer data: composite-u16 3e-5 (one pixel measured 2.4e-5 past the bound: a value at an 8-bit
+# rounding boundary), the others 1e-5 (composite-u8: one pixel 2.8e-6 past it).
+TOLERANCE_CPU = {"composite": 1e-5, "shaded": 1e-5, "mip": 1e-5, "minip": 1e-5,
+                 "composite-u8": 1e-5, "shaded-u8": 1e-5, "composite-u16": 3e-5, "shaded-u16": 1e-5}
 # Which VTK mapper each mirror profile is compared with (the PNG's suffix, render_scene_with_vtk.py's --mapper).
 MIRRORS = (("vtk-gpu", "gpu", TOLERANCE), ("vtk-cpu", "fixed", TOLERANCE_CPU))
 
@@ -53,21 +57,34 @@ def field():
     return (np.exp(-r2 / 60.0) * (0.75 + 0.25 * np.cos(x / 2.5))).astype(np.float32)
 
 
-def write_nrrd(path, values):
+# Integer volumes for the fixed-point mapper's integer paths: the field scaled to [0, top] and rounded.
+# u8: one table entry per integer value (256); u16 with a range above 32767: the 32768-entry tables.
+DATA = {"f32": ("volume.nrrd", "float", "<f4", 1.0), "u8": ("volume-u8.nrrd", "uchar", "u1", 255.0),
+        "u16": ("volume-u16.nrrd", "ushort", "<u2", 60000.0)}
+
+
+def write_nrrd(path, values, nrrd_type="float", dtype="<f4"):
     nz, ny, nx = values.shape
     with open(path, "wb") as f:
-        f.write(f"NRRD0004\ntype: float\ndimension: 3\nsizes: {nx} {ny} {nz}\nencoding: raw\nendian: little\n\n"
+        f.write(f"NRRD0004\ntype: {nrrd_type}\ndimension: 3\nsizes: {nx} {ny} {nz}\nencoding: raw\nendian: little\n\n"
                 .encode("ascii"))
-        f.write(values.astype("<f4").tobytes())
+        f.write(values.astype(dtype).tobytes())
+
+
+def write_volumes(out):
+    v = field()
+    for name, (file, nrrd_type, dtype, top) in DATA.items():
+        values = v if name == "f32" else np.round(v / v.max() * top)
+        write_nrrd(os.path.join(out, file), values, nrrd_type, dtype)
 
 
 EYE = [29.0, 17.0, 63.0]
 
 
-def scene(projection, shaded=False):
+def scene(projection, shaded=False, data="f32"):
     h = (N - 1) / 2.0
     volume = {
-        "source": "volume.nrrd",
+        "source": DATA[data][0],
         "origin": [-h, -h, -h],
         "spacing": [1, 1, 1],
         "interpolation": "trilinear",
@@ -80,10 +97,13 @@ def scene(projection, shaded=False):
         volume["transfer"]["opacity"] = [[0.0, 0.2], [1.0, 1.0]]
     if projection == "average":
         volume["transfer"]["opacity"] = [[0.0, 1.0], [1.0, 1.0]]
+    top = DATA[data][3]  # the transfer functions' points over the integer data's range
+    volume["transfer"]["color"] = [[p[0] * top] + p[1:] for p in volume["transfer"]["color"]]
+    volume["transfer"]["opacity"] = [[p[0] * top, p[1]] for p in volume["transfer"]["opacity"]]
     if shaded:
         volume["shading"] = {"ka": 0.2, "kd": 0.7, "ks": 0.3, "n": 10, "two_sided": True}
     return {
-        "description": f"VTK parity: {projection}{' shaded' if shaded else ''}",
+        "description": f"VTK parity: {projection}{' shaded' if shaded else ''}, {data} data",
         "volume": volume,
         "lights": [{"type": "headlight", "color": [1, 1, 1]}],
         "camera": {"type": "perspective", "eye": EYE, "target": [0, 0, 0], "up": [0, 1, 0],
@@ -94,7 +114,10 @@ def scene(projection, shaded=False):
 
 
 CASES = {"composite": ("composite", False), "shaded": ("composite", True), "mip": ("mip", False),
-         "minip": ("minip", False), "average": ("average", False)}
+         "minip": ("minip", False), "average": ("average", False),
+         # the fixed-point mapper's integer paths (vtk-cpu only)
+         "composite-u8": ("composite", False, "u8"), "shaded-u8": ("composite", True, "u8"),
+         "composite-u16": ("composite", False, "u16"), "shaded-u16": ("composite", True, "u16")}
 
 
 def run(cmd):
@@ -128,13 +151,12 @@ def main():
     volref, out = args[0], args[1]
     cases = args[2:] or list(CASES)
     os.makedirs(out, exist_ok=True)
-    write_nrrd(os.path.join(out, "volume.nrrd"), field())
+    write_volumes(out)
     failed = []
     for name in cases:
-        projection, shaded = CASES[name]
         path = os.path.join(out, f"{name}.json")
         with open(path, "w") as f:
-            json.dump(scene(projection, shaded), f, indent=1)
+            json.dump(scene(*CASES[name]), f, indent=1)
         reference = os.path.join(out, f"{name}-reference.exr")
         run([volref, "render", path, "-o", reference, "--set", "render.profile=reference"])
         for profile, mapper, tolerance in MIRRORS:

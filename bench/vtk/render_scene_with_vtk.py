@@ -40,7 +40,8 @@ def fail(message):
 
 
 def read_nrrd(path):
-    """A float NRRD with an attached raw little-endian body: returns (dims, values (nz, ny, nx))."""
+    """A float, unsigned char or unsigned short NRRD with an attached raw little-endian body: returns
+    (dims, values (nz, ny, nx)) in the file's type."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.index(b"\n\n")
@@ -49,10 +50,11 @@ def read_nrrd(path):
         if ":" in line and not line.startswith("#"):
             k, v = line.split(":", 1)
             fields[k.strip()] = v.strip()
-    if fields.get("type") != "float" or fields.get("encoding") != "raw" or fields.get("endian", "little") != "little":
-        fail(f"{path}: only float, raw, little-endian NRRD files are supported")
+    types = {"float": "<f4", "uchar": "u1", "unsigned char": "u1", "ushort": "<u2", "unsigned short": "<u2"}
+    if fields.get("type") not in types or fields.get("encoding") != "raw" or fields.get("endian", "little") != "little":
+        fail(f"{path}: only float, uchar and ushort, raw, little-endian NRRD files are supported")
     dims = [int(x) for x in fields["sizes"].split()]
-    values = np.frombuffer(data[end + 2:], dtype="<f4", count=dims[0] * dims[1] * dims[2])
+    values = np.frombuffer(data[end + 2:], dtype=types[fields["type"]], count=dims[0] * dims[1] * dims[2])
     return dims, values.reshape(dims[2], dims[1], dims[0])
 
 

@@ -179,7 +179,7 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
     integrator = scene.render.profile == ProfileId::Reference
                      ? make_integrator(*context)
-                     : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume);
+                     : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume, &scene);
 }
 
 PreparedScene::~PreparedScene() = default;

@@ -10,6 +10,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "transfer/Classifier.h"
 #include "transfer/Shader.h"
 
@@ -170,6 +171,10 @@ Caster::Caster(const Volume& volume, const Classifier& classifier, const Shader*
     shift_ = float(-vmin);
     scale_ = scaled ? (vmax - vmin != 0.0 ? float(32767.0 / (vmax - vmin)) : 1.0f) : 1.0f;
     const std::size_t n = std::size_t(dims_[0] * dims_[1] * dims_[2]);
+    // Per voxel: the table index (4 bytes), and when shaded the float data and the normal code (6 more),
+    // plus the held volume (8 bytes per voxel at most).
+    check_memory(n * (sizeof(unsigned) + (shaded_ ? sizeof(float) + sizeof(unsigned short) : 0) + sizeof(double)),
+                 where + "voxel tables");
     scalars_.resize(n);
     if (shaded_) data_.resize(n);
     std::size_t idx = 0;

@@ -9,6 +9,7 @@
 
 #include "TestScenes.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/explain/PixelTrace.h"
 #include "core/integrate/VtkCpuProfile.h"
 #include "core/render/PreparedScene.h"
@@ -246,4 +247,19 @@ TEST(VtkCpuProfile, TraceLastRowIsTheRenderedPixelForEveryProfile) {
             EXPECT_GT(rendered.a, 0.0);
         }
     }
+}
+
+// The per-voxel tables are checked against the memory limit before they are allocated: 17^3 voxels
+// shaded need 17^3 (4 + 4 + 2 + 8) = 88434 bytes = 86.4 KiB, more than a limit of 50000 bytes.
+TEST(VtkCpuProfile, TablesRespectTheMemoryLimit) {
+    const std::size_t saved = memory_limit();
+    set_memory_limit(50000);
+    std::string message;
+    try {
+        const PreparedScene p(blob(ProfileId::VtkCpu, Projection::Composite, true), {1, false});
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    set_memory_limit(saved);
+    EXPECT_NE(message.find("\"vtk-cpu\" voxel tables: needs 86.4 KiB"), std::string::npos) << message;
 }

@@ -18,8 +18,8 @@ vtkFixedPointVolumeRayCastMapper and compared with render.profile "vtk-cpu" (the
 renders no average in VTK 9.1); composite-u8, shaded-u8, composite-u16 and shaded-u16 render the field
 stored as 8- and 16-bit integers with the fixed-point mapper only (its integer table paths).
 
-Options (for measuring, not used by the test): --eye X,Y,Z and --size W,H change the camera's eye and
-the image size of every case.
+Options (for measuring, not used by the test): --eye X,Y,Z, --size W,H and --spacing SX,SY,SZ change
+the camera's eye, the image size and the voxel spacing (the volume stays centred at 0) of every case.
 """
 import json
 import os
@@ -79,14 +79,15 @@ def write_volumes(out):
 
 
 EYE = [29.0, 17.0, 63.0]
+SPACING = [1.0, 1.0, 1.0]
 
 
 def scene(projection, shaded=False, data="f32"):
     h = (N - 1) / 2.0
     volume = {
         "source": DATA[data][0],
-        "origin": [-h, -h, -h],
-        "spacing": [1, 1, 1],
+        "origin": [-h * SPACING[0], -h * SPACING[1], -h * SPACING[2]],
+        "spacing": SPACING,
         "interpolation": "trilinear",
         "transfer": {"domain": "data",
                      "color": [[0.0, 0.1, 0.2, 0.9], [0.4, 0.2, 0.8, 0.3], [0.7, 1.0, 0.6, 0.1], [1.0, 1.0, 1.0, 1.0]],
@@ -135,19 +136,21 @@ def compare(volref, a, b, tolerance, fit=False):
 
 
 def main():
-    global SIZE, EYE
+    global SIZE, EYE, SPACING
     args = sys.argv[1:]
-    for flag in ("--eye", "--size"):
+    for flag in ("--eye", "--size", "--spacing"):
         if flag in args:
             i = args.index(flag)
             values = [float(x) for x in args[i + 1].split(",")]
             del args[i:i + 2]
             if flag == "--eye":
                 EYE = values
+            elif flag == "--spacing":
+                SPACING = values
             else:
                 SIZE = [int(values[0]), int(values[1])]
     if len(args) < 2:
-        sys.exit("usage: parity.py VOLREF OUT_DIR [CASE ...] [--eye X,Y,Z] [--size W,H]")
+        sys.exit("usage: parity.py VOLREF OUT_DIR [CASE ...] [--eye X,Y,Z] [--size W,H] [--spacing SX,SY,SZ]")
     volref, out = args[0], args[1]
     cases = args[2:] or list(CASES)
     os.makedirs(out, exist_ok=True)

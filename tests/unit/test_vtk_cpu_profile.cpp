@@ -200,7 +200,7 @@ TEST(VtkCpuProfile, OpacityTableCorrectedForTheStepByHand) {
 }
 
 // The fixed-point mapper renders neither average, x-ray nor isosurfaces (VTK 9.1): one-line errors.
-TEST(VtkCpuProfile, AverageAndXrayAreErrors) {
+TEST(VtkCpuProfile, AverageXrayAndIsosurfacesAreErrors) {
     for (Projection pr : {Projection::Average, Projection::Xray}) {
         try {
             render_scene(blob(ProfileId::VtkCpu, pr, false), {1, false});
@@ -211,6 +211,16 @@ TEST(VtkCpuProfile, AverageAndXrayAreErrors) {
             EXPECT_NE(m.find("render.projection"), std::string::npos) << m;
             EXPECT_EQ(m.find('\n'), std::string::npos) << m;
         }
+    }
+    // Isosurfaces (first-hit) neither.
+    Scene iso = blob(ProfileId::VtkCpu, Projection::FirstHit, false);
+    iso.render.isovalue = 0.5;
+    try {
+        render_scene(iso, {1, false});
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("render.profile: \"vtk-cpu\" does not render the first-hit projection"), std::string::npos) << m;
     }
     Scene ortho = blob(ProfileId::VtkCpu, Projection::Composite, false);
     ortho.camera.type = CameraSpec::Type::Orthographic;

@@ -60,10 +60,11 @@ Volume make_procedural_volume(const FieldSpec& field,
     if (field.kind == FieldSpec::Kind::Cells && field.values.size() != count)
         throw Error("volume.source.values: expected " + std::to_string(count) + " values (dims product), got " +
                     std::to_string(field.values.size()));
-    v.values.resize(count);
+    v.values.allocate(ScalarType::F64, count, false);  // every voxel is written below
+    double* out = v.values.data<double>();
     for (std::int64_t k = 0; k < v.dims[2]; ++k)
         for (std::int64_t j = 0; j < v.dims[1]; ++j)
-            for (std::int64_t i = 0; i < v.dims[0]; ++i) v.values[v.index(i, j, k)] = field_value(field, v, position(i, j, k), i, j, k);
+            for (std::int64_t i = 0; i < v.dims[0]; ++i) out[v.index(i, j, k)] = field_value(field, v, position(i, j, k), i, j, k);
     return v;
 }
 

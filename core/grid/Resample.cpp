@@ -19,15 +19,16 @@ namespace {
 template <class F>
 void fill_parallel(Volume& out, const F& f) {
     const std::int64_t nx = out.dims[0], ny = out.dims[1];
+    double* values = out.values.data<double>();  // make_output's f64 storage
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, out.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
         for (std::int64_t k = r.begin(); k != r.end(); ++k)
             for (std::int64_t j = 0; j < ny; ++j)
-                for (std::int64_t i = 0; i < nx; ++i) out.values[out.index(i, j, k)] = f(i, j, k);
+                for (std::int64_t i = 0; i < nx; ++i) values[out.index(i, j, k)] = f(i, j, k);
     });
 }
 
 void check_source(const Volume& v, const std::string& what) {
-    const std::size_t count = checked_voxel_count(v.dims, what);
+    const std::size_t count = checked_voxel_count(v.dims, what, scalar_type_size(v.values.type()));
     if (v.values.size() != count)
         throw Error(what + ": " + std::to_string(v.values.size()) + " values for dims " + std::to_string(v.dims[0]) +
                     " x " + std::to_string(v.dims[1]) + " x " + std::to_string(v.dims[2]));
@@ -35,7 +36,7 @@ void check_source(const Volume& v, const std::string& what) {
 
 Volume make_output(const std::array<std::int64_t, 3>& dims, const glm::dvec3& origin, const glm::dvec3& spacing) {
     Volume out;
-    out.values.resize(checked_voxel_count(dims, "resample output"));
+    out.values.allocate(ScalarType::F64, checked_voxel_count(dims, "resample output"), false);  // filled by fill_parallel
     out.dims = dims;
     out.origin = origin;
     out.spacing = spacing;

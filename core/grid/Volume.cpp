@@ -50,8 +50,11 @@ std::array<double, 2> scalar_type_range(ScalarType t) {
 
 std::array<double, 2> Volume::value_range() const {
     if (values.empty()) return {0.0, 0.0};
-    auto [lo, hi] = std::minmax_element(values.begin(), values.end());
-    return {*lo, *hi};
+    // One pass in the storage type (NaN compares false, as std::minmax_element's comparisons do).
+    return values.visit([&](const auto* p) -> std::array<double, 2> {
+        auto [lo, hi] = std::minmax_element(p, p + values.size());
+        return {double(*lo), double(*hi)};
+    });
 }
 
 std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const std::string& what,

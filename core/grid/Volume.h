@@ -1,9 +1,11 @@
 // Volume: a regular, vertex-centred scalar grid (conventions section 1).
 //
 // Voxel (i, j, k) holds the value at origin + (i*sx, j*sy, k*sz); the domain is the box
-// [origin, origin + (dims - 1) * spacing]. Storage is i fastest, then j, then k. Values are kept as
-// double whatever the file's type, so every type (u8 .. u32, i8 .. i32, f32, f64) is held exactly and
-// reconstruction never re-rounds them; `type` remembers the file's type for the normalised domain.
+// [origin, origin + (dims - 1) * spacing]. Storage is i fastest, then j, then k. Values are kept in
+// the file's type (VoxelArray: u8 .. u32, i8 .. i32, f32, f64, 1 to 8 bytes per voxel) and read as
+// double, which is exact for every type, so reconstruction never re-rounds them. `type` is the
+// file's type for the normalised domain; the readers store the values in that same type
+// (values.type() == type); procedural fields, resampled grids and caches are f64.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -13,25 +15,16 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/grid/VoxelArray.h"
+
 namespace volref {
-
-enum class ScalarType { U8, I8, U16, I16, U32, I32, F32, F64 };
-
-// "u8", "i16", "f32", ... (the names used in scene files, sidecars and messages).
-const char* scalar_type_name(ScalarType t);
-// Size of one value of the type in bytes.
-std::size_t scalar_type_size(ScalarType t);
-// True for the integer types.
-bool scalar_type_is_integer(ScalarType t);
-// [lowest, highest] representable value of an integer type (used as the default normalisation window).
-std::array<double, 2> scalar_type_range(ScalarType t);
 
 struct Volume {
     std::array<std::int64_t, 3> dims{0, 0, 0};
     glm::dvec3 origin{0.0};
     glm::dvec3 spacing{1.0};
     ScalarType type = ScalarType::F64;
-    std::vector<double> values;  // dims[0] * dims[1] * dims[2] values, i fastest
+    VoxelArray values;  // dims[0] * dims[1] * dims[2] values, i fastest, in the storage type values.type()
 
     std::size_t index(std::int64_t i, std::int64_t j, std::int64_t k) const {
         return static_cast<std::size_t>(i + dims[0] * (j + dims[1] * k));
@@ -58,8 +51,9 @@ struct Volume {
     }
 };
 
-// Checks that every dim is >= 1 and that their product (and its size in bytes as double) does not
-// overflow or exceed `max_bytes`; throws Error naming `what` otherwise. Returns the voxel count.
+// Checks that every dim is >= 1 and that their product (and its size in bytes at `bytes_per_value`,
+// the storage type's size) does not overflow, exceed 2^38 bytes or the memory limit; throws Error
+// naming `what` otherwise. Returns the voxel count.
 std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const std::string& what,
                                 std::size_t bytes_per_value = sizeof(double));
 

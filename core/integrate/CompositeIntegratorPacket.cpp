@@ -20,14 +20,14 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
         return;
     const Volume& v = sampler->volume();
     // Non-finite voxels: the scalar path, whose pipeline makes them transparent (docs/accuracy.md).
-    if (!std::all_of(v.values.begin(), v.values.end(), [](double x) { return std::isfinite(x); })) return;
+    if (!all_finite(v.values)) return;
     PacketCompositeInputs in;
     if (tf->needs_gradient() || p.shaded()) {
         const auto* field = dynamic_cast<const GradientField*>(p.gradient_source());
         if (!field) return;
         if (field->cached_component(0)) {
             in.gradient = PacketCompositeInputs::Gradient::Cached;
-            for (int a = 0; a < 3; ++a) in.cached_gradient[a] = field->cached_component(a)->values.data();
+            for (int a = 0; a < 3; ++a) in.cached_gradient[a] = field->cached_component(a)->values.data<double>();
         } else if (field->scheme() == GradientSpec::Scheme::Central) {
             in.gradient = PacketCompositeInputs::Gradient::Central;
         } else if (field->scheme() == GradientSpec::Scheme::Forward) {
@@ -68,7 +68,8 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
             }
         }
     }
-    in.voxels = v.values.data();
+    in.voxels = v.values.raw();
+    in.voxel_type = v.values.type();
     for (int a = 0; a < 3; ++a) {
         in.dims[a] = v.dims[a];
         in.origin[a] = v.origin[a];

@@ -13,9 +13,10 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
     if (!sampler || sampler->interpolation() != Interpolation::Trilinear) return;
     const Volume& v = sampler->volume();
     // Non-finite voxels: the scalar path, which ignores them (docs/accuracy.md).
-    if (!std::all_of(v.values.begin(), v.values.end(), [](double x) { return std::isfinite(x); })) return;
+    if (!all_finite(v.values)) return;
     PacketExtremumInputs in;
-    in.voxels = v.values.data();
+    in.voxels = v.values.raw();
+    in.voxel_type = v.values.type();
     for (int a = 0; a < 3; ++a) {
         in.dims[a] = v.dims[a];
         in.origin[a] = v.origin[a];

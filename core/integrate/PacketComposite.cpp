@@ -150,12 +150,15 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     HWY_ALIGN double buf[RayPacket::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
     // The cached gradient components share the volume's grid.
     const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
-    const PacketTrilinear gx(cached ? in.cached_gradient[0] : in.voxels, in.dims, in.origin, in.inv_spacing);
-    const PacketTrilinear gy(cached ? in.cached_gradient[1] : in.voxels, in.dims, in.origin, in.inv_spacing);
-    const PacketTrilinear gz(cached ? in.cached_gradient[2] : in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear gx(cached ? static_cast<const void*>(in.cached_gradient[0]) : in.voxels,
+                              cached ? ScalarType::F64 : in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear gy(cached ? static_cast<const void*>(in.cached_gradient[1]) : in.voxels,
+                              cached ? ScalarType::F64 : in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear gz(cached ? static_cast<const void*>(in.cached_gradient[2]) : in.voxels,
+                              cached ? ScalarType::F64 : in.voxel_type, in.dims, in.origin, in.inv_spacing);
     const PacketGradient gradient{in, trilinear, {&gx, &gy, &gz}};
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
 

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "core/camera/Ray.h"
+#include "core/grid/VoxelArray.h"
 #include "core/integrate/Integrator.h"
 #include "geometry/RayIntervals.h"
 
@@ -42,7 +43,8 @@ class MacrocellGrid;
 
 // Everything the kernel reads, as plain arrays.
 struct PacketCompositeInputs {
-    const double* voxels = nullptr;  // the volume's values, i fastest
+    const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
+    ScalarType voxel_type = ScalarType::F64;
     std::int64_t dims[3] = {1, 1, 1};
     double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
     bool normalized = false;  // transfer coordinate (v - lo) * inv_width, else v

@@ -20,7 +20,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     RayPacket packet(rays, intervals, count, in.step);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinear trilinear(in.voxels, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinear trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
     const V zero = hn::Zero(d);
     V best = zero, t_best = zero, seen = zero;
     while (packet.next()) {

@@ -8,12 +8,14 @@
 #include <vector>
 
 #include "core/camera/Ray.h"
+#include "core/grid/VoxelArray.h"
 #include "geometry/RayIntervals.h"
 
 namespace volref {
 
 struct PacketExtremumInputs {
-    const double* voxels = nullptr;
+    const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
+    ScalarType voxel_type = ScalarType::F64;
     std::int64_t dims[3] = {1, 1, 1};
     double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
     double step = 1.0;

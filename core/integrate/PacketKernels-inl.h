@@ -11,9 +11,12 @@
 
 #include <hwy/highway.h>
 
+#include <bit>
+#include <cstdint>
 #include <vector>
 
 #include "core/camera/Ray.h"
+#include "core/grid/VoxelArray.h"
 #include "core/integrate/SegmentWalk.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -78,17 +81,37 @@ struct RayPacket {
 
 // Trilinear reconstruction of a regular grid for packets of world points (VolumeSampler::trilinear:
 // u = clamp((x - origin) inv_spacing, 0, n - 1), cell min(floor(u), n - 2), Levoy's sum in order).
+// The voxels are read in their storage type (VoxelArray) and converted to double exactly, so the sum
+// is the same whatever the type. One switch on the type per packet sample, then per type:
+//   f64: 64-bit index gathers (as before);
+//   f32, i32, u32: 32-bit gathers with int32 indices, promoted to double (u32: read as i32, plus 2^32
+//     where negative, exact);
+//   u16, i16, u8, i8: a 32-bit gather of the word that ends with the sample (VoxelArray pads the
+//     buffer, so the bytes before the first sample are inside the allocation; little-endian hosts),
+//     shifted right by 16 or 24 bits (logical for unsigned, arithmetic for signed types);
+//   anything else (a volume of 2^31 samples or bytes or more, or a big-endian host): lane by lane.
 struct PacketTrilinear {
-    const double* voxels;
+    using DI32 = hn::Rebind<std::int32_t, D>;
+    using DU32 = hn::Rebind<std::uint32_t, D>;
+    using DF32 = hn::Rebind<float, D>;
+    enum class Kind { F64, F32, I32, U32, U16, I16, U8, I8, Lanes };
+
+    const void* voxels;
+    ScalarType type;
+    Kind kind;
     V org[3], inv[3], maxi[3], top[3];
     bool flat[3];
     V nx, nxy;
     hn::Vec<DI> offx, offy, offz;
+    hn::Vec<DI32> offx32, offy32, offz32;
 
-    PacketTrilinear(const double* data, const std::int64_t dims[3], const double origin[3], const double inv_spacing[3]) {
+    PacketTrilinear(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
+                    const double inv_spacing[3]) {
         const D d;
         const DI di;
+        const DI32 di32;
         voxels = data;
+        type = data_type;
         for (int a = 0; a < 3; ++a) {
             org[a] = hn::Set(d, origin[a]);
             inv[a] = hn::Set(d, inv_spacing[a]);
@@ -101,11 +124,120 @@ struct PacketTrilinear {
         offx = hn::Set(di, flat[0] ? 0 : 1);
         offy = hn::Set(di, flat[1] ? 0 : dims[0]);
         offz = hn::Set(di, flat[2] ? 0 : dims[0] * dims[1]);
+        const std::uint64_t count = std::uint64_t(dims[0]) * std::uint64_t(dims[1]) * std::uint64_t(dims[2]);
+        const bool fits32 = count * scalar_type_size(type) < (std::uint64_t(1) << 31) - 64;
+        const std::int64_t unit = std::int64_t(scalar_type_size(type) < 4 ? scalar_type_size(type) : 1);
+        // 32-bit offsets: in elements for the 4-byte types, in bytes for the 1- and 2-byte ones.
+        offx32 = hn::Set(di32, std::int32_t(fits32 ? (flat[0] ? 0 : 1) * unit : 0));
+        offy32 = hn::Set(di32, std::int32_t(fits32 ? (flat[1] ? 0 : dims[0]) * unit : 0));
+        offz32 = hn::Set(di32, std::int32_t(fits32 ? (flat[2] ? 0 : dims[0] * dims[1]) * unit : 0));
+        constexpr bool little = std::endian::native == std::endian::little;
+        switch (type) {
+            case ScalarType::F64: kind = Kind::F64; break;
+            case ScalarType::F32: kind = fits32 ? Kind::F32 : Kind::Lanes; break;
+            case ScalarType::I32: kind = fits32 ? Kind::I32 : Kind::Lanes; break;
+            case ScalarType::U32: kind = fits32 ? Kind::U32 : Kind::Lanes; break;
+            case ScalarType::U16: kind = fits32 && little ? Kind::U16 : Kind::Lanes; break;
+            case ScalarType::I16: kind = fits32 && little ? Kind::I16 : Kind::Lanes; break;
+            case ScalarType::U8: kind = fits32 && little ? Kind::U8 : Kind::Lanes; break;
+            case ScalarType::I8: kind = fits32 && little ? Kind::I8 : Kind::Lanes; break;
+            default: kind = Kind::Lanes; break;
+        }
+    }
+
+    // The eight corners f1..f8 (Levoy's order) of the cells at `idx` (i + nx j + nx ny k, any index
+    // vector type), each fetched by g.
+    template <class IV, class G>
+    static HWY_INLINE void eight(IV idx, IV ox, IV oy, IV oz, const G& g, V f[8]) {
+        f[0] = g(idx);
+        f[1] = g(hn::Add(idx, ox));
+        f[2] = g(hn::Add(hn::Add(idx, ox), oy));
+        f[3] = g(hn::Add(idx, oy));
+        const IV idz = hn::Add(idx, oz);
+        f[4] = g(idz);
+        f[5] = g(hn::Add(idz, ox));
+        f[6] = g(hn::Add(hn::Add(idz, ox), oy));
+        f[7] = g(hn::Add(idz, oy));
+    }
+
+    // A 32-bit word ending with each 1- or 2-byte sample, shifted down to the sample.
+    template <int kShift, bool kSigned>
+    HWY_INLINE V narrow(hn::Vec<DI32> byte_offset) const {
+        const D d;
+        const DI32 di32;
+        const DU32 du32;
+        const auto* base = reinterpret_cast<const std::int32_t*>(static_cast<const char*>(voxels) - (4 - (32 - kShift) / 8));
+        const auto word = hn::GatherOffset(di32, base, byte_offset);
+        if constexpr (kSigned) return hn::PromoteTo(d, hn::ShiftRight<kShift>(word));
+        else return hn::PromoteTo(d, hn::BitCast(di32, hn::ShiftRight<kShift>(hn::BitCast(du32, word))));
+    }
+
+    HWY_INLINE void corners(V cell0, V cell1, V cell2, V f[8]) const {
+        const D d;
+        const DI di;
+        const DI32 di32;
+        const DF32 df32;
+        if (kind == Kind::F64 || kind == Kind::Lanes) {
+            // i + nx j + nx ny k, exact in double.
+            const auto idx = hn::Add(hn::ConvertTo(di, hn::Add(cell0, hn::Mul(nx, cell1))), hn::ConvertTo(di, hn::Mul(nxy, cell2)));
+            if (kind == Kind::F64) {
+                const auto* p = static_cast<const double*>(voxels);
+                eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return hn::GatherIndex(d, p, i); }, f);
+            } else {
+                eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return lanes(i); }, f);
+            }
+            return;
+        }
+        // The same index, exact in double and < 2^31, as int32 (in bytes for the 1- and 2-byte types).
+        V index = hn::Add(hn::Add(cell0, hn::Mul(nx, cell1)), hn::Mul(nxy, cell2));
+        if (kind == Kind::U16 || kind == Kind::I16) index = hn::Add(index, index);
+        const auto idx = hn::DemoteTo(di32, index);
+        switch (kind) {
+            case Kind::F32: {
+                const auto* p = static_cast<const float*>(voxels);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return hn::PromoteTo(d, hn::GatherIndex(df32, p, i)); }, f);
+                break;
+            }
+            case Kind::I32: {
+                const auto* p = static_cast<const std::int32_t*>(voxels);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return hn::PromoteTo(d, hn::GatherIndex(di32, p, i)); }, f);
+                break;
+            }
+            case Kind::U32: {
+                const auto* p = static_cast<const std::int32_t*>(voxels);
+                const V two32 = hn::Set(d, 4294967296.0), zero = hn::Zero(d);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR {
+                    const V s = hn::PromoteTo(d, hn::GatherIndex(di32, p, i));
+                    return hn::IfThenElse(hn::Lt(s, zero), hn::Add(s, two32), s);
+                }, f);
+                break;
+            }
+            case Kind::U16: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<16, false>(i); }, f); break;
+            case Kind::I16: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<16, true>(i); }, f); break;
+            case Kind::U8: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<24, false>(i); }, f); break;
+            case Kind::I8: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<24, true>(i); }, f); break;
+            default: break;
+        }
+    }
+
+    // Lane by lane (64-bit indices), any storage type.
+    HWY_INLINE V lanes(hn::Vec<DI> idx) const {
+        const D d;
+        const DI di;
+        HWY_ALIGN std::int64_t ix[RayPacket::kLanes];
+        HWY_ALIGN double out[RayPacket::kLanes];
+        hn::Store(idx, di, ix);
+        const std::size_t n = hn::Lanes(d);
+        dispatch_scalar_type(type, [&](auto tag) {
+            using T = decltype(tag);
+            const T* p = static_cast<const T*>(voxels);
+            for (std::size_t l = 0; l < n; ++l) out[l] = double(p[ix[l]]);
+        });
+        return hn::Load(d, out);
     }
 
     HWY_INLINE V operator()(V x, V y, V z) const {
         const D d;
-        const DI di;
         const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
         const V X[3] = {x, y, z};
         V cell[3], frac[3];
@@ -119,29 +251,19 @@ struct PacketTrilinear {
                 frac[a] = hn::Sub(u, cell[a]);
             }
         }
-        // i + nx j + nx ny k, exact in double.
-        const auto idx = hn::Add(hn::ConvertTo(di, hn::Add(cell[0], hn::Mul(nx, cell[1]))),
-                                 hn::ConvertTo(di, hn::Mul(nxy, cell[2])));
-        const V f1 = hn::GatherIndex(d, voxels, idx);
-        const V f2 = hn::GatherIndex(d, voxels, hn::Add(idx, offx));
-        const V f3 = hn::GatherIndex(d, voxels, hn::Add(hn::Add(idx, offx), offy));
-        const V f4 = hn::GatherIndex(d, voxels, hn::Add(idx, offy));
-        const auto idz = hn::Add(idx, offz);
-        const V f5 = hn::GatherIndex(d, voxels, idz);
-        const V f6 = hn::GatherIndex(d, voxels, hn::Add(idz, offx));
-        const V f7 = hn::GatherIndex(d, voxels, hn::Add(hn::Add(idz, offx), offy));
-        const V f8 = hn::GatherIndex(d, voxels, hn::Add(idz, offy));
+        V f[8];
+        corners(cell[0], cell[1], cell[2], f);
         const V p = frac[0], q = frac[1], r = frac[2];
         const V P = hn::Sub(one, p), Q = hn::Sub(one, q), R = hn::Sub(one, r);
         V v = zero;
-        v = hn::Add(v, hn::Mul(f1, hn::Mul(hn::Mul(P, Q), R)));
-        v = hn::Add(v, hn::Mul(f2, hn::Mul(hn::Mul(p, Q), R)));
-        v = hn::Add(v, hn::Mul(f3, hn::Mul(hn::Mul(p, q), R)));
-        v = hn::Add(v, hn::Mul(f4, hn::Mul(hn::Mul(P, q), R)));
-        v = hn::Add(v, hn::Mul(f5, hn::Mul(hn::Mul(P, Q), r)));
-        v = hn::Add(v, hn::Mul(f6, hn::Mul(hn::Mul(p, Q), r)));
-        v = hn::Add(v, hn::Mul(f7, hn::Mul(hn::Mul(p, q), r)));
-        v = hn::Add(v, hn::Mul(f8, hn::Mul(hn::Mul(P, q), r)));
+        v = hn::Add(v, hn::Mul(f[0], hn::Mul(hn::Mul(P, Q), R)));
+        v = hn::Add(v, hn::Mul(f[1], hn::Mul(hn::Mul(p, Q), R)));
+        v = hn::Add(v, hn::Mul(f[2], hn::Mul(hn::Mul(p, q), R)));
+        v = hn::Add(v, hn::Mul(f[3], hn::Mul(hn::Mul(P, q), R)));
+        v = hn::Add(v, hn::Mul(f[4], hn::Mul(hn::Mul(P, Q), r)));
+        v = hn::Add(v, hn::Mul(f[5], hn::Mul(hn::Mul(p, Q), r)));
+        v = hn::Add(v, hn::Mul(f[6], hn::Mul(hn::Mul(p, q), r)));
+        v = hn::Add(v, hn::Mul(f[7], hn::Mul(hn::Mul(P, q), r)));
         return v;
     }
 };

@@ -20,6 +20,8 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
+#include <sys/types.h>
 #include <vector>
 
 #include <zlib.h>
@@ -77,6 +79,23 @@ inline std::string read_file_bytes(const std::filesystem::path& path) {
         if (n < chunk.size()) break;
     }
     if (std::ferror(f.get())) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
+    return bytes;
+}
+
+// The first `limit` bytes of the file at `path` (all of it when it is no longer); `whole` tells
+// whether that is the whole file.
+inline std::string read_file_prefix(const std::filesystem::path& path, std::size_t limit, bool& whole) {
+    FileHandle f = open_for_reading(path);
+    std::string bytes(limit + 1, '\0');
+    std::size_t got = 0;
+    while (got < bytes.size()) {
+        const std::size_t n = std::fread(bytes.data() + got, 1, bytes.size() - got, f.get());
+        if (n == 0) break;
+        got += n;
+    }
+    if (std::ferror(f.get())) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
+    whole = got <= limit;
+    bytes.resize(std::min(got, limit));
     return bytes;
 }
 
@@ -294,17 +313,211 @@ inline std::vector<double> decode_ascii_samples(std::string_view text, ScalarTyp
     return values;
 }
 
-// The one place a reader fills a Volume's samples: `values` (i fastest, as decode_samples or
-// decode_ascii_samples return them) become the volume's, and `type` its file type. The volume's dims
-// must already be set; a count that does not match them is a reader bug, reported as an Error.
-// (Should the storage become typed, only this function changes.)
-inline void store_samples(Volume& volume, ScalarType type, std::vector<double> values, const std::string& where) {
-    const std::size_t count = checked_voxel_count(volume.dims, where, sizeof(double));
-    if (values.size() != count)
-        throw Error(where + ": internal error: " + std::to_string(values.size()) + " samples for " +
-                    std::to_string(count) + " voxels");
+// Allocates the volume's storage for `type` (its dims must be set; the voxel count is checked against
+// 2^38 bytes and the memory limit at the type's size) and records `type` as the file's type.
+inline void allocate_samples(Volume& volume, ScalarType type, const std::string& where) {
+    const std::size_t count = checked_voxel_count(volume.dims, where, scalar_type_size(type));
     volume.type = type;
-    volume.values = std::move(values);
+    volume.values.allocate(type, count, false);
+}
+
+// Reverses the bytes of every sample in place when the file's byte order is not the host's.
+inline void to_native_order(VoxelArray& values, std::endian order) {
+    const std::size_t size = scalar_type_size(values.type());
+    if (order == std::endian::native || size == 1) return;
+    auto* p = static_cast<unsigned char*>(values.raw());
+    const std::size_t n = values.size();
+    for (std::size_t i = 0; i < n; ++i, p += size) std::reverse(p, p + size);
+}
+
+// The one place a reader fills a Volume's samples from decoded numbers (the ascii encodings):
+// `values` (i fastest, each exactly representable in `type`, as decode_ascii_samples returns them)
+// are stored in `type`, which becomes the file's type. A count that does not match the dims is a
+// reader bug, reported as an Error.
+inline void store_samples(Volume& volume, ScalarType type, const std::vector<double>& values, const std::string& where) {
+    allocate_samples(volume, type, where);
+    if (values.size() != volume.values.size())
+        throw Error(where + ": internal error: " + std::to_string(values.size()) + " samples for " +
+                    std::to_string(volume.values.size()) + " voxels");
+    volume.values.visit_mutable([&](auto* p) {
+        using T = std::remove_pointer_t<decltype(p)>;
+        for (std::size_t i = 0; i < values.size(); ++i) p[i] = T(values[i]);
+    });
+}
+
+// Binary samples already in memory (`bytes`: exactly the dims' count of `type`, byte order `order`)
+// copied into the volume's typed storage and put in the host's byte order.
+inline void store_sample_bytes(Volume& volume, ScalarType type, std::endian order, std::string_view bytes,
+                               const std::string& where) {
+    allocate_samples(volume, type, where);
+    if (bytes.size() != volume.values.bytes())
+        throw Error(where + ": internal error: " + std::to_string(bytes.size()) + " bytes of samples for " +
+                    std::to_string(volume.values.size()) + " voxels of " + scalar_type_name(type));
+    if (!bytes.empty()) std::memcpy(volume.values.raw(), bytes.data(), bytes.size());
+    to_native_order(volume.values, order);
+}
+
+// A region of bytes read front to back: a string in memory, or a file from `offset` to its end
+// (read in pieces, never whole). size() is the region's length.
+class ByteSource {
+public:
+    explicit ByteSource(std::string_view memory) : memory_(memory), size_(memory.size()) {}
+    ByteSource(const std::filesystem::path& path, std::uint64_t offset, const std::string& where)
+        : file_(open_for_reading(path)), where_(where) {
+        std::error_code ec;
+        const std::uint64_t total = std::filesystem::file_size(path, ec);
+        if (ec) throw Error(where + ": cannot read file: " + ec.message());
+        size_ = offset >= total ? 0 : total - offset;
+        base_ = std::min(offset, total);
+        seek(base_);
+    }
+    std::uint64_t size() const { return size_; }
+    std::uint64_t consumed() const { return pos_; }
+    std::uint64_t remaining() const { return size_ - pos_; }
+    // Skips n bytes (n <= remaining()).
+    void skip(std::uint64_t n) {
+        if (file_) seek(base_ + pos_ + n);
+        pos_ += n;
+    }
+    // Reads up to n bytes into dst; returns how many (fewer only at the end of the region).
+    std::size_t read(void* dst, std::size_t n) {
+        n = std::size_t(std::min<std::uint64_t>(n, remaining()));
+        if (n == 0) return 0;
+        if (!file_) {
+            std::memcpy(dst, memory_.data() + pos_, n);
+        } else {
+            std::size_t got = 0;
+            while (got < n) {
+                const std::size_t r = std::fread(static_cast<char*>(dst) + got, 1, n - got, file_.get());
+                if (r == 0) {
+                    if (std::ferror(file_.get())) throw Error(where_ + ": cannot read file: " + std::strerror(errno));
+                    break;  // the file shrank while being read
+                }
+                got += r;
+            }
+            n = got;
+        }
+        pos_ += n;
+        return n;
+    }
+
+private:
+    void seek(std::uint64_t absolute) {
+        if (fseeko(file_.get(), off_t(absolute), SEEK_SET) != 0)
+            throw Error(where_ + ": cannot read file: " + std::strerror(errno));
+    }
+    std::string_view memory_;
+    FileHandle file_{nullptr, &std::fclose};
+    std::string where_;
+    std::uint64_t size_ = 0, pos_ = 0, base_ = 0;
+};
+
+// Inflates the gzip or zlib stream read from `in` (as inflate_stream: concatenated gzip members,
+// the same errors) straight into dst: the first `skip` decompressed bytes are discarded, the next
+// `room` bytes go to dst. Returns how many bytes dst received, plus 1 when the stream holds more
+// (so a return of room + 1 means the data is longer than room). Input is read in 256 KiB pieces.
+inline std::size_t inflate_into(ByteSource& in, std::uint64_t skip, char* dst, std::size_t room, const std::string& where) {
+    constexpr std::size_t kPiece = std::size_t(1) << 30;
+    z_stream zs{};
+    if (inflateInit2(&zs, 15 + 32) != Z_OK) throw Error(where + ": cannot initialise zlib's inflate");
+    std::unique_ptr<z_stream, int (*)(z_stream*)> guard(&zs, &inflateEnd);
+    std::vector<Bytef> input(std::size_t(1) << 18), scratch(std::size_t(1) << 16);
+    std::uint64_t skipped = 0;
+    std::size_t kept = 0;
+    bool more = false;
+    const auto refill = [&] {
+        if (zs.avail_in == 0) {
+            zs.next_in = input.data();
+            zs.avail_in = static_cast<uInt>(in.read(input.data(), input.size()));
+        }
+    };
+    for (;;) {
+        Bytef* out = nullptr;
+        std::size_t want = 0;
+        const bool skipping = skipped < skip;
+        if (skipping) {
+            out = scratch.data();
+            want = static_cast<std::size_t>(std::min<std::uint64_t>(scratch.size(), skip - skipped));
+        } else if (kept < room) {
+            out = reinterpret_cast<Bytef*>(dst) + kept;
+            want = std::min(kPiece, room - kept);
+        } else {
+            out = scratch.data();  // one byte more tells "longer than room"
+            want = 1;
+        }
+        zs.next_out = out;
+        zs.avail_out = static_cast<uInt>(want);
+        refill();
+        const int ret = inflate(&zs, Z_NO_FLUSH);
+        const std::size_t produced = want - zs.avail_out;
+        if (skipping)
+            skipped += produced;
+        else if (kept < room)
+            kept += produced;
+        else if (produced > 0)
+            more = true;
+        if (more) break;
+
+        if (ret == Z_OK) continue;
+        if (ret == Z_STREAM_END) {
+            refill();
+            if (zs.avail_in == 0) break;
+            // Another gzip member (magic 1f 8b) may follow; anything else after the end is damage.
+            if (zs.avail_in < 2 && in.remaining() > 0) {  // the magic straddles two pieces
+                std::memmove(input.data(), zs.next_in, zs.avail_in);
+                zs.next_in = input.data();
+                zs.avail_in += static_cast<uInt>(in.read(input.data() + zs.avail_in, input.size() - zs.avail_in));
+            }
+            if (zs.avail_in >= 2 && zs.next_in[0] == 0x1f && zs.next_in[1] == 0x8b) {
+                inflateReset(&zs);
+                continue;
+            }
+            throw Error(where + ": corrupt gzip stream: " + std::to_string(zs.avail_in + in.remaining()) +
+                        " bytes of trailing data after the end of the compressed stream");
+        }
+        if (ret == Z_BUF_ERROR && zs.avail_in == 0) {
+            if (in.remaining() == 0) throw Error(where + ": corrupt gzip stream: the compressed data ends early");
+            continue;  // the next piece of input is read at the top of the loop
+        }
+        if (ret == Z_MEM_ERROR) throw Error(where + ": out of memory while inflating gzip data");
+        throw Error(where + ": corrupt gzip stream (zlib: " + (zs.msg ? zs.msg : zError(ret)) + ")");
+    }
+    return kept + (more ? 1 : 0);
+}
+
+// Reads the volume's binary samples (its dims set; `type` in byte order `order`) from `in` straight
+// into its typed storage, with sample_bytes' rules and messages: byte_skip counts the bytes before
+// the samples (of the region for raw data, of the decompressed data for gzip); -1 (raw only) means
+// the samples end the region. Raw data must hold exactly byte_skip + the samples' bytes, gzip data
+// must inflate to exactly that. No second copy of the data is made: the peak is the volume itself
+// (plus 320 KiB of buffers for gzip).
+inline void read_samples(Volume& volume, ScalarType type, std::endian order, ByteSource& in, BinaryEncoding encoding,
+                         std::int64_t byte_skip, const std::string& where) {
+    const std::size_t expected = checked_voxel_count(volume.dims, where, scalar_type_size(type)) * scalar_type_size(type);
+    if (encoding == BinaryEncoding::Raw) {
+        const std::uint64_t size = in.size();
+        if (byte_skip == -1) {
+            if (size < expected) throw Error(truncated_message(where, expected, std::size_t(size)));
+            in.skip(size - expected);
+        } else {
+            const auto skip = static_cast<std::uint64_t>(byte_skip);
+            const std::uint64_t found = skip >= size ? 0 : size - skip;
+            if (found < expected) throw Error(truncated_message(where, expected, std::size_t(found)));
+            if (found > expected) throw Error(too_long_message(where, expected, std::to_string(found)));
+            in.skip(skip);
+        }
+        allocate_samples(volume, type, where);
+        const std::size_t got = in.read(volume.values.raw(), expected);
+        if (got < expected) throw Error(truncated_message(where, expected, got));
+    } else {
+        if (byte_skip < 0) throw Error(where + ": byte skip -1 is only allowed with raw encoding");
+        allocate_samples(volume, type, where);
+        const std::size_t got =
+            inflate_into(in, static_cast<std::uint64_t>(byte_skip), static_cast<char*>(volume.values.raw()), expected, where);
+        if (got < expected) throw Error(truncated_message(where, expected, got) + " after inflating");
+        if (got > expected) throw Error(too_long_message(where, expected, "more after inflating"));
+    }
+    to_native_order(volume.values, order);
 }
 
 }  // namespace volref::io

@@ -57,7 +57,7 @@ Volume read_den(const std::filesystem::path& path) {
     std::string storage;
     const std::string_view bytes = io::sample_bytes(std::string_view(file).substr(kHeaderBytes),
                                                     io::BinaryEncoding::Raw, 0, count, storage, where);
-    io::store_samples(volume, ScalarType::U8, io::decode_samples(bytes, ScalarType::U8, order), where);
+    io::store_sample_bytes(volume, ScalarType::U8, order, bytes, where);
     return volume;
 }
 

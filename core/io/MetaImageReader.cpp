@@ -210,48 +210,44 @@ Volume read_metaimage(const std::filesystem::path& path) {
     if (const Field* f = fields.find("compresseddatasize")) compressed_size = fields.integer(*f, 0);
     std::int64_t header_size = 0;
     if (const Field* f = fields.find("headersize")) header_size = fields.integer(*f, -1);
-    const std::size_t count = checked_voxel_count(volume.dims, where, sizeof(double));
-    const std::size_t expected = count * scalar_type_size(type);
+    checked_voxel_count(volume.dims, where, scalar_type_size(type));
     if (!header.has_data_file) throw Error(where + ": missing required key 'ElementDataFile'");
     const Field& data_field = *fields.find("elementdatafile");
 
-    // The data region: after the header line (LOCAL), or the named file.
-    std::string data_file;
+    // The data region: after the header line (LOCAL), or the named file (read in pieces, straight
+    // into the volume).
     std::string data_where = where;
-    std::string_view region;
+    std::optional<io::ByteSource> source;
     const std::string data_name = data_field.value;
     if (lower(data_name) == "local") {
-        region = std::string_view(file).substr(header.data_offset);
+        source.emplace(std::string_view(file).substr(header.data_offset));
     } else {
         if (lower(data_name) == "list" || data_name.find('%') != std::string::npos ||
             split_words(data_name).size() > 1)
             fields.fail(data_field, "several data files are not supported (give one file or LOCAL)");
         std::filesystem::path p(data_name);
         if (p.is_relative()) p = path.parent_path() / p;
-        data_file = io::read_file_bytes(p);
+        source.emplace(p, 0, p.string());
         data_where = p.string() + " (data file of " + where + ")";
-        region = data_file;
     }
     // Errors in a data file name it first.
     const std::string at = lower(data_name) == "local" ? where : data_where;
-    std::string storage;
-    std::string_view bytes;
+    const std::uint64_t region_size = source->size();
+    const std::endian order = msb ? std::endian::big : std::endian::little;
     if (compressed) {
         if (header_size != 0) fields.fail(*fields.find("headersize"), "HeaderSize with CompressedData is not supported");
         if (compressed_size) {
-            if (std::uint64_t(*compressed_size) > region.size())
+            if (std::uint64_t(*compressed_size) > region_size)
                 throw Error(at + ": truncated: CompressedDataSize is " + std::to_string(*compressed_size) +
-                            " bytes, found " + std::to_string(region.size()));
-            if (std::uint64_t(*compressed_size) < region.size())
+                            " bytes, found " + std::to_string(region_size));
+            if (std::uint64_t(*compressed_size) < region_size)
                 throw Error(at + ": CompressedDataSize is " + std::to_string(*compressed_size) + " bytes, but " +
-                            std::to_string(region.size()) + " bytes of compressed data follow");
+                            std::to_string(region_size) + " bytes of compressed data follow");
         }
-        bytes = io::sample_bytes(region, io::BinaryEncoding::Gzip, 0, expected, storage, at);
+        io::read_samples(volume, type, order, *source, io::BinaryEncoding::Gzip, 0, at);
     } else {
-        bytes = io::sample_bytes(region, io::BinaryEncoding::Raw, header_size, expected, storage, at);
+        io::read_samples(volume, type, order, *source, io::BinaryEncoding::Raw, header_size, at);
     }
-    io::store_samples(volume, type, io::decode_samples(bytes, type, msb ? std::endian::big : std::endian::little),
-                      where);
     return volume;
 }
 

@@ -210,7 +210,7 @@ Volume read_nifti(const std::filesystem::path& path) {
     std::unique_ptr<nifti_image, ImageDeleter> nim(nifti_image_read(path.c_str(), 0));
     if (!nim) throw Error(where + ": nifti_clib could not read the header (see nifti_tool -check_hdr)");
     const std::array<std::int64_t, 3> file_dims{raw.dim[1], ndim >= 2 ? raw.dim[2] : 1, ndim >= 3 ? raw.dim[3] : 1};
-    const std::size_t count = checked_voxel_count(file_dims, where, sizeof(double));
+    const std::size_t count = checked_voxel_count(file_dims, where, scalar_type_size(type));
     const Orientation o = orientation(*nim, where);
 
     // The image bytes: in the same file after vox_offset (.nii), or in the .img file.
@@ -220,37 +220,46 @@ Volume read_nifti(const std::filesystem::path& path) {
     const std::size_t expected = count * scalar_type_size(type);
     // Errors in a separate .img file start with its path and end with "(image file of HEADER)".
     const std::string at = image_path.string();
-    std::string file, storage;
-    std::string_view bytes;
+    // nifti_clib's MSB_FIRST (2) is defined only inside the library.
+    const std::endian order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
+    // The stored samples, in the file's type and voxel order, read in pieces straight into memory.
+    Volume stored;
+    stored.dims = file_dims;
     try {
-        file = io::read_file_bytes(image_path);
         if (nifti_is_gzfile(image_path.c_str())) {
-            storage = io::inflate_stream(file, offset, expected, at).data;
-            if (storage.size() < expected)
-                throw Error(io::truncated_message(at, expected, storage.size()) + " after inflating (from vox_offset " +
+            io::ByteSource source(image_path, 0, at);
+            io::allocate_samples(stored, type, at);
+            const std::size_t got = io::inflate_into(source, offset, static_cast<char*>(stored.values.raw()), expected, at);
+            if (got < expected)
+                throw Error(io::truncated_message(at, expected, got) + " after inflating (from vox_offset " +
                             std::to_string(offset) + ")");
-            bytes = storage;
         } else {
-            const std::size_t found = offset >= file.size() ? 0 : file.size() - std::size_t(offset);
+            io::ByteSource source(image_path, offset, at);
+            const std::size_t found = std::size_t(source.size());
             if (found < expected)
                 throw Error(io::truncated_message(at, expected, found) + " (from vox_offset " + std::to_string(offset) +
                             ")");
-            bytes = std::string_view(file).substr(std::size_t(offset), expected);
+            io::allocate_samples(stored, type, at);
+            const std::size_t got = source.read(stored.values.raw(), expected);
+            if (got < expected) throw Error(io::truncated_message(at, expected, got));
         }
     } catch (const Error& e) {
         if (image_path == path) throw;
         throw Error(std::string(e.what()) + " (image file of " + where + ")");
     }
-    // nifti_clib's MSB_FIRST (2) is defined only inside the library.
-    const std::endian order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
-    std::vector<double> stored = io::decode_samples(bytes, type, order);
+    io::to_native_order(stored.values, order);
 
-    // Scaling: value = slope * stored + inter, when slope is set and not the identity.
-    ScalarType volume_type = type;
+    // Scaling: value = slope * stored + inter, when slope is set and not the identity (f64 values).
     const double slope = nim->scl_slope, inter = nim->scl_inter;
     if (std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0)) {
-        for (double& x : stored) x = slope * x + inter;
-        volume_type = ScalarType::F64;
+        checked_voxel_count(file_dims, where + ": scaled by scl_slope", sizeof(double));
+        VoxelArray scaled(ScalarType::F64, count);
+        double* out = scaled.data<double>();
+        stored.values.visit([&](const auto* p) {
+            for (std::size_t i = 0; i < count; ++i) out[i] = slope * double(p[i]) + inter;
+        });
+        stored.values = std::move(scaled);
+        stored.type = ScalarType::F64;
     }
 
     // Reorder so that volume axis a is world axis a, increasing.
@@ -265,27 +274,32 @@ Volume read_nifti(const std::filesystem::path& path) {
         volume.origin[a] = o.offset[a] - (o.flip[std::size_t(c)] ? o.spacing[c] * double(n - 1) : 0.0);
     }
     const bool identity = voxel_axis == std::array<int, 3>{0, 1, 2} && !o.flip[0] && !o.flip[1] && !o.flip[2];
+    volume.type = stored.type;
     if (identity) {
-        io::store_samples(volume, volume_type, std::move(stored), where);
+        volume.values = std::move(stored.values);
         return volume;
     }
-    std::vector<double> values(count);
+    // A second array in the same type: the peak while reordering is twice the volume.
+    volume.values.allocate(stored.values.type(), count, false);
     const std::array<std::int64_t, 3> stride{1, file_dims[0], file_dims[0] * file_dims[1]};
-    std::size_t out = 0;
-    for (std::int64_t k = 0; k < volume.dims[2]; ++k)
-        for (std::int64_t j = 0; j < volume.dims[1]; ++j)
-            for (std::int64_t i = 0; i < volume.dims[0]; ++i) {
-                const std::array<std::int64_t, 3> n{i, j, k};
-                std::int64_t src = 0;
-                for (int a = 0; a < 3; ++a) {
-                    const int c = voxel_axis[std::size_t(a)];
-                    const std::int64_t idx = o.flip[std::size_t(c)] ? volume.dims[std::size_t(a)] - 1 - n[std::size_t(a)]
-                                                                    : n[std::size_t(a)];
-                    src += idx * stride[std::size_t(c)];
+    stored.values.visit([&](const auto* in) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(in)>>;
+        T* values = volume.values.template data<T>();
+        std::size_t out = 0;
+        for (std::int64_t k = 0; k < volume.dims[2]; ++k)
+            for (std::int64_t j = 0; j < volume.dims[1]; ++j)
+                for (std::int64_t i = 0; i < volume.dims[0]; ++i) {
+                    const std::array<std::int64_t, 3> n{i, j, k};
+                    std::int64_t src = 0;
+                    for (int a = 0; a < 3; ++a) {
+                        const int c = voxel_axis[std::size_t(a)];
+                        const std::int64_t idx = o.flip[std::size_t(c)] ? volume.dims[std::size_t(a)] - 1 - n[std::size_t(a)]
+                                                                        : n[std::size_t(a)];
+                        src += idx * stride[std::size_t(c)];
+                    }
+                    values[out++] = in[std::size_t(src)];
                 }
-                values[out++] = stored[std::size_t(src)];
-            }
-    io::store_samples(volume, volume_type, std::move(values), where);
+    });
     return volume;
 }
 

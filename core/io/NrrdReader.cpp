@@ -523,24 +523,51 @@ struct DataLayout {
     std::size_t count = 0;
 };
 
-// The samples held in `region` (the data file, or what follows an attached header).
-std::vector<double> decode_data(std::string_view region, const DataLayout& layout, const std::string& where) {
+io::BinaryEncoding binary_encoding(const DataLayout& layout) {
+    return layout.encoding == Encoding::Gzip ? io::BinaryEncoding::Gzip : io::BinaryEncoding::Raw;
+}
+
+// Reads the samples held in `region` (the data file, or what follows an attached header) into the
+// volume's typed storage.
+void decode_data(Volume& volume, std::string_view region, const DataLayout& layout, const std::string& where) {
     region = skip_lines(region, layout.line_skip, where);
-    if (layout.encoding == Encoding::Ascii)
-        return parse_ascii(region, layout.byte_skip, layout.type, layout.count, where);
-    const auto encoding =
-        layout.encoding == Encoding::Gzip ? io::BinaryEncoding::Gzip : io::BinaryEncoding::Raw;
-    std::string storage;
-    const std::string_view bytes = io::sample_bytes(
-        region, encoding, layout.byte_skip, layout.count * scalar_type_size(layout.type), storage, where);
-    return io::decode_samples(bytes, layout.type, layout.endian);
+    if (layout.encoding == Encoding::Ascii) {
+        io::store_samples(volume, layout.type, parse_ascii(region, layout.byte_skip, layout.type, layout.count, where),
+                          where);
+        return;
+    }
+    io::ByteSource source(region);
+    io::read_samples(volume, layout.type, layout.endian, source, binary_encoding(layout), layout.byte_skip, where);
+}
+
+// Raw and gzip data without line skips are read from the file in pieces, straight into the volume.
+bool streamable(const DataLayout& layout) { return layout.encoding != Encoding::Ascii && layout.line_skip == 0; }
+
+// Whether `prefix` (the start of a NRRD file) holds the blank line that ends the header.
+bool has_header_end(std::string_view prefix) {
+    std::size_t pos = prefix.find('\n');
+    while (pos != std::string_view::npos && pos + 1 < prefix.size()) {
+        const std::size_t eol = prefix.find('\n', pos + 1);
+        if (eol == std::string_view::npos) return false;
+        std::string_view line = prefix.substr(pos + 1, eol - pos - 1);
+        if (line.empty() || line == "\r") return true;
+        pos = eol;
+    }
+    return false;
 }
 
 }  // namespace
 
 Volume read_nrrd(const std::filesystem::path& path) {
     const std::string where = path.string();
-    const std::string file = io::read_file_bytes(path);
+    // The header, from the start of the file: a big file's attached data is not read here.
+    constexpr std::size_t kPrefix = std::size_t(1) << 20;
+    bool whole = false;
+    std::string file = io::read_file_prefix(path, kPrefix, whole);
+    if (!whole && !has_header_end(file)) {
+        file = io::read_file_bytes(path);
+        whole = true;
+    }
     const NrrdHeader header = parse_header(file, where);
     const Fields fields(header, where);
 
@@ -564,21 +591,34 @@ Volume read_nrrd(const std::filesystem::path& path) {
     layout.byte_skip = parse_skip(fields, "byte skip", -1);
     if (layout.byte_skip == -1 && layout.encoding != Encoding::Raw)
         fields.fail("byte skip", "-1 (data at the end of the file) is only allowed with raw encoding");
-    layout.count = checked_voxel_count(volume.dims, where, sizeof(double));
+    layout.count = checked_voxel_count(volume.dims, where, scalar_type_size(volume.type));
 
     if (fields.find("data file")) {
         const std::filesystem::path data_path = parse_data_file(fields, path);
         try {
-            volume.values = decode_data(io::read_file_bytes(data_path), layout, data_path.string());
+            if (streamable(layout)) {
+                io::ByteSource source(data_path, 0, data_path.string());
+                io::read_samples(volume, layout.type, layout.endian, source, binary_encoding(layout), layout.byte_skip,
+                                 data_path.string());
+            } else {
+                decode_data(volume, io::read_file_bytes(data_path), layout, data_path.string());
+            }
         } catch (const Error& e) {
             throw Error(std::string(e.what()) + " (data file of " + where + ")");
         }
     } else if (header.data_offset) {
-        volume.values = decode_data(std::string_view(file).substr(*header.data_offset), layout, where);
+        if (streamable(layout)) {
+            io::ByteSource source(path, *header.data_offset, where);
+            io::read_samples(volume, layout.type, layout.endian, source, binary_encoding(layout), layout.byte_skip, where);
+        } else {
+            if (!whole) file = io::read_file_bytes(path);
+            decode_data(volume, std::string_view(file).substr(*header.data_offset), layout, where);
+        }
     } else {
         throw Error(where +
                     ": no data: the header has no 'data file' field and no blank line before attached data");
     }
+    volume.type = layout.type;
     return volume;
 }
 

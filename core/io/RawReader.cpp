@@ -176,13 +176,11 @@ Volume read_raw_volume(const std::filesystem::path& path) {
     volume.type = sidecar.type;
     volume.origin = sidecar.origin;
     volume.spacing = sidecar.spacing;
-    const std::size_t count = checked_voxel_count(volume.dims, sidecar_path.string(), sizeof(double));
+    checked_voxel_count(volume.dims, sidecar_path.string(), scalar_type_size(volume.type));
 
-    const std::string data = io::read_file_bytes(path);
-    std::string storage;
-    const std::string_view bytes = io::sample_bytes(data, sidecar.encoding, sidecar.header_bytes,
-                                                    count * scalar_type_size(volume.type), storage, where);
-    volume.values = io::decode_samples(bytes, volume.type, sidecar.endian);
+    // Straight from the file into the typed storage (no copy of the file in memory).
+    io::ByteSource data(path, 0, where);
+    io::read_samples(volume, sidecar.type, sidecar.endian, data, sidecar.encoding, sidecar.header_bytes, where);
     return volume;
 }
 

@@ -440,7 +440,7 @@ Volume read_vti(const std::filesystem::path& path) {
     } else {
         array.fail("format", "expected ascii, binary or appended, got " + io::quoted(format));
     }
-    io::store_samples(volume, type, io::decode_samples(samples, type, order), where);
+    io::store_sample_bytes(volume, type, order, samples, where);
     return volume;
 }
 

@@ -199,7 +199,7 @@ Volume read_vtk_legacy(const std::filesystem::path& path) {
         const std::size_t expected = count * scalar_type_size(type);
         if (data.size() < expected)
             throw Error(io::truncated_message(where + ": line " + std::to_string(data_line), expected, data.size()));
-        io::store_samples(volume, type, io::decode_samples(data.substr(0, expected), type, std::endian::big), where);
+        io::store_sample_bytes(volume, type, std::endian::big, data.substr(0, expected), where);
     } else {
         // Exactly `count` numbers; a later attribute (a keyword) ends them.
         const std::size_t line = words.line();

@@ -26,13 +26,15 @@ GradientField::GradientField(const VolumeSampler& sampler, GradientSpec spec) : 
     if (!spec.cache) return;
 
     cache_ = std::make_unique<Cache>();
-    for (auto& c : cache_->components) c = v.same_grid();
+    for (auto& c : cache_->components) c = v.same_grid();  // f64, whatever the volume's storage type
+    double* out[3] = {cache_->components[0].values.data<double>(), cache_->components[1].values.data<double>(),
+                      cache_->components[2].values.data<double>()};
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
         for (std::int64_t k = r.begin(); k != r.end(); ++k)
             for (std::int64_t j = 0; j < v.dims[1]; ++j)
                 for (std::int64_t i = 0; i < v.dims[0]; ++i) {
                     const glm::dvec3 g = on_the_fly(v.voxel_position(i, j, k));
-                    for (int a = 0; a < 3; ++a) cache_->components[a].values[v.index(i, j, k)] = g[a];
+                    for (int a = 0; a < 3; ++a) out[a][v.index(i, j, k)] = g[a];
                 }
     });
     for (int a = 0; a < 3; ++a)

@@ -60,18 +60,23 @@ MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& cla
                 voxel_box(m, first, last);
                 double lo = kInf, hi = -kInf;
                 bool finite = true, visible = false;
-                for (std::int64_t k = first[2]; k <= last[2]; ++k)
-                    for (std::int64_t j = first[1]; j <= last[1]; ++j)
-                        for (std::int64_t i = first[0]; i <= last[0]; ++i) {
-                            const double x = v.at(i, j, k);
-                            if (!std::isfinite(x)) {
-                                finite = false;
-                                continue;
+                v.values.visit([&](const auto* values) {  // one switch on the storage type per macrocell
+                    const std::int64_t row_length = last[0] - first[0] + 1;
+                    for (std::int64_t k = first[2]; k <= last[2]; ++k)
+                        for (std::int64_t j = first[1]; j <= last[1]; ++j) {
+                            const auto* row = values + v.index(first[0], j, k);
+                            for (std::int64_t i = 0; i < row_length; ++i) {
+                                const double x = double(row[i]);
+                                if (!std::isfinite(x)) {
+                                    finite = false;
+                                    continue;
+                                }
+                                lo = std::min(lo, x);
+                                hi = std::max(hi, x);
+                                if (pre && !visible) visible = voxel_visible(x);
                             }
-                            lo = std::min(lo, x);
-                            hi = std::max(hi, x);
-                            if (pre && !visible) visible = voxel_visible(x);
                         }
+                });
                 if (!finite) {
                     ranges_[id] = {-kInf, kInf};
                     continue;

@@ -11,17 +11,21 @@ namespace volref {
 PreClassifiedVolume::PreClassifiedVolume(const VolumeSampler& sampler, const Classifier& classifier,
                                          const GradientSource* gradient) {
     const Volume& v = sampler.volume();
-    for (Volume& c : channels_) c = v.same_grid();
+    for (Volume& c : channels_) c = v.same_grid();  // f64, whatever the volume's storage type
+    double* out[4];
+    for (std::size_t ch = 0; ch < 4; ++ch) out[ch] = channels_[ch].values.data<double>();
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
-        for (std::int64_t k = r.begin(); k != r.end(); ++k)
-            for (std::int64_t j = 0; j < v.dims[1]; ++j)
-                for (std::int64_t i = 0; i < v.dims[0]; ++i) {
-                    const std::size_t idx = v.index(i, j, k);
-                    const double g = gradient ? glm::length(gradient->gradient(v.voxel_position(i, j, k))) : 0.0;
-                    const Classified c = classifier.classify(v.values[idx], g);
-                    for (int ch = 0; ch < 3; ++ch) channels_[std::size_t(ch)].values[idx] = c.opacity * c.color[ch];
-                    channels_[3].values[idx] = c.opacity;
-                }
+        v.values.visit([&](const auto* values) {  // one switch on the storage type per block of slices
+            for (std::int64_t k = r.begin(); k != r.end(); ++k)
+                for (std::int64_t j = 0; j < v.dims[1]; ++j)
+                    for (std::int64_t i = 0; i < v.dims[0]; ++i) {
+                        const std::size_t idx = v.index(i, j, k);
+                        const double g = gradient ? glm::length(gradient->gradient(v.voxel_position(i, j, k))) : 0.0;
+                        const Classified c = classifier.classify(double(values[idx]), g);
+                        for (int ch = 0; ch < 3; ++ch) out[ch][idx] = c.opacity * c.color[ch];
+                        out[3][idx] = c.opacity;
+                    }
+        });
     });
     for (std::size_t ch = 0; ch < 4; ++ch)
         samplers_[ch] = std::make_unique<VolumeSampler>(channels_[ch], sampler.interpolation());

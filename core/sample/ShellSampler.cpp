@@ -142,9 +142,14 @@ double ShellSampler::trilinear(const glm::dvec3& u) const {
     const LinearAxis y = linear_axis(u.y, volume_.dims[1], periodic_[1]);
     const LinearAxis z = linear_axis(u.z, volume_.dims[2], periodic_[2]);
     const Volume& v = volume_;
-    const std::array<double, 8> f{v.at(x.i0, y.i0, z.i0), v.at(x.i1, y.i0, z.i0), v.at(x.i1, y.i1, z.i0),
-                                  v.at(x.i0, y.i1, z.i0), v.at(x.i0, y.i0, z.i1), v.at(x.i1, y.i0, z.i1),
-                                  v.at(x.i1, y.i1, z.i1), v.at(x.i0, y.i1, z.i1)};
+    const std::size_t n[8] = {v.index(x.i0, y.i0, z.i0), v.index(x.i1, y.i0, z.i0), v.index(x.i1, y.i1, z.i0),
+                              v.index(x.i0, y.i1, z.i0), v.index(x.i0, y.i0, z.i1), v.index(x.i1, y.i0, z.i1),
+                              v.index(x.i1, y.i1, z.i1), v.index(x.i0, y.i1, z.i1)};
+    // One switch on the storage type per sample, then typed loads (exact conversions to double).
+    const std::array<double, 8> f = v.values.visit([&](const auto* p) -> std::array<double, 8> {
+        return {double(p[n[0]]), double(p[n[1]]), double(p[n[2]]), double(p[n[3]]),
+                double(p[n[4]]), double(p[n[5]]), double(p[n[6]]), double(p[n[7]])};
+    });
     return volref::trilinear(f, x.p, y.p, z.p);
 }
 
@@ -154,19 +159,21 @@ double ShellSampler::tricubic(const glm::dvec3& u) const {
     const CubicAxis ax = cubic_axis(k, u.x, volume_.dims[0], periodic_[0]);
     const CubicAxis ay = cubic_axis(k, u.y, volume_.dims[1], periodic_[1]);
     const CubicAxis az = cubic_axis(k, u.z, volume_.dims[2], periodic_[2]);
-    double plane[4];
-    for (int c = 0; c < 4; ++c) {
-        double row[4];
-        for (int b = 0; b < 4; ++b) {
-            const double f[4] = {volume_.at(ax.idx[0], ay.idx[std::size_t(b)], az.idx[std::size_t(c)]),
-                                 volume_.at(ax.idx[1], ay.idx[std::size_t(b)], az.idx[std::size_t(c)]),
-                                 volume_.at(ax.idx[2], ay.idx[std::size_t(b)], az.idx[std::size_t(c)]),
-                                 volume_.at(ax.idx[3], ay.idx[std::size_t(b)], az.idx[std::size_t(c)])};
-            row[b] = dot4(ax.w, f);
+    const Volume& v = volume_;
+    return v.values.visit([&](const auto* p) {  // one switch on the storage type per sample
+        double plane[4];
+        for (int c = 0; c < 4; ++c) {
+            double row[4];
+            for (int b = 0; b < 4; ++b) {
+                const std::int64_t jb = ay.idx[std::size_t(b)], kc = az.idx[std::size_t(c)];
+                const double f[4] = {double(p[v.index(ax.idx[0], jb, kc)]), double(p[v.index(ax.idx[1], jb, kc)]),
+                                     double(p[v.index(ax.idx[2], jb, kc)]), double(p[v.index(ax.idx[3], jb, kc)])};
+                row[b] = dot4(ax.w, f);
+            }
+            plane[c] = dot4(ay.w, row);
         }
-        plane[c] = dot4(ay.w, row);
-    }
-    return dot4(az.w, plane);
+        return dot4(az.w, plane);
+    });
 }
 
 glm::dvec3 ShellSampler::gradient(const glm::dvec3& world) const {

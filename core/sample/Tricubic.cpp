@@ -74,12 +74,12 @@ inline double dot4(const std::array<double, 4>& w, const double* f) {
 
 // The nested 1-D passes of the header. With Gradient = false only the value is formed (by the same
 // operations as with Gradient = true, so the values agree bit for bit).
-template <bool Gradient>
-double evaluate(const Volume& v, CubicKernel k, const glm::dvec3& u, glm::dvec3* gradient) {
+// T: the storage type (one instantiation per type; evaluate() dispatches once per sample).
+template <bool Gradient, class T>
+double evaluate_typed(const Volume& v, const T* data, CubicKernel k, const glm::dvec3& u, glm::dvec3* gradient) {
     const Axis ax = setup_axis(k, u.x, v.dims[0]);
     const Axis ay = setup_axis(k, u.y, v.dims[1]);
     const Axis az = setup_axis(k, u.z, v.dims[2]);
-    const double* data = v.values.data();
     const std::int64_t nx = v.dims[0], ny = v.dims[1];
 
     // Pass 1 (along i) for the 16 rows, k outer, j inner.
@@ -88,8 +88,8 @@ double evaluate(const Volume& v, CubicKernel k, const glm::dvec3& u, glm::dvec3*
     for (int c = 0; c < 4; ++c) {
         for (int b = 0; b < 4; ++b) {
             const std::int64_t base = nx * (ay.idx[b] + ny * az.idx[c]);
-            const double f[4] = {data[std::size_t(base + ax.idx[0])], data[std::size_t(base + ax.idx[1])],
-                                 data[std::size_t(base + ax.idx[2])], data[std::size_t(base + ax.idx[3])]};
+            const double f[4] = {double(data[std::size_t(base + ax.idx[0])]), double(data[std::size_t(base + ax.idx[1])]),
+                                 double(data[std::size_t(base + ax.idx[2])]), double(data[std::size_t(base + ax.idx[3])])};
             row_v[c][b] = dot4(ax.w, f);
             if constexpr (Gradient) row_dx[c][b] = dot4(ax.dw, f);
         }
@@ -114,6 +114,11 @@ double evaluate(const Volume& v, CubicKernel k, const glm::dvec3& u, glm::dvec3*
         (void)gradient;
     }
     return value;
+}
+
+template <bool Gradient>
+double evaluate(const Volume& v, CubicKernel k, const glm::dvec3& u, glm::dvec3* gradient) {
+    return v.values.visit([&](const auto* data) { return evaluate_typed<Gradient>(v, data, k, u, gradient); });
 }
 
 }  // namespace

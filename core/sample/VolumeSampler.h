@@ -81,8 +81,13 @@ inline std::array<double, 8> VolumeSampler::corners(const std::array<std::int64_
     const std::int64_t j1 = std::min(j0 + 1, volume_.dims[1] - 1);
     const std::int64_t k1 = std::min(k0 + 1, volume_.dims[2] - 1);
     const Volume& v = volume_;
-    return {v.at(i0, j0, k0), v.at(i1, j0, k0), v.at(i1, j1, k0), v.at(i0, j1, k0),
-            v.at(i0, j0, k1), v.at(i1, j0, k1), v.at(i1, j1, k1), v.at(i0, j1, k1)};
+    const std::size_t n[8] = {v.index(i0, j0, k0), v.index(i1, j0, k0), v.index(i1, j1, k0), v.index(i0, j1, k0),
+                              v.index(i0, j0, k1), v.index(i1, j0, k1), v.index(i1, j1, k1), v.index(i0, j1, k1)};
+    // One switch on the storage type per cell, then eight typed loads (exact conversions to double).
+    return v.values.visit([&](const auto* p) -> std::array<double, 8> {
+        return {double(p[n[0]]), double(p[n[1]]), double(p[n[2]]), double(p[n[3]]),
+                double(p[n[4]]), double(p[n[5]]), double(p[n[6]]), double(p[n[7]])};
+    });
 }
 
 inline double VolumeSampler::trilinear(const glm::dvec3& world) const {

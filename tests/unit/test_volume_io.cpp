@@ -89,6 +89,9 @@ bool same_double(double a, double b) {
 
 void expect_values(const Volume& v, const std::vector<double>& expected) {
     ASSERT_EQ(v.values.size(), expected.size());
+    // Kept in the file's type: as many bytes in memory as the file's samples.
+    EXPECT_EQ(v.values.type(), v.type);
+    EXPECT_EQ(v.values.bytes(), expected.size() * scalar_type_size(v.type));
     for (std::size_t i = 0; i < expected.size(); ++i)
         EXPECT_TRUE(same_double(v.values[i], expected[i]))
             << "value " << i << ": got " << v.values[i] << ", wrote " << expected[i];

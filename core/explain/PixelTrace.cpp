@@ -17,14 +17,16 @@ namespace volref::explain {
 
 namespace {
 
-GridLocation locate(const PreparedScene& scene, const glm::dvec3& position) {
+GridLocation locate(const PreparedScene& scene, const glm::dvec3& world) {
     GridLocation g;
-    if (scene.model.cartesian) {
-        const VolumeSampler& s = *scene.model.cartesian;
+    const PreparedVolume& volume = scene.volume();
+    const glm::dvec3 position = volume.transform ? volume.transform->to_local(world) : world;
+    if (volume.model.cartesian) {
+        const VolumeSampler& s = *volume.model.cartesian;
         g.index = s.continuous_index(position);
         s.locate(g.index, g.cell, g.local);
-    } else if (scene.model.shell_grid) {
-        const ShellGrid& grid = *scene.model.shell_grid;
+    } else if (volume.model.shell_grid) {
+        const ShellGrid& grid = *volume.model.shell_grid;
         g.index = grid.continuous_index(position);
         // The cell and fraction of ShellSampler's trilinear reconstruction (docs/shells.md section 3):
         // non-periodic axes clamp u to [0, n - 1] and take i = min(floor(u), n - 2) (0 when n = 1);
@@ -96,21 +98,23 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     if (x < 0 || x >= scene.scene.image.width || y < 0 || y >= scene.scene.image.height)
         throw Error("--pixel: (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
                     std::to_string(scene.scene.image.width) + " x " + std::to_string(scene.scene.image.height) + " image");
+    if (scene.volumes.size() > 1) throw Error("trace: a scene of several volumes is not traced yet (trace one volume at a time)");
+    const PreparedVolume& v = scene.volume();
     PixelTrace t;
     t.x = x;
     t.y = y;
     t.ray = scene.pixel_ray(x, y);
     t.intervals = scene.intervals(t.ray);
-    t.step = scene.step;
-    t.unit_distance = scene.classifier->unit_distance();
+    t.step = v.step;
+    t.unit_distance = v.classifier->unit_distance();
     t.projection = r.projection;
     t.order = r.order;
-    t.has_gradient = scene.gradient != nullptr;
-    t.shaded = scene.shader != nullptr && t.projection == Projection::Composite;
-    t.lights = t.shaded ? scene.shader->lights().size() : 0;
-    t.skipping = scene.macrocells != nullptr;
+    t.has_gradient = v.gradient != nullptr;
+    t.shaded = v.shader != nullptr && t.projection == Projection::Composite;
+    t.lights = t.shaded ? v.shader->lights().size() : 0;
+    t.skipping = v.macrocells != nullptr;
     Collector collector(scene, t.samples);
-    t.pixel = scene.integrator->integrate_traced(t.ray, t.intervals, collector);
+    t.pixel = v.integrator->integrate_traced(v.volume_ray(t.ray), t.intervals, collector);
     return t;
 }
 

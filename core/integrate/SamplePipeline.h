@@ -14,6 +14,7 @@
 #include "core/sample/PreClassifiedVolume.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/Classifier.h"
+#include "geometry/VolumeTransform.h"
 #include "transfer/Shader.h"
 
 namespace volref {
@@ -26,10 +27,16 @@ struct PipelineSample {
 
 class SamplePipeline {
 public:
-    // `gradient`, `preclassified` and `shader` may be null (not used by the scene).
+    // `gradient`, `preclassified` and `shader` may be null (not used by the scene). `transform` (null:
+    // none) places a volume in the world: the rays given to this pipeline are then the volume's local
+    // rays (VolumeTransform::local_ray: positions in its own space, t a world distance), and the
+    // gradient (for classification and shading) and the view direction are turned back into world
+    // vectors, grad_world = A^-T grad_local, V = -A d_local.
     SamplePipeline(const FieldSampler& sampler, const Classifier& classifier, const GradientSource* gradient,
-                   const PreClassifiedVolume* preclassified, const Shader* shader)
-        : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader) {}
+                   const PreClassifiedVolume* preclassified, const Shader* shader,
+                   const VolumeTransform* transform = nullptr)
+        : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader),
+          transform_(transform) {}
 
     double value(const Ray& ray, double t) const { return sampler_.value(ray.at(t)); }
 
@@ -54,6 +61,7 @@ public:
     const Shader* shader() const { return shader_; }
     const GradientSource* gradient_source() const { return gradient_; }
     bool preclassified() const { return pre_ != nullptr; }
+    const VolumeTransform* transform() const { return transform_; }
 
 private:
     template <bool kDetail>
@@ -64,7 +72,7 @@ private:
         glm::dvec3 g(0.0);
         bool have_gradient = false;
         auto gradient = [&]() -> const glm::dvec3& {
-            if (!have_gradient) g = gradient_->gradient(x);
+            if (!have_gradient) g = transform_ ? transform_->gradient_to_world(gradient_->gradient(x)) : gradient_->gradient(x);
             have_gradient = true;
             return g;
         };
@@ -73,8 +81,8 @@ private:
         s.opacity = c.opacity;
         const bool shade = shader_ && (use == Use::Surface || (use == Use::Composite && c.opacity > 0.0));
         if constexpr (kDetail) {
-            s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t, detail->shading) : c.color;
-            detail->position = x;
+            s.color = shade ? shader_->shade(c.color, gradient(), -view_direction(ray), t, detail->shading) : c.color;
+            detail->position = transform_ ? transform_->to_world(x) : x;
             detail->value = s.value;
             detail->has_gradient = have_gradient;
             detail->gradient = g;
@@ -82,7 +90,7 @@ private:
             detail->classified_color = c.color;
             detail->shaded = shade;
         } else {
-            s.color = shade ? shader_->shade(c.color, gradient(), -ray.direction, t) : c.color;
+            s.color = shade ? shader_->shade(c.color, gradient(), -view_direction(ray), t) : c.color;
         }
         // A non-finite value (a NaN or +-Inf voxel read by the sample) or colour is transparent
         // (docs/accuracy.md, "Non-finite voxels").
@@ -97,11 +105,17 @@ private:
         return s;
     }
 
+    // The world direction of the ray (the local ray's mapped back for a transformed volume).
+    glm::dvec3 view_direction(const Ray& ray) const {
+        return transform_ ? transform_->direction_to_world(ray.direction) : ray.direction;
+    }
+
     const FieldSampler& sampler_;
     const Classifier& classifier_;
     const GradientSource* gradient_;
     const PreClassifiedVolume* pre_;
     const Shader* shader_;
+    const VolumeTransform* transform_;
 };
 
 }  // namespace volref

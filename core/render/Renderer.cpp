@@ -127,19 +127,17 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     const PreparedScene prepared(scene, options);
     if (stats) {
         stats->non_finite_voxels = 0;
-        for (double v : prepared.model.volume.values)
-            if (!std::isfinite(v)) ++stats->non_finite_voxels;
+        for (const auto& v : prepared.volumes)
+            for (double x : v->model.volume.values)
+                if (!std::isfinite(x)) ++stats->non_finite_voxels;
     }
     const Camera& camera = *prepared.camera;
-    const BoundingGeometry& geometry = prepared.geometry;
-    const int volume_id = prepared.volume_id;
-    const Integrator* integrator = prepared.integrator.get();
     const int W = scene.image.width, H = scene.image.height;
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
-    if (integrator->writes_depth()) channels.push_back("Z");
+    if (prepared.writes_depth()) channels.push_back("Z");
     const std::size_t error_channel = channels.size();
-    if (integrator->writes_error()) channels.push_back("error");
+    if (prepared.writes_error()) channels.push_back("error");
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
@@ -149,7 +147,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
             // Each tile row is integrated in packets of up to kMaxPacketRays pixels.
-            std::vector<Interval> intervals[kMaxPacketRays];
+            PreparedScene::Scratch scratch;
             Ray rays[kMaxPacketRays];
             PixelValue values[kMaxPacketRays];
             for (int tile = r.begin(); tile != r.end(); ++tile) {
@@ -160,15 +158,11 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
                     for (int xs = x0; xs < x_end; xs += kMaxPacketRays) {
                         const int count = std::min(kMaxPacketRays, x_end - xs);
                         for (int i = 0; i < count; ++i) rays[i] = camera.pixel_ray(xs + i, y);
-                        geometry.intervals(rays, count, volume_id, intervals);  // Embree packets
-                        if (options.simd)
-                            integrator->integrate_packet(rays, intervals, values, count);
-                        else
-                            for (int i = 0; i < count; ++i) values[i] = integrator->integrate(rays[i], intervals[i]);
+                        prepared.integrate(rays, count, values, options.simd, scratch);  // Embree packets per volume
                         for (int i = 0; i < count; ++i) {
                             for (int c = 0; c < 4; ++c) image.at(xs + i, y, std::size_t(c)) = values[i].rgba[c];
-                            if (integrator->writes_depth()) image.at(xs + i, y, 4) = values[i].depth;
-                            if (integrator->writes_error()) image.at(xs + i, y, error_channel) = values[i].error;
+                            if (prepared.writes_depth()) image.at(xs + i, y, 4) = values[i].depth;
+                            if (prepared.writes_error()) image.at(xs + i, y, error_channel) = values[i].error;
                         }
                     }
                 progress.tile_done();

@@ -104,6 +104,22 @@ struct BoundsSpec {
     int tessellate = 0;                  // shells: > 0 = use a triangle mesh of about this many segments per turn
 };
 
+// A clip plane (conventions section 4): the kept side is where (p - point) . normal >= 0 (as VTK's
+// vtkPlane clipping), point and normal in world coordinates.
+struct ClipPlaneSpec {
+    glm::dvec3 point{0.0};
+    glm::dvec3 normal{0.0, 0.0, 1.0};  // non-zero (not normalised: only its direction matters)
+};
+
+// VTK's cropping (vtkVolumeMapper::SetCroppingRegionPlanes / SetCroppingRegionFlags): six planes
+// x0 <= x1, y0 <= y1, z0 <= z1 in the volume's own coordinates (before `transform`) cut its space
+// into 27 regions, numbered (ix + 3 iy + 9 iz) with ix = 0 below x0, 1 in [x0, x1], 2 above x1 (the
+// same for y, z); region r is kept when bit r of `regions` is set.
+struct CropSpec {
+    std::array<double, 6> planes{0, 0, 0, 0, 0, 0};  // x0, x1, y0, y1, z0, z1
+    std::uint32_t regions = 0x0002000;                // VTK_CROP_SUBVOLUME
+};
+
 struct VolumeSpec {
     VolumeSourceSpec source;
     std::optional<glm::dvec3> origin;   // overrides the file's (procedural fields: default 0)
@@ -116,6 +132,11 @@ struct VolumeSpec {
     Classify classify = Classify::Post;  // post: interpolate, then classify; pre: classify voxels, then interpolate
     std::optional<ShadingSpec> shading;  // absent: unshaded
     GradientSpec gradient;
+    // From the volume's own space (grid, bounds, crop planes) to world space; absent = identity.
+    // An affine matrix (last row 0 0 0 1) with a non-zero determinant.
+    std::optional<glm::dmat4> transform;
+    std::vector<ClipPlaneSpec> clip_planes;  // each cuts the volume's intervals (kept side >= 0)
+    std::optional<CropSpec> crop;
 };
 
 struct LightSpec {

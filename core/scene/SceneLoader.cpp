@@ -21,6 +21,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/scene/JsonReader.h"
+#include "geometry/VolumeTransform.h"
 
 namespace volref {
 
@@ -513,14 +514,106 @@ GradientSpec read_gradient(const Json& v, const std::string& path, const Context
     return g;
 }
 
+// An invertible affine matrix whose entries and inverse are finite; `path` names it in messages.
+void check_affine(const glm::dmat4& m, const std::string& path, const Context& ctx) {
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row)
+            if (!std::isfinite(m[col][row])) ctx.fail(path, "the matrix has a non-finite entry");
+    if (!(m[0][3] == 0.0 && m[1][3] == 0.0 && m[2][3] == 0.0 && m[3][3] == 1.0))
+        ctx.fail(path, "expected an affine matrix (last row 0 0 0 1), got last row " + format_number(m[0][3]) + " " +
+                           format_number(m[1][3]) + " " + format_number(m[2][3]) + " " + format_number(m[3][3]));
+    const double det = glm::determinant(glm::dmat3(m));
+    if (!(std::fabs(det) > 1e-300) || !std::isfinite(det))
+        ctx.fail(path, "the matrix is not invertible (determinant " + format_number(det) + ")");
+    const glm::dmat4 inverse = glm::inverse(m);
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row)
+            if (!std::isfinite(inverse[col][row])) ctx.fail(path, "the matrix is not invertible (its inverse overflows)");
+}
+
+// "transform": 16 numbers, a ROW-major 4x4 affine matrix (as written on paper: the first four numbers
+// are the first row), or {"scale": [3], "rotate": {"axis": [3], "degrees": d}, "translate": [3]}
+// applied in that order (M = T R S); each part optional.
+glm::dmat4 read_transform(const Json& v, const std::string& path, const Context& ctx) {
+    glm::dmat4 m(1.0);
+    if (v.is_array()) {
+        const std::vector<double> a = read_numbers(v, path, ctx, 16);
+        for (int row = 0; row < 4; ++row)
+            for (int col = 0; col < 4; ++col) m[col][row] = a[static_cast<std::size_t>(4 * row + col)];
+    } else {
+        ObjectReader r(v, path, ctx);
+        r.allow({"scale", "rotate", "translate"});
+        const glm::dvec3 scale = r.vec3("scale", glm::dvec3(1.0));
+        for (int a = 0; a < 3; ++a)
+            if (scale[a] == 0.0) r.fail("scale", "expected non-zero scale factors, got " + format_number(scale[a]));
+        glm::dmat3 rotation(1.0);
+        if (const Json* rot = r.find("rotate")) {
+            ObjectReader rr(*rot, r.path("rotate"), ctx);
+            rr.allow({"axis", "degrees"});
+            const glm::dvec3 axis = read_direction(rr, "axis");
+            const double degrees = rr.number("degrees", 0.0);
+            rotation = rotation_matrix(axis, degrees);
+        }
+        const glm::dvec3 translate = r.vec3("translate", glm::dvec3(0.0));
+        const glm::dmat3 linear = rotation * glm::dmat3(glm::dvec3(scale.x, 0, 0), glm::dvec3(0, scale.y, 0),
+                                                        glm::dvec3(0, 0, scale.z));
+        m = glm::dmat4(linear);
+        m[3] = glm::dvec4(translate, 1.0);
+    }
+    check_affine(m, path, ctx);
+    return m;
+}
+
+// [{"point": [3], "normal": [3] non-zero}, ...]
+std::vector<ClipPlaneSpec> read_clip_planes(const Json& v, const std::string& path, const Context& ctx) {
+    const std::size_t n = read_array_size(v, path, ctx);
+    std::vector<ClipPlaneSpec> planes;
+    for (std::size_t i = 0; i < n; ++i) {
+        ObjectReader r(element(v, i), index_path(path, i), ctx);
+        r.allow({"point", "normal"});
+        ClipPlaneSpec p;
+        p.point = read_vec3(r.required("point"), r.path("point"), ctx);
+        p.normal = read_direction(r, "normal");
+        planes.push_back(p);
+    }
+    return planes;
+}
+
+// {"planes": [x0, x1, y0, y1, z0, z1], "regions": "subvolume" | "fence" | "inverted-fence" | "cross" |
+// "inverted-cross" | a 27-bit integer}; VTK's constants VTK_CROP_SUBVOLUME .. VTK_CROP_INVERTED_CROSS.
+CropSpec read_crop(const Json& v, const std::string& path, const Context& ctx) {
+    ObjectReader r(v, path, ctx);
+    r.allow({"planes", "regions"});
+    CropSpec c;
+    const std::vector<double> planes = read_numbers(r.required("planes"), r.path("planes"), ctx, 6);
+    for (int a = 0; a < 3; ++a) {
+        c.planes[std::size_t(2 * a)] = planes[std::size_t(2 * a)];
+        c.planes[std::size_t(2 * a + 1)] = planes[std::size_t(2 * a + 1)];
+        if (!(planes[std::size_t(2 * a)] <= planes[std::size_t(2 * a + 1)]))
+            ctx.fail(index_path(r.path("planes"), std::size_t(2 * a + 1)),
+                     std::string("the ") + "xyz"[a] + " planes must not decrease: " + format_number(planes[std::size_t(2 * a + 1)]) +
+                         " < " + format_number(planes[std::size_t(2 * a)]));
+    }
+    if (const Json* f = r.find("regions"); f && f->is_number()) {
+        c.regions = std::uint32_t(read_integer(*f, r.path("regions"), ctx, Range::closed(0, double((1u << 27) - 1))));
+    } else {
+        enum class P : std::uint32_t {
+            SubVolume = 0x0002000, Fence = 0x2ebfeba, InvertedFence = 0x5140145, Cross = 0x0417410, InvertedCross = 0x7be8bef
+        };
+        c.regions = std::uint32_t(r.choice<P>("regions", P::SubVolume,
+                                              {{"subvolume", P::SubVolume},
+                                               {"fence", P::Fence},
+                                               {"inverted-fence", P::InvertedFence},
+                                               {"cross", P::Cross},
+                                               {"inverted-cross", P::InvertedCross}}));
+    }
+    return c;
+}
+
 VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     ObjectReader r(v, path, ctx);
     r.allow({"source", "origin", "spacing", "interpolation", "bounds", "classify", "transfer", "classification",
              "shading", "gradient", "transform", "clip_planes", "crop"});
-    // Recognised keys that later work implements.
-    r.reject("transform", "volume transforms are not implemented yet");
-    r.reject("clip_planes", "clip planes are not implemented yet");
-    r.reject("crop", "cropping is not implemented yet");
 
     VolumeSpec spec;
     spec.source = read_source(r.required("source"), r.path("source"), ctx, base_dir);
@@ -543,22 +636,28 @@ VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ct
     if (const Json* s = r.find("shading")) spec.shading = read_shading(*s, r.path("shading"), ctx);
     if (const Json* g = r.find("gradient"))
         spec.gradient = read_gradient(*g, r.path("gradient"), ctx, spec.interpolation);
+    if (const Json* t = r.find("transform")) spec.transform = read_transform(*t, r.path("transform"), ctx);
+    if (const Json* c = r.find("clip_planes")) spec.clip_planes = read_clip_planes(*c, r.path("clip_planes"), ctx);
+    if (const Json* c = r.find("crop")) spec.crop = read_crop(*c, r.path("crop"), ctx);
     return spec;
 }
 
-// "volume": {...}, or "volumes": [{...}] with exactly one element (several: not implemented yet).
-VolumeSpec read_volume_key(ObjectReader& r, const fs::path& base_dir) {
+// "volume": {...} (the shorthand for a list of one), or "volumes": [{...}, ...] (at least one).
+std::vector<VolumeSpec> read_volumes_key(ObjectReader& r, const fs::path& base_dir) {
     const Json* one = r.find("volume");
     const Json* many = r.find("volumes");
     if (one && many) r.fail("volumes", "give either \"volume\" or \"volumes\", not both");
+    std::vector<VolumeSpec> volumes;
     if (many) {
         const std::size_t n = read_array_size(*many, r.path("volumes"), r.context());
-        if (n == 0) r.fail("volumes", "expected one volume, got an empty array");
-        if (n > 1) r.fail("volumes", "several volumes are not implemented yet (got " + std::to_string(n) + ")");
-        return read_volume(element(*many, 0), index_path(r.path("volumes"), 0), r.context(), base_dir);
+        if (n == 0) r.fail("volumes", "expected at least one volume, got an empty array");
+        for (std::size_t i = 0; i < n; ++i)
+            volumes.push_back(read_volume(element(*many, i), index_path(r.path("volumes"), i), r.context(), base_dir));
+        return volumes;
     }
     if (!one) r.fail("volume", "required");
-    return read_volume(*one, r.path("volume"), r.context(), base_dir);
+    volumes.push_back(read_volume(*one, r.path("volume"), r.context(), base_dir));
+    return volumes;
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -722,7 +821,7 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     r.allow({"description", "volume", "volumes", "lights", "camera", "image", "render"});
     r.optional_string("description");  // a note for humans; ignored
     Scene scene;
-    scene.volume() = read_volume_key(r, base_dir);
+    scene.volumes = read_volumes_key(r, base_dir);
     if (const Json* v = r.find("lights")) scene.lights = read_lights(*v, r.path("lights"), ctx);
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);

@@ -188,7 +188,7 @@ TEST(Adaptive, LinearFieldPiecewiseLinearTransferMatchesQuadrature) {
         const Ray ray = p.pixel_ray(0, 0);
         const std::vector<Interval> ivs = p.intervals(ray);
         ASSERT_EQ(ivs.size(), 1u);
-        const PixelValue got = p.integrator->integrate(ray, ivs);
+        const PixelValue got = p.integrator().integrate(ray, ivs);
         const glm::dvec3 x0 = ray.at(ivs[0].t0);
         const double f0 = 0.3 * x0.x + 0.2 * x0.y + 0.5 * x0.z;
         const double g = 0.3 * ray.direction.x + 0.2 * ray.direction.y + 0.5 * ray.direction.z;
@@ -238,7 +238,7 @@ TEST(Adaptive, LineIntegralsOfALinearField) {
         const glm::dvec3 m = ray.at(0.5 * (ivs[0].t0 + ivs[0].t1));
         const double mean = 0.3 * m.x + 0.2 * m.y + 0.5 * m.z;
         const double want = proj == Projection::Average ? mean : 0.25 * mean * ivs[0].length();
-        const PixelValue got = p.integrator->integrate(ray, ivs);
+        const PixelValue got = p.integrator().integrate(ray, ivs);
         EXPECT_NEAR(got.rgba.r, want, 1e-12);
         EXPECT_EQ(got.rgba.a, 1.0);
         EXPECT_LT(got.error, 1e-12);
@@ -281,7 +281,7 @@ TEST(Adaptive, TransferFunctionWithAJump) {
     const PreparedScene p(s, {1, false});
     const Ray ray = p.pixel_ray(0, 0);
     const std::vector<Interval> ivs = p.intervals(ray);
-    const PixelValue got = p.integrator->integrate(ray, ivs);
+    const PixelValue got = p.integrator().integrate(ray, ivs);
     const glm::dvec3 x0 = ray.at(ivs[0].t0);
     const double f0 = 0.3 * x0.x + 0.2 * x0.y + 0.5 * x0.z;
     const double g = 0.3 * ray.direction.x + 0.2 * ray.direction.y + 0.5 * ray.direction.z;

@@ -172,7 +172,7 @@ namespace {
 // True when the scene's composite integrator takes the SIMD packet path.
 bool takes_packet_path(const Scene& s) {
     const PreparedScene prepared(s, {.threads = 1});
-    const auto* composite = dynamic_cast<const CompositeIntegrator*>(prepared.integrator.get());
+    const auto* composite = dynamic_cast<const CompositeIntegrator*>(&prepared.integrator());
     return composite && composite->has_packet_path();
 }
 

@@ -115,7 +115,7 @@ TEST(Trace, SkippingLeavesOutOnlyTransparentSamples) {
     RenderOptions on, off;
     off.empty_space_skipping = false;
     const PreparedScene a(s, on), b(s, off);
-    ASSERT_NE(a.macrocells, nullptr);  // the scene has empty macrocells
+    ASSERT_NE(a.volume().macrocells, nullptr);  // the scene has empty macrocells
     const explain::PixelTrace ta = explain::trace_pixel(a, 8, 8), tb = explain::trace_pixel(b, 8, 8);
     EXPECT_LT(ta.samples.size(), tb.samples.size());
     std::size_t j = 0;  // every row with skipping is a row without, at the same t, with the same numbers

@@ -1,0 +1,259 @@
+#include "core/render/PreparedVolume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/MemoryLimit.h"
+#include "core/grid/ProceduralField.h"
+#include "core/integrate/ProfileIntegrator.h"
+#include "core/io/VolumeReader.h"
+#include "geometry/ClipPlanes.h"
+#include "geometry/CropRegions.h"
+#include "geometry/ShellTessellation.h"
+#include "geometry/TriangleMesh.h"
+
+namespace volref {
+
+namespace {
+
+bool is_shell(const BoundsSpec& b) {
+    return b.type == BoundsSpec::Type::Cylindrical || b.type == BoundsSpec::Type::Spherical;
+}
+
+// Empty-space skipping needs a classifier whose opacity can be 0 on a range of values: not Levoy's
+// isovalue contours (see Classifier::may_have_opacity). A classifier that reads |grad f| is trusted
+// to give 0 only for a finite |grad f| (g * 0 is NaN for g = inf), so skipping is also off where a
+// gradient could overflow: non-finite data, |f| / spacing above 1e150 (every scheme's |grad f| is a
+// few times that, whose square must stay finite), a domain so far from the origin that x +- h rounds
+// away the spacing, or forward differences on an axis of two voxels (one-sided over x - lo, which can
+// be tiny).
+bool skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const Classifier& classifier, const Volume& volume) {
+    if (is_shell(vs.bounds)) return false;  // macrocells are Cartesian
+    if (render.projection != Projection::Composite) return false;
+    if (vs.classification && vs.classification->type == ClassificationSpec::Type::Isovalue) return false;
+    if (!classifier.needs_gradient()) return true;
+    const auto [vmin, vmax] = volume.value_range();
+    const double h = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+    const double far = std::max({glm::length(volume.domain_min()), glm::length(volume.domain_max())});
+    if (!(std::isfinite(vmin) && std::isfinite(vmax))) return false;
+    if (!(std::max(std::fabs(vmin), std::fabs(vmax)) / h <= 1e150)) return false;
+    if (!(far <= 0x1p40 * h)) return false;
+    if (vs.gradient.scheme == GradientSpec::Scheme::Forward)
+        for (int a = 0; a < 3; ++a)
+            if (volume.dims[a] == 2) return false;
+    return true;
+}
+
+// "volume" for a scene of one volume, "volumes[i]" otherwise (the key path in messages).
+std::string volume_key(const Scene& scene, std::size_t index) {
+    return scene.volumes.size() == 1 ? "volume" : "volumes[" + std::to_string(index) + "]";
+}
+
+}  // namespace
+
+void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
+    if (!is_shell(vs.bounds)) {
+        m.volume = load_volume(vs);
+        m.cartesian = std::make_unique<VolumeSampler>(m.volume, vs.interpolation);
+        m.sampler = m.cartesian.get();
+        m.voxel = std::min({m.volume.spacing.x, m.volume.spacing.y, m.volume.spacing.z});
+        return;
+    }
+    if (vs.origin) throw Error("volume.origin: not used with shell bounds (the shell places the samples)");
+    if (vs.spacing) throw Error("volume.spacing: not used with shell bounds (the shell places the samples)");
+    const bool cylinder = vs.bounds.type == BoundsSpec::Type::Cylindrical;
+    auto make_grid = [&](const std::array<std::int64_t, 3>& dims) {
+        return cylinder ? std::make_unique<ShellGrid>(vs.bounds.cylinder, dims)
+                        : std::make_unique<ShellGrid>(vs.bounds.sphere, dims);
+    };
+    if (vs.source.field) {
+        m.shell_grid = make_grid(vs.source.field->dims);
+        const ShellGrid& grid = *m.shell_grid;
+        m.volume = make_procedural_volume(*vs.source.field, [&grid](std::int64_t i, std::int64_t j, std::int64_t k) {
+            return grid.sample_position(i, j, k);
+        });
+    } else {
+        m.volume = read_volume(*vs.source.file, vs.source.format);
+        m.shell_grid = make_grid(m.volume.dims);
+    }
+    m.shell = cylinder ? std::make_unique<ShellSampler>(m.volume, vs.bounds.cylinder, vs.interpolation)
+                       : std::make_unique<ShellSampler>(m.volume, vs.bounds.sphere, vs.interpolation);
+    m.shell_field = std::make_unique<ShellField>(*m.shell);
+    m.sampler = m.shell_field.get();
+    m.voxel = m.shell_grid->default_gradient_step();
+}
+
+PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const RenderOptions& options, std::size_t held_bytes)
+    : spec(scene.volumes.at(index)) {
+    const VolumeSpec& vs = spec;
+    const std::string key = volume_key(scene, index);
+    build_volume_model(vs, model);
+    if (vs.transform) transform.emplace(*vs.transform);
+    const Volume& volume = model.volume;
+    const FieldSampler& sampler = *model.sampler;
+    classifier = make_classifier(vs, volume);
+
+    // One voxel in world units: the smallest world length of the grid's spacing vectors (the spacing
+    // itself without a transform; for shells, the beam-space step times the transform's smallest
+    // stretch of an axis).
+    double voxel = model.voxel;
+    if (transform) {
+        if (model.cartesian) {
+            voxel = std::numeric_limits<double>::infinity();
+            for (int a = 0; a < 3; ++a) {
+                glm::dvec3 e(0.0);
+                e[a] = volume.spacing[a];
+                voxel = std::min(voxel, transform->world_length(e));
+            }
+        } else {
+            double stretch = std::numeric_limits<double>::infinity();
+            for (int a = 0; a < 3; ++a) {
+                glm::dvec3 e(0.0);
+                e[a] = 1.0;
+                stretch = std::min(stretch, transform->world_length(e));
+            }
+            voxel *= stretch;
+        }
+    }
+    step = scene.render.step_units == StepUnits::World ? scene.render.step : scene.render.step * voxel;
+
+    const bool shell = model.shell != nullptr;
+    if (shell && (vs.gradient.scheme != GradientSpec::Scheme::Default || vs.gradient.cache || vs.gradient.cache_auto))
+        throw Error(key + ".gradient: shells take differences in world space (docs/shells.md); no scheme or cache applies");
+    if (shell && vs.classify == VolumeSpec::Classify::Pre)
+        throw Error(key + ".classify: pre-classification is not available for shell bounds");
+    if (transform && vs.classify == VolumeSpec::Classify::Pre && classifier->needs_gradient())
+        throw Error(key + ".classify: pre-classification of a transformed volume cannot use |grad f| (it would be "
+                          "measured in the volume's own space); use \"post\" or a classification without gradients");
+    if (scene.render.profile != ProfileId::Reference && transform)
+        throw Error(key + ".transform: the mirror profiles render untransformed volumes only (use render.profile \"reference\")");
+
+    // Only what the scene uses is built: gradients for shading or gradient-based classification,
+    // the pre-classified volume for classify "pre", the shader for shading.
+    const bool shades = vs.shading.has_value() &&
+                        (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
+    // Memory (core/MemoryLimit.h): what is held (earlier volumes, this volume) plus what is about to
+    // be allocated.
+    // The voxels are held in the file's type (VoxelArray); the derived grids (gradient cache,
+    // pre-classified volume) are f64.
+    const std::size_t voxels = volume.values.size(), volume_bytes = volume.values.bytes(), f64_bytes = voxels * sizeof(double);
+    bytes = volume_bytes;
+    // At most 6 channels (R G B A, Z for first-hit, error) of doubles (docs/conventions.md section 13).
+    constexpr std::size_t kMaxImageChannels = 6;
+    const std::size_t image_bytes =
+        std::size_t(scene.image.width) * std::size_t(scene.image.height) * kMaxImageChannels * sizeof(double);
+    const std::size_t held = held_bytes + volume_bytes + image_bytes;
+    check_memory(held, "image: " + std::to_string(scene.image.width) + " x " + std::to_string(scene.image.height) +
+                           " pixels with the volume" + (scene.volumes.size() == 1 ? std::string() : "s"));
+    if (shades || classifier->needs_gradient()) {
+        if (shell) {
+            gradient = model.shell_field.get();
+        } else {
+            const GradientSpec g = resolve_gradient_cache(vs.gradient, volume, *classifier, scene.image, step);
+            if (g.cache) {
+                check_memory(held + 3 * f64_bytes, key + ".gradient.cache: the gradient volumes");
+                bytes += 3 * f64_bytes;
+            }
+            gradient_field = std::make_unique<GradientField>(*model.cartesian, g);
+            gradient = gradient_field.get();
+        }
+    }
+    if (vs.classify == VolumeSpec::Classify::Pre) {
+        check_memory(held_bytes + bytes + image_bytes + 4 * f64_bytes, key + ".classify: the pre-classified volume");
+        preclassified = std::make_unique<PreClassifiedVolume>(*model.cartesian, *classifier, gradient);
+        bytes += 4 * f64_bytes;
+    }
+    if (shades) {
+        const auto [vmin, vmax] = volume.value_range();
+        shader = std::make_unique<Shader>(*vs.shading, scene.lights,
+                                          conventions::kZeroGradientRelative * std::max(std::fabs(vmin), std::fabs(vmax)) / voxel);
+    }
+    pipeline = std::make_unique<SamplePipeline>(sampler, *classifier, gradient, preclassified.get(), shader.get(),
+                                                transform ? &*transform : nullptr);
+    // The macrocell grid of empty-space skipping, kept only if some macrocell is empty.
+    if (options.empty_space_skipping && skipping_applies(vs, scene.render, *classifier, volume)) {
+        macrocells = std::make_unique<MacrocellGrid>(
+            *model.cartesian, *classifier, preclassified ? MacrocellGrid::Classification::Pre : MacrocellGrid::Classification::Post);
+        if (macrocells->empty_count() == 0) macrocells.reset();
+    }
+
+    // The bounding geometry (in the volume's own space), and the box the default camera frames.
+    glm::dvec3 lo, hi;
+    if (shell) {
+        const bool cylinder = vs.bounds.type == BoundsSpec::Type::Cylindrical;
+        const auto box = cylinder ? bounding_box(vs.bounds.cylinder) : bounding_box(vs.bounds.sphere);
+        lo = box[0];
+        hi = box[1];
+        if (vs.bounds.tessellate > 0) {
+            // The mesh may bulge past the shell's box by its chord error: no domain clipping.
+            const glm::dvec3 pad(glm::length(box[1] - box[0]));
+            geometry_id = geometry.add_mesh(cylinder ? tessellate(vs.bounds.cylinder, vs.bounds.tessellate)
+                                                     : tessellate(vs.bounds.sphere, vs.bounds.tessellate),
+                                            box[0] - pad, box[1] + pad);
+        } else {
+            geometry_id = cylinder ? geometry.add_cylindrical_shell(vs.bounds.cylinder)
+                                   : geometry.add_spherical_shell(vs.bounds.sphere);
+        }
+    } else {
+        const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
+        if (vs.bounds.type == BoundsSpec::Type::Mesh) {
+            const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
+            glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
+            for (const glm::dvec3& p : mesh.vertices) {
+                mlo = glm::min(mlo, p);
+                mhi = glm::max(mhi, p);
+            }
+            lo = glm::max(mlo, domain_lo);
+            hi = glm::min(mhi, domain_hi);
+            geometry_id = geometry.add_mesh(mesh, domain_lo, domain_hi);
+        } else {
+            const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
+            if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
+                throw Error(key + ".bounds: min must not exceed max");
+            lo = glm::max(box_lo, domain_lo);
+            hi = glm::min(box_hi, domain_hi);
+            geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+        }
+    }
+    geometry.commit();
+    if (!transform) {
+        view_lo = lo;
+        view_hi = hi;
+    } else {  // the world box of the transformed corners
+        view_lo = glm::dvec3(std::numeric_limits<double>::infinity());
+        view_hi = -view_lo;
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 p = transform->to_world(glm::dvec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z));
+            view_lo = glm::min(view_lo, p);
+            view_hi = glm::max(view_hi, p);
+        }
+    }
+
+    context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
+    // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
+    integrator = scene.render.profile == ProfileId::Reference
+                     ? make_integrator(*context)
+                     : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume, &scene);
+    // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed
+    // volume whose gradient is used.
+    packets = !(transform && (shader || classifier->needs_gradient()));
+}
+
+PreparedVolume::~PreparedVolume() = default;
+
+void PreparedVolume::intervals(const Ray* rays, int count, Ray* local, std::vector<Interval>* out) const {
+    for (int i = 0; i < count; ++i) local[i] = volume_ray(rays[i]);
+    geometry.intervals(local, count, geometry_id, out);
+    for (int i = 0; i < count; ++i) {
+        if (spec.crop) crop_intervals(local[i], *spec.crop, out[i]);
+        if (!spec.clip_planes.empty()) clip_intervals(rays[i], spec.clip_planes, out[i]);
+    }
+}
+
+}  // namespace volref

@@ -1,0 +1,19 @@
+#include "geometry/VolumeTransform.h"
+
+#include "geometry/ShellIntersection.h"
+
+namespace volref {
+
+glm::dmat3 rotation_matrix(const glm::dvec3& a, double degrees) {
+    double c, s;
+    cos_sin_degrees(degrees, c, s);
+    const double k = 1.0 - c;
+    // Columns of R (glm is column-major: m[col][row]).
+    glm::dmat3 r;
+    r[0] = glm::dvec3(c + k * a.x * a.x, k * a.x * a.y + s * a.z, k * a.x * a.z - s * a.y);
+    r[1] = glm::dvec3(k * a.y * a.x - s * a.z, c + k * a.y * a.y, k * a.y * a.z + s * a.x);
+    r[2] = glm::dvec3(k * a.z * a.x + s * a.y, k * a.z * a.y - s * a.x, c + k * a.z * a.z);
+    return r;
+}
+
+}  // namespace volref

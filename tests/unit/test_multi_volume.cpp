@@ -321,6 +321,51 @@ TEST(Transform, TranslationMovesTheImageByWholePixels) {
     EXPECT_GT(lit, 30) << "the moved volume is in view";
 }
 
+// A scale by powers of two, S = diag(2, 1, 0.5), applied to a unit-spacing grid at origin o equals the
+// same grid with spacing (2, 1, 0.5) at origin S o: the local rays are no longer unit (|A^-1 d| != 1),
+// the world lengths stay the same, and every division by 2 or 0.5 is exact, so the two renders agree
+// to rounding (the gradient comes back through A^-T = S^-1, which a wrong A would not give). Shaded
+// (scalar path) and unshaded (SIMD packets of local rays), perspective.
+TEST(Transform, ScaleEqualsTheSpacing) {
+    FieldSpec f;
+    f.kind = FieldSpec::Kind::MarschnerLobb;
+    f.dims = {9, 7, 11};
+    for (const bool shaded : {false, true}) {
+        auto scene = [&](bool transformed) {
+            Scene s;
+            s.volume().source.field = f;
+            if (transformed) {
+                s.volume().origin = glm::dvec3(-4, -3, -5);
+                s.volume().spacing = glm::dvec3(1.0);
+                s.volume().transform = glm::dmat4(glm::dmat3(glm::dvec3(2, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 0.5)));
+            } else {
+                s.volume().origin = glm::dvec3(-8, -3, -2.5);
+                s.volume().spacing = glm::dvec3(2, 1, 0.5);
+            }
+            s.volume().transfer.color = {{0.0, 1, 0.2, 0}, {1.0, 0.1, 0.5, 1}};
+            s.volume().transfer.opacity = {{0.0, 0.0}, {0.4, 0.05}, {1.0, 0.6}};
+            if (shaded) s.volume().shading = ShadingSpec{};
+            s.camera.type = CameraSpec::Type::Perspective;
+            s.camera.eye = {14, -9, 12};
+            s.camera.target = {0, 0, 0};
+            s.camera.fov_y = 40;
+            s.image.width = s.image.height = 24;
+            s.render.step = 0.3;
+            s.render.step_units = StepUnits::World;
+            return s;
+        };
+        const Image a = render1(scene(true)), b = render1(scene(false));
+        int lit = 0;
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                expect_near(rgba(a, x, y), rgba(b, x, y), 1e-12,
+                            std::string(shaded ? "shaded " : "unshaded ") + std::to_string(x) + "," + std::to_string(y));
+                lit += a.at(x, y, 3) > 0.01;
+            }
+        EXPECT_GT(lit, 100) << "the volume is in view";
+    }
+}
+
 // ---- clip planes -----------------------------------------------------------------------------
 
 // A constant-density ball (spherical shell bounds, radius [0, 3]) cut by the plane through its centre

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 
@@ -45,11 +46,20 @@ std::string format_bytes(std::size_t bytes) {
     return buf;
 }
 
-void check_memory(std::size_t bytes, const std::string& what) {
+namespace {
+thread_local std::size_t held_on_this_thread = 0;  // HeldMemory's count
+}  // namespace
+
+HeldMemory::HeldMemory(std::size_t bytes) : bytes_(bytes) { held_on_this_thread += bytes; }
+HeldMemory::~HeldMemory() { held_on_this_thread -= bytes_; }
+
+void check_memory(std::size_t request, const std::string& what) {
     const std::size_t limit = memory_limit();
+    const std::size_t bytes = request > SIZE_MAX - held_on_this_thread ? SIZE_MAX : request + held_on_this_thread;
     if (bytes > limit)
-        throw Error(what + ": needs " + format_bytes(bytes) + ", more than the memory limit of " + format_bytes(limit) +
-                    " (--max-memory)");
+        throw Error(what + ": needs " + format_bytes(request) +
+                    (held_on_this_thread ? " besides the " + format_bytes(held_on_this_thread) + " the earlier volumes hold" : std::string()) +
+                    ", more than the memory limit of " + format_bytes(limit) + " (--max-memory)");
 }
 
 std::size_t parse_memory_size(const std::string& text, const std::string& what) {

@@ -22,6 +22,20 @@ std::size_t physical_memory();
 // when bytes > memory_limit().
 void check_memory(std::size_t bytes, const std::string& what);
 
+// While alive, every check_memory on the calling thread also counts `bytes` as held: the memory the
+// volumes prepared before the current one hold (several volumes), so that reading the next volume's
+// file is refused before its allocation when the total would not fit. Nests (the counts add).
+class HeldMemory {
+public:
+    explicit HeldMemory(std::size_t bytes);
+    ~HeldMemory();
+    HeldMemory(const HeldMemory&) = delete;
+    HeldMemory& operator=(const HeldMemory&) = delete;
+
+private:
+    std::size_t bytes_;
+};
+
 // Parses a size: a number with an optional unit B, K/KB/KiB, M/MB/MiB, G/GB/GiB, T/TB/TiB (all
 // binary: K = 1024; case-insensitive). Throws Error naming `what` for anything else or 0.
 std::size_t parse_memory_size(const std::string& text, const std::string& what);

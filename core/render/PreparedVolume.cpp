@@ -93,7 +93,16 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     : spec(scene.volumes.at(index)) {
     const VolumeSpec& vs = spec;
     const std::string key = volume_key(scene, index);
-    build_volume_model(vs, model);
+    try {
+        // The volumes before this one stay in memory: the reader's checks count them too.
+        const HeldMemory earlier(held_bytes);
+        build_volume_model(vs, model);
+    } catch (const Error& e) {
+        // The model's messages name keys as "volume.KEY"; in a list of volumes, name the element.
+        const std::string what = e.what();
+        if (key != "volume" && what.rfind("volume.", 0) == 0) throw Error(key + what.substr(6));
+        throw;
+    }
     if (vs.transform) transform.emplace(*vs.transform);
     const Volume& volume = model.volume;
     const FieldSampler& sampler = *model.sampler;

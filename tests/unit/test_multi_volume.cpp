@@ -7,6 +7,7 @@
 
 #include "TestScenes.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 #include "geometry/CropRegions.h"
@@ -245,6 +246,29 @@ TEST(MultiVolume, FirstHitTakesTheNearerVolume) {
     EXPECT_NEAR(im.at(1, 1, 4), 14.0, 1e-9);
     s.volumes = {a};
     EXPECT_NEAR(render1(s).at(1, 1, 4), 18.0, 1e-9);
+}
+
+// The memory limit counts the volumes already prepared: two 32^3 fields of doubles (256 KiB each)
+// under a 400 KiB limit: the first fits, the second is refused before it is generated, and the
+// message names it.
+TEST(MultiVolume, MemoryLimitCountsTheEarlierVolumes) {
+    const std::size_t saved = memory_limit();
+    Scene s = ortho_scene(0.0, 0.0, 1, 1);
+    s.volumes = {constant_box({0, 0, 0}, {32, 32, 32}, {1, 0, 0}, 0.1), constant_box({4, 0, 0}, {32, 32, 32}, {0, 0, 1}, 0.1)};
+    set_memory_limit(400 << 10);
+    std::string message;
+    try {
+        render1(s);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    set_memory_limit(saved);
+    EXPECT_EQ(message, "volumes[1].source.dims: a volume of 32 x 32 x 32: needs 256 KiB besides the 256 KiB the earlier "
+                       "volumes hold, more than the memory limit of 400 KiB (--max-memory)");
+    s.volumes.pop_back();
+    set_memory_limit(400 << 10);
+    EXPECT_NO_THROW(render1(s));  // one alone fits
+    set_memory_limit(saved);
 }
 
 // ---- transforms ------------------------------------------------------------------------------

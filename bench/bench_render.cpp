@@ -7,6 +7,9 @@
 //   scalar       one ray at a time, every segment sampled (simd = false, empty_space_skipping = false;
 //                1 thread): the reference path as it was before packets and skipping
 // The image is the same bits on every path (tested elsewhere), so only the time differs.
+// Benchmarks tiles/<scene>/tile:<n>/threads:<t> render the default path with RenderOptions::tile_size
+// = n (8 .. 64 pixels square; conventions::kTileSize is the default), for the measured choice of the
+// tile size (docs/performance.md, "Tile size"); the image does not depend on it (tested).
 //
 // Scenes:
 //   default      reference_scenes/default.json as the loader reads it: Marschner-Lobb 64^3, trilinear,
@@ -136,6 +139,23 @@ const SampleCount& samples(const std::string& name) {
 
 enum class Path { Full, NoSkipping, Scalar };
 
+void register_tiles(const std::string& name, int tile, int threads) {
+    const std::string bench = "tiles/" + name + "/tile:" + std::to_string(tile) + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(bench.c_str(), [name, tile, threads](benchmark::State& state) {
+        const Scene& s = scene(name);
+        volref::RenderOptions options;
+        options.threads = threads;
+        options.tile_size = tile;
+        for (auto _ : state) {
+            const volref::Image image = volref::render_scene(s, options);
+            benchmark::DoNotOptimize(image.pixels.data());
+            benchmark::ClobberMemory();
+        }
+    })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+}
+
 void register_render(const std::string& name, Path path, int threads) {
     const char* path_name = path == Path::Full ? "full" : path == Path::NoSkipping ? "no_skipping" : "scalar";
     const std::string bench = "render/" + name + "/" + path_name + "/threads:" + std::to_string(threads);
@@ -174,6 +194,9 @@ int main(int argc, char** argv) {
         register_render(name, Path::NoSkipping, 1);  // for ml256_setup: without building the macrocell grid
         if (std::string(name) != "ml256_setup") register_render(name, Path::Scalar, 1);
     }
+    for (const char* name : {"default", "default_shaded"})
+        for (int tile : {8, 16, 32, 64})
+            for (int threads : {1, 2}) register_tiles(name, tile, threads);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();

@@ -112,7 +112,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.has_gradient = v.gradient != nullptr;
     t.shaded = v.shader != nullptr && t.projection == Projection::Composite;
     t.lights = t.shaded ? v.shader->lights().size() : 0;
-    t.skipping = v.macrocells != nullptr;
+    t.skipping = v.macrocells != nullptr && t.projection == Projection::Composite;  // the traced mip / minip loop does not skip
     Collector collector(scene, t.samples);
     t.pixel = v.integrator->integrate_traced(v.volume_ray(t.ray), t.intervals, collector);
     return t;

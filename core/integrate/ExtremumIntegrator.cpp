@@ -24,6 +24,7 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
     }
     in.step = ctx.step;
     in.maximum = maximum;
+    in.macrocells = ctx.macrocells;  // skipping (PreparedVolume builds the grid for mip / minip)
     packet_ = in;
 }
 

@@ -8,6 +8,8 @@
 #include "core/integrate/PacketExtremum.h"
 #include "core/integrate/PacketKernels-inl.h"
 
+#include <limits>
+
 HWY_BEFORE_NAMESPACE();
 namespace volref {
 namespace HWY_NAMESPACE {
@@ -17,7 +19,11 @@ using namespace packet;
 void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count) {
     const D d;
-    RayPacket packet(rays, intervals, count, in.step);
+    // Each lane's extremum so far for the walk's skipping (NaN before its first sample).
+    HWY_ALIGN double extremum[RayPacket::kLanes];
+    for (double& e : extremum) e = std::numeric_limits<double>::quiet_NaN();
+    RayPacket packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum);
+    const V nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
     const PacketTrilinear trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
@@ -33,6 +39,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
         best = hn::IfThenElse(take, v, best);
         t_best = hn::IfThenElse(take, t, t_best);
         seen = hn::IfThenElse(alive, hn::Set(d, 1.0), seen);
+        if (in.macrocells) hn::Store(hn::IfThenElse(hn::Gt(seen, zero), best, nan), d, extremum);
     }
     HWY_ALIGN double b[RayPacket::kLanes], tb[RayPacket::kLanes], s[RayPacket::kLanes];
     hn::Store(best, d, b);

@@ -13,6 +13,8 @@
 
 namespace volref {
 
+class MacrocellGrid;
+
 struct PacketExtremumInputs {
     const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
     ScalarType voxel_type = ScalarType::F64;
@@ -20,6 +22,9 @@ struct PacketExtremumInputs {
     double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
     double step = 1.0;
     bool maximum = true;
+    // Skipping (null: none): macrocells whose values cannot beat a ray's extremum so far are passed
+    // over (SegmentWalk.h, extremum mode); the result is bitwise the same.
+    const MacrocellGrid* macrocells = nullptr;
 };
 
 struct RayExtremum {

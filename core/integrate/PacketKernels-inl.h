@@ -41,8 +41,10 @@ struct RayPacket {
     bool active[kLanes];
     std::size_t lanes = 0;
 
+    // `extremum` (mip / minip skipping, SegmentWalk.h's extremum mode): each lane's running extremum,
+    // kLanes values the caller keeps up to date (NaN before a lane's first sample).
     RayPacket(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
-              const MacrocellGrid* grid = nullptr) {
+              const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true) {
         lanes = hn::Lanes(D());
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
@@ -54,7 +56,9 @@ struct RayPacket {
             dy[l] = r.direction.y;
             dz[l] = r.direction.z;
             active[l] = real;
-            if (real) walk[l] = ForwardSegmentWalk(grid, rays[l], intervals[l], step);
+            if (real)
+                walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum)
+                                   : ForwardSegmentWalk(grid, rays[l], intervals[l], step);
         }
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live

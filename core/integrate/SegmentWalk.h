@@ -3,6 +3,13 @@
 // segment is visited exactly as without skipping, in the same order. Shared by the scalar
 // CompositeIntegrator and the SIMD packet path, so both visit the same segments.
 //
+// Extremum mode (mip / minip): instead of the empty flag, a macrocell is passed over when no value it
+// can reconstruct beats the ray's extremum so far, *extremum (read each time the walk enters a
+// macrocell; NaN, before the first sample, beats nothing): value_bounds(m).hi <= *extremum for the
+// maximum, value_bounds(m).lo >= *extremum for the minimum. The extremum only takes strictly better
+// values (the first of equal ones wins), so the skipped segments could not have changed it, nor
+// where it was first reached.
+//
 // Per interval, per run: the macrocell m of segment k's midpoint (macrocell_of, the sampler's own
 // placement); the segments up to where the ray leaves m (exit_distance, an estimate); if m is empty
 // the estimate is checked (bisected back when too long, extended by doubling when too short) and the
@@ -59,6 +66,14 @@ public:
         : grid_(grid), ray_(&ray), intervals_(&intervals), step_(step) {
         if (!intervals.empty()) n_ = segment_count(intervals[0], step);
     }
+    // Extremum mode (see the header comment): `extremum` is the ray's running maximum (`maximum`) or
+    // minimum, NaN until its first sample; the caller updates it between calls to next().
+    ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step,
+                       const double* extremum, bool maximum)
+        : ForwardSegmentWalk(grid, ray, intervals, step) {
+        extremum_ = extremum;
+        maximum_ = maximum;
+    }
 
     bool next(Segment& s) {
         using namespace segment_walk;
@@ -82,10 +97,19 @@ public:
             // The estimate: segments k .. end - 1 have their midpoints before the ray leaves m.
             const std::int64_t end =
                 std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m), n_), k_ + 1, n_);
-            if (!grid_->empty(m)) {
+            if (!skippable(m)) {
                 end_ = end;
+                if (extremum_) {
+                    // Extremum mode backs off on rays where the checks keep failing (the ray's
+                    // extremum is not yet beyond what the macrocells hold): after f failed checks in a
+                    // row the run is stretched to 2^min(f, 3) times its length, so such a ray pays for
+                    // one check per up to 8 macrocells. Visiting more segments never changes the result.
+                    end_ = std::min(n_, k_ + ((end - k_) << std::min(failed_checks_, 3)));
+                    ++failed_checks_;
+                }
                 continue;
             }
+            failed_checks_ = 0;
             auto in_m = [&](std::int64_t j) { return macrocell_of(*grid_, *ray_, iv, step_, j, n_) == m; };
             std::int64_t in = end - 1, out = n_;  // the run's last segment is in [in, out)
             if (in > k_ && !in_m(in)) {
@@ -106,7 +130,16 @@ public:
     }
 
 private:
+    bool skippable(const MacrocellGrid::Index& m) const {
+        if (!extremum_) return grid_->empty(m);
+        const std::array<double, 2> b = grid_->value_bounds(m);
+        return maximum_ ? b[1] <= *extremum_ : b[0] >= *extremum_;  // false for a NaN extremum
+    }
+
     const MacrocellGrid* grid_ = nullptr;
+    const double* extremum_ = nullptr;  // extremum mode
+    bool maximum_ = true;
+    int failed_checks_ = 0;  // extremum mode: failed checks in a row
     const Ray* ray_ = nullptr;
     const std::vector<Interval>* intervals_ = nullptr;
     double step_ = 1.0;

@@ -50,6 +50,16 @@ bool skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const Clas
     return true;
 }
 
+// mip / minip skip macrocells whose values cannot beat a ray's extremum so far: on the SIMD path of
+// the fixed step (ExtremumIntegrator's packets: Cartesian trilinear, finite voxels), reference profile.
+bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const RenderOptions& options,
+                               const VolumeSampler* sampler) {
+    if (is_shell(vs.bounds) || !sampler || !options.simd) return false;
+    if (render.projection != Projection::Mip && render.projection != Projection::Minip) return false;
+    if (render.integrator != IntegrationMethod::Fixed || render.profile != ProfileId::Reference) return false;
+    return sampler->interpolation() == Interpolation::Trilinear && all_finite(sampler->volume().values);
+}
+
 // "volume" for a scene of one volume, "volumes[i]" otherwise (the key path in messages).
 std::string volume_key(const Scene& scene, std::size_t index) {
     return scene.volumes.size() == 1 ? "volume" : "volumes[" + std::to_string(index) + "]";
@@ -185,11 +195,14 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
     pipeline = std::make_unique<SamplePipeline>(sampler, *classifier, gradient, preclassified.get(), shader.get(),
                                                 transform ? &*transform : nullptr);
-    // The macrocell grid of empty-space skipping, kept only if some macrocell is empty.
+    // The macrocell grid of empty-space skipping, kept only if some macrocell is empty; for mip and
+    // minip (the fixed step's SIMD path), the grid's value bounds (SegmentWalk.h, extremum mode).
     if (options.empty_space_skipping && skipping_applies(vs, scene.render, *classifier, volume)) {
         macrocells = std::make_unique<MacrocellGrid>(
             *model.cartesian, *classifier, preclassified ? MacrocellGrid::Classification::Pre : MacrocellGrid::Classification::Post);
         if (macrocells->empty_count() == 0) macrocells.reset();
+    } else if (options.empty_space_skipping && extremum_skipping_applies(vs, scene.render, options, model.cartesian.get())) {
+        macrocells = std::make_unique<MacrocellGrid>(*model.cartesian, *classifier, MacrocellGrid::Classification::Post);
     }
 
     // The bounding geometry (in the volume's own space), and the box the default camera frames.

@@ -142,4 +142,11 @@ double MacrocellGrid::entry_distance(const Ray& ray, const Index& m) const {
     return t;
 }
 
+std::array<double, 2> MacrocellGrid::value_bounds(const Index& m) const {
+    const auto [lo, hi] = ranges_[linear(m)];
+    if (!(std::isfinite(lo) && std::isfinite(hi)))
+        return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    return reconstruction_bounds(sampler_.interpolation(), lo, hi);
+}
+
 }  // namespace volref

@@ -16,6 +16,9 @@
 //                        opacity is 0 exactly for every kernel): a_i = classify(v_i, 0) for classifiers
 //                        that ignore the gradient, else "classify cannot give > 0 at v_i" (any |grad f|).
 // A macrocell with a non-finite voxel is never empty.
+// mip / minip use the same grid without the flags: value_bounds(m) bounds every value a sample in m
+// can reconstruct, so a macrocell whose bound cannot beat a ray's extremum so far is passed over
+// (SegmentWalk.h).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -43,6 +46,9 @@ public:
     std::int64_t empty_count() const { return empty_count_; }
     // [min, max] of the voxels the samples in macrocell m read ([-inf, +inf] if one is not finite).
     std::array<double, 2> range(const Index& m) const { return ranges_[linear(m)]; }
+    // Every value a sample in macrocell m can reconstruct lies in this interval (reconstruction_bounds of
+    // range(m)); [-inf, +inf] when a voxel it reads is not finite.
+    std::array<double, 2> value_bounds(const Index& m) const;
     // False for an index outside the grid.
     bool empty(const Index& m) const { return inside(m) && empty_[linear(m)] != 0; }
     // The voxels (first, last, inclusive, per axis) that the samples in macrocell m read.

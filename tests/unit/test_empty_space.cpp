@@ -12,6 +12,8 @@
 #include "core/integrate/SamplePipeline.h"
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/Tricubic.h"
+#include "core/integrate/SegmentWalk.h"
+#include "geometry/BoxIntersection.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/BoundaryClassifier.h"
 #include "transfer/IsovalueClassifier.h"
@@ -696,5 +698,122 @@ TEST(EmptySpace, SpotsNextToEmptyMacrocells) {
             set_step(s, n % 3 == 0 ? 16.0 / 9.0 : n % 3 == 1 ? 0.5 : 0.77);
             s.render.order = n % 2 ? CompositeOrder::BackToFront : CompositeOrder::FrontToBack;
             expect_bitwise_equal(s, "spots, interpolation " + std::to_string(int(interp)) + " view " + std::to_string(n));
+        }
+}
+
+// ---- mip / minip: macrocells whose values cannot beat a ray's extremum so far -----------------
+
+// The walk in extremum mode against every segment: the same extremum, first reached at the same t,
+// bitwise, while visiting fewer segments (a Gaussian: once a ray has passed its closest approach to
+// the centre, no macrocell beats its maximum; the minimum is at the ends of the chord).
+TEST(ExtremumSkipping, WalkFindsTheSameExtremumWithFewerSamples) {
+    FieldSpec g;
+    g.kind = FieldSpec::Kind::Gaussian;
+    g.dims = {41, 37, 43};
+    g.center = {17.0, 20.0, 22.0};
+    g.sigma = 6.0;
+    const Volume volume = make_procedural_volume(g, glm::dvec3(0.0), glm::dvec3(1.0));
+    const VolumeSampler sampler(volume, Interpolation::Trilinear);
+    TransferSpec ts;
+    const TransferFunction tf(ts, volume);
+    const MacrocellGrid grid(sampler, tf, MacrocellGrid::Classification::Post);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (const bool maximum : {true, false}) {
+        std::int64_t visited = 0, all = 0;
+        for (int n = 0; n < 400; ++n) {
+            Ray ray;
+            ray.origin = glm::dvec3(20.0, 18.0, 21.0) + 60.0 * glm::normalize(glm::dvec3(u(rng), u(rng), u(rng)));
+            const glm::dvec3 target = glm::dvec3(20.0 + 15 * u(rng), 18.0 + 15 * u(rng), 21.0 + 15 * u(rng));
+            ray.direction = glm::normalize(target - ray.origin);
+            Interval chord;
+            if (!intersect_box(ray, volume.domain_min(), volume.domain_max(), chord)) continue;
+            const std::vector<Interval> iv{chord};
+            const double step = 0.3 + 0.1 * (n % 7);
+            auto run = [&](bool skip, std::int64_t& count) {
+                double best = std::numeric_limits<double>::quiet_NaN(), t_best = 0.0;
+                ForwardSegmentWalk walk = skip ? ForwardSegmentWalk(&grid, ray, iv, step, &best, maximum)
+                                               : ForwardSegmentWalk(nullptr, ray, iv, step);
+                Segment s;
+                while (walk.next(s)) {
+                    ++count;
+                    const double v = sampler.value(ray.at(s.midpoint()));
+                    if (std::isnan(best) || (maximum ? v > best : v < best)) {
+                        best = v;
+                        t_best = s.midpoint();
+                    }
+                }
+                return std::make_pair(best, t_best);
+            };
+            const auto a = run(true, visited), b = run(false, all);
+            EXPECT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << (maximum ? "max" : "min") << " ray " << n;
+        }
+        EXPECT_LT(visited, all) << (maximum ? "max" : "min");
+        std::printf("%s: visited %lld of %lld segments\n", maximum ? "mip" : "minip", (long long)visited, (long long)all);
+        EXPECT_LT(visited, all) << "some segments skipped";
+        if (!maximum) EXPECT_LT(10 * visited, 6 * all) << "minip: most of each chord skipped";
+    }
+}
+
+// Whole renders on the SIMD path (where mip / minip skip), skipping on and off: bitwise the same image,
+// over several fields, odd dims, steps, cameras (perspective, orthographic, axis-parallel, inside) and
+// a bounds box smaller than the domain.
+TEST(ExtremumSkipping, RendersAreBitwiseTheSame) {
+    auto render_simd = [](const Scene& s, bool skipping) {
+        RenderOptions o;
+        o.threads = 1;
+        o.empty_space_skipping = skipping;
+        return render_scene(s, o);
+    };
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> angle(0.0, 6.283185307179586), elevation(-1.4, 1.4), dist(35.0, 80.0);
+    std::vector<FieldSpec> fields;
+    FieldSpec g;
+    g.kind = FieldSpec::Kind::Gaussian;
+    g.dims = {33, 29, 2};
+    g.center = {15.0, 13.0, 0.5};
+    g.sigma = 6.0;
+    fields.push_back(g);
+    g.dims = {31, 33, 35};
+    g.center = {12.0, 17.0, 20.0};
+    fields.push_back(g);
+    FieldSpec ml;
+    ml.kind = FieldSpec::Kind::MarschnerLobb;
+    ml.dims = {41, 41, 41};
+    fields.push_back(ml);
+    int n = 0;
+    for (const FieldSpec& f : fields)
+        for (const Projection p : {Projection::Mip, Projection::Minip}) {
+            Scene s = field_scene(f);
+            s.volume().transfer.opacity = {{0.0, 0.1}, {1.0, 1.0}};
+            s.render.projection = p;
+            s.image.width = s.image.height = 16;
+            const glm::dvec3 c = 0.5 * glm::dvec3(double(f.dims[0] - 1), double(f.dims[1] - 1), double(f.dims[2] - 1));
+            for (int k = 0; k < 5; ++k, ++n) {
+                const double a = angle(rng), e = elevation(rng), r = dist(rng);
+                const glm::dvec3 eye = c + r * glm::dvec3(std::cos(a) * std::cos(e), std::sin(a) * std::cos(e), std::sin(e));
+                if (k == 3)
+                    s.camera = orthographic(c + glm::dvec3(0, 0, 90), c, {0, 1, 0}, 40.0);  // axis-parallel rays
+                else if (k == 4)
+                    s.camera = perspective(c + glm::dvec3(1.5, -0.5, 0.25), eye, {0, 0, 1}, 80.0);  // eye inside
+                else
+                    s.camera = k % 2 ? perspective(eye, c, {0, 0, 1}, 35.0) : orthographic(eye, c, {0, 0, 1}, 40.0);
+                set_step(s, 0.25 + 0.35 * k);
+                if (n % 4 == 3) {
+                    s.volume().bounds.min = 0.4 * c;  // starts and ends inside macrocells
+                    s.volume().bounds.max = 1.5 * c;
+                } else {
+                    s.volume().bounds.min.reset();
+                    s.volume().bounds.max.reset();
+                }
+                const Image on = render_simd(s, true), off = render_simd(s, false);
+                ASSERT_EQ(on.pixels.size(), off.pixels.size());
+                EXPECT_EQ(std::memcmp(on.pixels.data(), off.pixels.data(), on.pixels.size() * sizeof(on.pixels[0])), 0)
+                    << "case " << n;
+                double max_alpha = 0.0;
+                for (int y = 0; y < off.height; ++y)
+                    for (int x = 0; x < off.width; ++x) max_alpha = std::max(max_alpha, off.at(x, y, 3));
+                EXPECT_GT(max_alpha, 0.0) << "case " << n << ": blank image";
+            }
         }
 }

@@ -11,7 +11,9 @@
 # voxels, VTK_CMP_IDLE (0.9) and VTK_CMP_WAIT_BUDGET (240): before each timed run, wait until the
 # CPUs were at least this idle over half a second, spending at most this many seconds waiting in the
 # whole run (the machine is shared; the idle fraction of every run goes to OUT_DIR/runs/idle.tsv),
-# VOLREF_BUILD (build) the build folder holding cli/volref.
+# VTK_CMP_FAST (1) whether to time volref's fast profile too (`--set render.profile=fast`: float SIMD
+# lanes and early ray termination at transmittance 2^-10, docs/conventions.md section 9b; 0 skips
+# those runs), VOLREF_BUILD (build) the build folder holding cli/volref.
 #
 # Steps:
 #  1. freeze the volref binary: cli/volref and libvolref.so.0 are copied to OUT_DIR/bin and run from
@@ -20,8 +22,10 @@
 #  3. render each case's reference with volref at step VTK_CMP_REF_STEP voxel (EXR);
 #  4. the timing loop, interleaved: for each rep, for each thread count, for each case:
 #     volref (one render), volref's set-up (the same scene at 1 x 1 pixel: volume generation and the
-#     rest of the fixed cost), VTK fixed-point, VTK GPU. Each run's numbers go to OUT_DIR/runs/ as
-#     one JSON file; the last image of each renderer and thread count to OUT_DIR/images/.
+#     rest of the fixed cost), volref's fast profile and its own set-up (the same two runs with
+#     `--set render.profile=fast`; files *-fast-* and *-fastsetup-*, unless VTK_CMP_FAST=0), VTK
+#     fixed-point, VTK GPU. Each run's numbers go to OUT_DIR/runs/ as one JSON file; the last image of
+#     each renderer and thread count to OUT_DIR/images/.
 # A VTK run that fails leaves its stderr in OUT_DIR/runs/*.err and the loop goes on.
 set -eu
 
@@ -38,9 +42,11 @@ cases=${VTK_CMP_CASES:-"composite shaded mip dense"}
 ref_step=${VTK_CMP_REF_STEP:-0.0625}
 idle_min=${VTK_CMP_IDLE:-0.9}
 wait_left=$(( ${VTK_CMP_WAIT_BUDGET:-240} * 2 ))   # in half seconds
+fast=${VTK_CMP_FAST:-1}
 build=${VOLREF_BUILD:-$root/build}
 py=/usr/bin/python3          # Debian's Python: python3-vtk9 and python3-numpy live there
 ref_threads=$(nproc)
+case "$fast" in 0 | 1) ;; *) echo "$0: VTK_CMP_FAST must be 0 or 1, not '$fast'" >&2; exit 2 ;; esac
 
 rm -rf "${out:?}/bin" "${out:?}/runs" "${out:?}/images" "${out:?}/ref" "${out:?}/samples"
 mkdir -p "$out/bin" "$out/runs" "$out/images" "$out/ref" "$out/samples"
@@ -123,13 +129,26 @@ while [ "$rep" -le "$reps" ]; do
     for t in $threads_list; do
         for c in $cases; do
             scene="$here/scenes/$c.json"
-            log "rep $rep/$reps, $t thread(s), $c: volref, set-up, VTK fixed-point, VTK GPU"
+            if [ "$fast" = 1 ]; then
+                log "rep $rep/$reps, $t thread(s), $c: volref, set-up, volref fast, fast set-up, VTK fixed-point, VTK GPU"
+            else
+                log "rep $rep/$reps, $t thread(s), $c: volref, set-up, VTK fixed-point, VTK GPU"
+            fi
             wait_idle "$c-t$t-volref-$rep"
             timed_volref "$out/runs/$c-t$t-volref-$rep.json" render "$scene" \
                 -o "$out/images/$c-volref-t$t.png" --threads "$t"
             wait_idle "$c-t$t-setup-$rep"
             timed_volref "$out/runs/$c-t$t-setup-$rep.json" render "$scene" \
                 -o "$out/runs/setup.png" --threads "$t" --set image.width=1 --set image.height=1
+            if [ "$fast" = 1 ]; then
+                wait_idle "$c-t$t-fast-$rep"
+                timed_volref "$out/runs/$c-t$t-fast-$rep.json" render "$scene" \
+                    -o "$out/images/$c-fast-t$t.png" --threads "$t" --set render.profile=fast
+                wait_idle "$c-t$t-fastsetup-$rep"
+                timed_volref "$out/runs/$c-t$t-fastsetup-$rep.json" render "$scene" \
+                    -o "$out/runs/setup.png" --threads "$t" --set image.width=1 --set image.height=1 \
+                    --set render.profile=fast
+            fi
             wait_idle "$c-t$t-fixed-$rep"
             timed_vtk "$out/runs/$c-t$t-fixed-$rep.json" fixed "$t" "$scene" "$out/images/$c-fixed-t$t.png"
             wait_idle "$c-t$t-gpu-$rep"
@@ -152,7 +171,7 @@ case " $cases " in *" shaded "*)
         [ -s "$out/runs/shaded-$m-defaultlight.err" ] || rm -f "$out/runs/shaded-$m-defaultlight.err"
     done ;;
 esac
-printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s, "idle_min": %s, "wait_budget_s": %s, "loadavg_start": "%s", "loadavg_end": "%s"}\n' \
-    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" "$idle_min" "${VTK_CMP_WAIT_BUDGET:-240}" \
+printf '{"reps": %s, "frames": %s, "threads": "%s", "cases": "%s", "ref_step": %s, "ref_threads": %s, "idle_min": %s, "wait_budget_s": %s, "fast": %s, "loadavg_start": "%s", "loadavg_end": "%s"}\n' \
+    "$reps" "$frames" "$threads_list" "$cases" "$ref_step" "$ref_threads" "$idle_min" "${VTK_CMP_WAIT_BUDGET:-240}" "$fast" \
     "$load_start" "$(cut -d' ' -f1-3 /proc/loadavg)" >"$out/settings.json"
 log "done: results in $out"

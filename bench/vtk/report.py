@@ -11,7 +11,9 @@ generating the 256^3 volume and building the pipeline), since VTK's per-volume w
 untimed warm-up frame. FPS = 1 / median frame time. Samples per second use the sample count of
 count_samples.py (volref's exact count at step 1 voxel) for every renderer. Errors: compare.py,
 against volref's reference render (step OUT_DIR/settings.json ref_step), images of the largest
-thread count.
+thread count. volref's fast profile (`--set render.profile=fast`: runs/*-fast-*.json with their own
+set-up runs/*-fastsetup-*.json, images/*-fast-t*.png; VTK_CMP_FAST=1 in driver.sh) is reported like
+volref's default when its runs are there; without them the section is the same as before.
 """
 import argparse
 import datetime
@@ -37,7 +39,8 @@ CASE_TITLES = {
     "mip": "MIP",
     "dense": "composite, dense TF",
 }
-RENDERERS = [("volref", "volref, step 1"), ("fixed", "VTK fixed-point"), ("gpu", "VTK GPU (llvmpipe)")]
+RENDERERS = [("volref", "volref, step 1"), ("fast", "volref fast, step 1"), ("fixed", "VTK fixed-point"),
+             ("gpu", "VTK GPU (llvmpipe)")]
 
 
 def load(path):
@@ -64,13 +67,15 @@ def collect(out, settings):
     for c in cases:
         for t in threads:
             r = {"failures": []}
-            for kind in ("volref", "setup"):
+            for kind in ("volref", "setup", "fast", "fastsetup"):
                 runs = [load(p) for p in sorted(glob.glob(f"{out}/runs/{c}-t{t}-{kind}-*.json"))]
                 r[kind + "_render"] = median([x["render_s"] for x in runs])
                 r[kind + "_process"] = median([x["process_s"] for x in runs])
                 r[kind + "_n"] = len(runs)
             r["volref_frame"] = (r["volref_render"] - r["setup_render"]
                                  if r["volref_render"] is not None and r["setup_render"] is not None else None)
+            r["fast_frame"] = (r["fast_render"] - r["fastsetup_render"]
+                               if r["fast_render"] is not None and r["fastsetup_render"] is not None else None)
             for m in ("fixed", "gpu"):
                 runs = [load(p) for p in sorted(glob.glob(f"{out}/runs/{c}-t{t}-{m}-*.json"))]
                 frames = [f for x in runs for f in x["frames_s"]]
@@ -166,6 +171,18 @@ def closest_note(ratios):
             f"({'x, '.join(f'{r:.2f}' for r in by_case[worst])}x).")
 
 
+def short_of(values, target, unit, short_text):
+    """How values (one per case and thread count) stand against a target they should reach: short_text
+    (formatted with a = target / max, b = target / min) when all are below it."""
+    lo, hi = min(values), max(values)
+    if hi < target:
+        return short_text.format(a=target / hi, b=target / lo)
+    if lo >= target:
+        return f"at least {target:g}{unit} in all {len(values)} case and thread-count pairs"
+    n = sum(1 for v in values if v >= target)
+    return f"at least {target:g}{unit} in {n} of {len(values)} case and thread-count pairs"
+
+
 def idle_note(out, settings):
     path = f"{out}/runs/idle.tsv"
     if not os.path.exists(path):
@@ -193,6 +210,7 @@ def section(out, args):
     samples = {c: load(f"{out}/samples/{c}.json") for c in cases}
     refs = {c: load(f"{out}/ref/{c}.json") for c in cases if os.path.exists(f"{out}/ref/{c}.json")}
     errs, same = image_errors(out, cases, threads)
+    has_fast = any(r["fast_n"] for r in res.values())
     mach = machine(out, res)
     reps, frames = settings["reps"], settings["frames"]
     tmax = max(threads)
@@ -229,7 +247,9 @@ def section(out, args):
 
     # Frame rates.
     w(f"**Frame rates** (medians: volref over {reps} runs, VTK over {reps} runs x {frames} timed frames after "
-      "one warm-up frame per run; all runs interleaved: volref, volref set-up, fixed-point, GPU, for each case "
+      "one warm-up frame per run; all runs interleaved: volref, volref set-up, "
+      + ("volref fast, fast set-up, " if has_fast else "") +
+      "fixed-point, GPU, for each case "
       "and thread count in turn, repeated). *render*: the time `volref render` prints, which includes "
       "generating the 256^3 volume; *set-up*: the same command at 1 x 1 pixel (volume generation and pipeline "
       "set-up, one thread); *frame* = render - set-up, the part comparable with VTK's frames (VTK's volume "
@@ -262,6 +282,39 @@ def section(out, args):
         w(f"volref FPS = 1 / frame. Counted on volref's whole render time instead (volume generation included), "
           f"volref / fixed-point would be {min(ratios_render):.2f}x to {max(ratios_render):.2f}x.")
         w("")
+    fast_ratios_fixed = []
+    if has_fast:
+        w(f"**volref's fast profile** (`--set render.profile=fast`, the same scenes otherwise), timed like the "
+          f"default: medians over {reps} runs, *set-up* its own run at 1 x 1 pixel with the fast profile, "
+          "*frame* = render - set-up, FPS = 1 / frame. *fast / default*: its FPS over the default volref FPS "
+          "above.")
+        w("")
+        w("| case | threads | fast render | set-up | frame | process | fast FPS | fast / default | fast / fixed-point | fast / GPU |")
+        w("|---|---|---|---|---|---|---|---|---|---|")
+        fast_ratios_render = []
+        for c in cases:
+            for t in threads:
+                r = res[(c, t)]
+                ff = r["fast_frame"]
+                q_fps = 1.0 / ff if ff and ff > 0 else None
+                v_fps = 1.0 / r["volref_frame"] if r["volref_frame"] and r["volref_frame"] > 0 else None
+                f_fps = 1.0 / r["fixed_frame"] if r["fixed_frame"] else None
+                g_fps = 1.0 / r["gpu_frame"] if r["gpu_frame"] else None
+                rv = q_fps / v_fps if q_fps and v_fps else None
+                rf = q_fps / f_fps if q_fps and f_fps else None
+                rg = q_fps / g_fps if q_fps and g_fps else None
+                if rf:
+                    fast_ratios_fixed.append((rf, c, t))
+                    if r["fast_render"]:
+                        fast_ratios_render.append((1.0 / r["fast_render"]) / f_fps)
+                w(f"| {CASE_TITLES.get(c, c)} | {t} | {fixed(r['fast_render'], 2)} s | "
+                  f"{fixed(r['fastsetup_render'], 2)} s | {fixed(ff, 2)} s | {fixed(r['fast_process'], 2)} s | "
+                  f"{fixed(q_fps, 2)} | {fixed(rv, 2)} | {fixed(rf, 3)} | {fixed(rg, 2)} |")
+        w("")
+        if fast_ratios_render:
+            w(f"Counted on the fast profile's whole render time instead (volume generation included), fast / "
+              f"fixed-point would be {min(fast_ratios_render):.2f}x to {max(fast_ratios_render):.2f}x.")
+            w("")
 
     # Samples per second.
     w("**Samples per second.** Samples per frame = volref's exact count at step 1 voxel "
@@ -271,24 +324,33 @@ def section(out, args):
       "samples per ray give or take one, but its fixed-point mapper skips empty 4^3 blocks and stops rays early "
       "(remaining transparency below 255/32767), so for it these are *equivalent* samples per second (the work volref does), not "
       "samples it evaluated; likewise volref's own count includes the segments its empty-space skipping passes "
-      "over (as in \"Whole renders\" above). Per core = / threads (llvmpipe at LP_NUM_THREADS=1 still rasterises on one "
+      "over (as in \"Whole renders\" above)"
+      + ("; volref's fast profile is counted the same way, so its count also includes the samples its rays "
+         "leave out after early termination" if has_fast else "") +
+      ". Per core = / threads (llvmpipe at LP_NUM_THREADS=1 still rasterises on one "
       "worker thread plus the main thread).")
     w("")
-    w("| case | rays hitting | mean chord | samples per frame | threads | volref M/s (per core) | fixed-point M/s (per core) | GPU M/s (per core) |")
-    w("|---|---|---|---|---|---|---|---|")
-    per_core = []
+    if has_fast:
+        w("| case | rays hitting | mean chord | samples per frame | threads | volref M/s (per core) | volref fast M/s (per core) | fixed-point M/s (per core) | GPU M/s (per core) |")
+        w("|---|---|---|---|---|---|---|---|---|")
+    else:
+        w("| case | rays hitting | mean chord | samples per frame | threads | volref M/s (per core) | fixed-point M/s (per core) | GPU M/s (per core) |")
+        w("|---|---|---|---|---|---|---|---|")
+    per_core, fast_per_core = [], []
     for c in cases:
         s = samples[c]
         for i, t in enumerate(threads):
             r = res[(c, t)]
             cells = []
-            for m in ("volref", "fixed", "gpu"):
+            for m in ("volref", "fast", "fixed", "gpu") if has_fast else ("volref", "fixed", "gpu"):
                 ft = r[m + "_frame"]
                 if ft and ft > 0:
                     rate = s["samples"] / ft / 1e6
                     cells.append(f"{rate:.1f} ({rate / t:.1f})")
                     if m == "volref":
                         per_core.append((rate / t, c, t))
+                    elif m == "fast":
+                        fast_per_core.append((rate / t, c, t))
                 else:
                     cells.append("—")
             lead = (f"| {CASE_TITLES.get(c, c)} | {s['hits']} | {s['mean_chord']:.1f} | {s['samples'] / 1e6:.2f} M"
@@ -308,24 +370,33 @@ def section(out, args):
     ref_step = settings["ref_step"]
     w(f"**Error against volref's most accurate reference**: volref with `render.step` {ref_step} voxel "
       f"({1 / ref_step:.0f} samples per voxel, EXR, double precision throughout), the same scene otherwise. "
-      "Each image (volref at step 1, VTK's two mappers; the "
+      "Each image (volref at step 1"
+      + (" with its default and its fast profile" if has_fast else "") +
+      ", VTK's two mappers; the "
       f"{tmax}-thread runs' last images) is compared as RGB in [0, 1] over opaque black: RMSE over all "
-      "512 x 512 pixels and 3 channels (background included) / largest absolute difference. All three are "
+      "512 x 512 pixels and 3 channels (background included) / largest absolute difference. All "
+      + ("four" if has_fast else "three") + " are "
       "8-bit PNGs (VTK's window is 8 bits per channel), so none can be better than the *8-bit floor*: the "
       "reference itself rounded to 8 bits.")
     w("")
-    w("| case | reference render | 8-bit floor | volref, step 1 | VTK fixed-point | VTK GPU (llvmpipe) |")
-    w("|---|---|---|---|---|---|")
-    lower = []
+    if has_fast:
+        w("| case | reference render | 8-bit floor | volref, step 1 | volref fast, step 1 | VTK fixed-point | VTK GPU (llvmpipe) |")
+        w("|---|---|---|---|---|---|---|")
+    else:
+        w("| case | reference render | 8-bit floor | volref, step 1 | VTK fixed-point | VTK GPU (llvmpipe) |")
+        w("|---|---|---|---|---|---|")
+    lower, fast_lower = [], []
     for c in cases:
         def cell(key):
             e = errs.get((c, key))
             return "—" if e is None else f"{e['rmse']:.4f} / {e['max']:.3f}"
         rr = refs.get(c)
         w(f"| {CASE_TITLES.get(c, c)} | {fixed(rr['render_s'], 1) if rr else '—'} s | {cell('floor')} | "
-          f"{cell('volref')} | {cell('fixed')} | {cell('gpu')} |")
+          f"{cell('volref')} | " + (f"{cell('fast')} | " if has_fast else "") + f"{cell('fixed')} | {cell('gpu')} |")
         if (c, "volref") in errs and (c, "fixed") in errs:
             lower.append((c, errs[(c, "volref")]["rmse"], errs[(c, "fixed")]["rmse"]))
+        if (c, "fast") in errs and (c, "fixed") in errs:
+            fast_lower.append((c, errs[(c, "fast")]["rmse"], errs[(c, "fixed")]["rmse"]))
     w("")
     diffs = [f"{m} {c} {t} vs {tmax} threads: {d:.4f}" for (c, m, t), d in sorted(same.items()) if d > 0]
     if same:
@@ -349,17 +420,34 @@ def section(out, args):
         w(f"- FPS: volref reaches {lo[0]:.3f}x ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.3f}x ({hi[1]}, {hi[2]} "
           f"thread(s)) of the fixed-point mapper's frame rate on frame time alone; reaching 3x needs a "
           f"{3 / hi[0]:.1f}x to {3 / lo[0]:.1f}x speed-up.")
+    if fast_ratios_fixed:
+        lo, hi = min(fast_ratios_fixed), max(fast_ratios_fixed)
+        w(f"- FPS, fast profile: it reaches {lo[0]:.3f}x ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.3f}x ({hi[1]}, {hi[2]} "
+          "thread(s)) of the fixed-point mapper's frame rate on frame time alone; "
+          + short_of([x[0] for x in fast_ratios_fixed], 3, "x", "reaching 3x needs a {a:.1f}x to {b:.1f}x speed-up")
+          + ".")
     if per_core:
         lo, hi = min(per_core), max(per_core)
         w(f"- Throughput: {lo[0]:.1f} ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.1f} ({hi[1]}, {hi[2]} thread(s)) "
           f"M samples/s/core, {500 / hi[0]:.1f}x to {500 / lo[0]:.1f}x short of 500 M/s/core.")
+    if fast_per_core:
+        lo, hi = min(fast_per_core), max(fast_per_core)
+        w(f"- Throughput, fast profile: {lo[0]:.1f} ({lo[1]}, {lo[2]} thread(s)) to {hi[0]:.1f} ({hi[1]}, "
+          f"{hi[2]} thread(s)) M samples/s/core, "
+          + short_of([x[0] for x in fast_per_core], 500, " M/s/core", "{a:.1f}x to {b:.1f}x short of 500 M/s/core")
+          + ".")
     if lower:
         better = [c for c, v, f in lower if v < f]
         w(f"- Error: volref's step-1 image has a lower RMSE than the fixed-point mapper's in {len(better)} of "
           f"{len(lower)} cases" + (f" ({', '.join(better)})" if better else "") +
           "; " + ", ".join(f"{c} {v:.4f} vs {f:.4f}" for c, v, f in lower) + ".")
+    if fast_lower:
+        better = [c for c, v, f in fast_lower if v < f]
+        w(f"- Error, fast profile: its step-1 image has a lower RMSE than the fixed-point mapper's in "
+          f"{len(better)} of {len(fast_lower)} cases" + (f" ({', '.join(better)})" if better else "") +
+          "; " + ", ".join(f"{c} {v:.4f} vs {f:.4f}" for c, v, f in fast_lower) + ".")
     w("")
-    w(WHY + closest_note(ratios_fixed))
+    w((WHY.replace(WHY_FAST_AFTER, WHY_FAST_AFTER + WHY_FAST) if has_fast else WHY) + closest_note(ratios_fixed))
     w("")
 
     # Command and machine.
@@ -373,7 +461,8 @@ def section(out, args):
     extra = (f"The whole command took {total} on this run up to writing this section (packages already "
              "installed, volref already built). " if total else "")
     w(f"{extra}Settings: VTK_CMP_REPS={reps}, VTK_CMP_FRAMES={frames}, VTK_CMP_THREADS=\"{settings['threads']}\", "
-      f"VTK_CMP_REF_STEP={ref_step}; raw results (every run's JSON, the images, the references) are left in "
+      f"VTK_CMP_REF_STEP={ref_step}" + (", VTK_CMP_FAST=1" if has_fast else "") +
+      "; raw results (every run's JSON, the images, the references) are left in "
       f"`{args.out_label or out}`. Load average (1, 5, 15 min) at the start / end of the runs: "
       f"{settings.get('loadavg_start', '?')} / {settings.get('loadavg_end', '?')}. The machine is shared with "
       "other builds and tests, so single runs can be off by tens of percent; the interleaving spreads that "
@@ -411,6 +500,13 @@ WHY = ("What the renderers do per sample, which is where the gap comes from. vol
        "empty and stops a ray once its remaining transparency is below 255/32767 (about 1/128). The GPU mapper runs a "
        "float32 GLSL shader, compiled by llvmpipe to 256-bit vector code, and also stops at opacity "
        "1 - 1/255.")
+
+
+WHY_FAST_AFTER = "(the reference integrates every ray to its end). "
+WHY_FAST = ("volref's `fast` profile (render.profile \"fast\", docs/conventions.md section 9b) runs the same "
+            "kernels on float lanes (8 rays per AVX2 vector, 16 per AVX-512; every case, the shaded one included, "
+            "through the packet path) and stops a ray once its transmittance is at most 2^-10. ")
+assert WHY_FAST_AFTER in WHY
 
 
 def replace_section(doc_path, text):

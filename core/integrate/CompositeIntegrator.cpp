@@ -1,5 +1,7 @@
 #include "core/integrate/CompositeIntegrator.h"
 
+#include "core/Error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -57,6 +59,11 @@ void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ra
 }  // namespace
 
 PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    if (packet_ && packet_->fast) {  // the fast profile has only its packet path
+        PixelValue out;
+        composite_packet(*packet_, &ray, &intervals, &out, 1);
+        return out;
+    }
     NoRecording rec;
     return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
                                                             : back_to_front(ray, intervals, rec);
@@ -64,6 +71,9 @@ PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Inte
 
 PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                  SampleRecorder& recorder) const {
+    if (packet_ && packet_->fast)
+        throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
+                    "render.profile \"reference\"");
     Recording rec{recorder};
     return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
                                                             : back_to_front(ray, intervals, rec);

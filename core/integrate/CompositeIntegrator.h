@@ -20,6 +20,7 @@
 // are monotone in floating point), so every segment between two in m is in m. Otherwise the run is
 // sampled. Back to front walks the same way from the far end (entry_distance).
 #pragma once
+#include <memory>
 #include <optional>
 
 #include "core/integrate/Integrator.h"
@@ -28,9 +29,13 @@
 
 namespace volref {
 
+struct FloatCopies;
+
 class CompositeIntegrator final : public Integrator {
 public:
     explicit CompositeIntegrator(const IntegrationContext& ctx);
+    ~CompositeIntegrator() override;
+    // The fast profile (FastProfile.h) integrates every ray by the packet kernel, one ray or many.
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                 SampleRecorder& recorder) const override;
@@ -46,6 +51,7 @@ private:
     template <class Rec>
     PixelValue back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
+    std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
 };
 
 }  // namespace volref

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/integrate/FastProfile.h"
 #include "core/sample/GradientField.h"
 #include "transfer/Shader.h"
 #include "transfer/TransferFunction.h"
@@ -13,26 +14,60 @@ namespace volref {
 
 CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
     const SamplePipeline& p = ctx.pipeline;
+    const bool fast = ctx.render.profile == ProfileId::Fast;
+    // Where the packet path does not apply the reference takes the scalar path; the fast profile has
+    // no scalar path and says why (FastProfile.h).
+    auto unavailable = [&](const char* reason) {
+        if (fast) fast_profile_unavailable(reason);
+    };
     const auto* tf = dynamic_cast<const TransferFunction*>(&p.classifier());
     const VolumeSampler* sampler = p.cartesian_sampler();
-    if (!tf || !sampler || p.preclassified() || sampler->interpolation() != Interpolation::Trilinear ||
-        ctx.render.order != CompositeOrder::FrontToBack)
+    if (!tf) {
+        unavailable("this volume is classified otherwise");
         return;
+    }
+    if (!sampler) {
+        unavailable("this volume is not on a Cartesian grid");
+        return;
+    }
+    if (p.preclassified()) {
+        unavailable("this volume is pre-classified");
+        return;
+    }
+    if (sampler->interpolation() != Interpolation::Trilinear) {
+        unavailable("this volume is not trilinear");
+        return;
+    }
+    if (ctx.render.order != CompositeOrder::FrontToBack) {
+        unavailable("this scene composites back to front");
+        return;
+    }
     const Volume& v = sampler->volume();
     // Non-finite voxels: the scalar path, whose pipeline makes them transparent (docs/accuracy.md).
-    if (!all_finite(v.values)) return;
+    if (!all_finite(v.values)) {
+        unavailable("this volume has non-finite voxels");
+        return;
+    }
     PacketCompositeInputs in;
+    const Volume* cached[3] = {nullptr, nullptr, nullptr};
     if (tf->needs_gradient() || p.shaded()) {
         const auto* field = dynamic_cast<const GradientField*>(p.gradient_source());
-        if (!field) return;
+        if (!field) {
+            unavailable("this volume's gradient is not a grid's");
+            return;
+        }
         if (field->cached_component(0)) {
             in.gradient = PacketCompositeInputs::Gradient::Cached;
-            for (int a = 0; a < 3; ++a) in.cached_gradient[a] = field->cached_component(a)->values.data<double>();
+            for (int a = 0; a < 3; ++a) {
+                cached[a] = field->cached_component(a);
+                in.tables_double.cached_gradient[a] = cached[a]->values.data<double>();
+            }
         } else if (field->scheme() == GradientSpec::Scheme::Central) {
             in.gradient = PacketCompositeInputs::Gradient::Central;
         } else if (field->scheme() == GradientSpec::Scheme::Forward) {
             in.gradient = PacketCompositeInputs::Gradient::Forward;
         } else {
+            unavailable("this volume's gradient scheme is not central or forward differences");
             return;
         }
         for (int a = 0; a < 3; ++a) {
@@ -42,13 +77,16 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
         }
     }
     if (tf->needs_gradient()) {
-        in.gradient_opacity_x = tf->gradient_opacity_function().xs().data();
-        in.gradient_opacity_y = tf->gradient_opacity_function().ys().front().data();
+        in.tables_double.gradient_opacity_x = tf->gradient_opacity_function().xs().data();
+        in.tables_double.gradient_opacity_y = tf->gradient_opacity_function().ys().front().data();
         in.gradient_opacity_rows = int(tf->gradient_opacity_function().xs().size());
     }
     if (const Shader* shader = p.shader()) {
         const ShadingSpec& s = shader->spec();
-        if (shader->lights().size() > std::size_t(PacketCompositeInputs::kMaxPacketLights)) return;
+        if (shader->lights().size() > std::size_t(PacketCompositeInputs::kMaxPacketLights)) {
+            unavailable("this scene has more than 8 lights");
+            return;
+        }
         in.shaded = true;
         in.phong = s.model == ShadingSpec::Model::Phong;
         in.two_sided = s.two_sided;
@@ -79,19 +117,25 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     in.lo = tf->window()[0];
     in.inv_width = tf->inverse_window_width();
     // std::array<double, N> rows are contiguous doubles (N per row).
-    in.color_x = tf->color_function().xs().data();
-    in.color_y = tf->color_function().ys().front().data();
+    in.tables_double.color_x = tf->color_function().xs().data();
+    in.tables_double.color_y = tf->color_function().ys().front().data();
     in.color_rows = int(tf->color_function().xs().size());
-    in.opacity_x = tf->opacity_function().xs().data();
-    in.opacity_y = tf->opacity_function().ys().front().data();
+    in.tables_double.opacity_x = tf->opacity_function().xs().data();
+    in.tables_double.opacity_y = tf->opacity_function().ys().front().data();
     in.opacity_rows = int(tf->opacity_function().xs().size());
     in.unit_distance = tf->unit_distance();
     in.step = ctx.step;
     in.terminate = ctx.render.early_termination.has_value();
     in.threshold = ctx.render.early_termination.value_or(1.0);
     in.macrocells = ctx.macrocells;
+    if (fast) {
+        fast_copies_ = std::make_unique<FloatCopies>();
+        make_fast(in, v, cached, 3, *fast_copies_);
+    }
     packet_ = in;
 }
+
+CompositeIntegrator::~CompositeIntegrator() = default;
 
 void CompositeIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
                                            int count) const {

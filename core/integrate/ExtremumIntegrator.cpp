@@ -1,5 +1,7 @@
 #include "core/integrate/ExtremumIntegrator.h"
 
+#include "core/Error.h"
+#include "core/integrate/FastProfile.h"
 #include "core/integrate/Segments.h"
 
 #include <algorithm>
@@ -9,11 +11,25 @@
 namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
+    const bool fast = ctx.render.profile == ProfileId::Fast;
     const VolumeSampler* sampler = ctx.pipeline.cartesian_sampler();
-    if (!sampler || sampler->interpolation() != Interpolation::Trilinear) return;
+    auto unavailable = [&](const char* reason) {
+        if (fast) fast_profile_unavailable(reason);
+    };
+    if (!sampler) {
+        unavailable("this volume is not on a Cartesian grid");
+        return;
+    }
+    if (sampler->interpolation() != Interpolation::Trilinear) {
+        unavailable("this volume is not trilinear");
+        return;
+    }
     const Volume& v = sampler->volume();
     // Non-finite voxels: the scalar path, which ignores them (docs/accuracy.md).
-    if (!all_finite(v.values)) return;
+    if (!all_finite(v.values)) {
+        unavailable("this volume has non-finite voxels");
+        return;
+    }
     PacketExtremumInputs in;
     in.voxels = v.values.raw();
     in.voxel_type = v.values.type();
@@ -25,8 +41,15 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
     in.step = ctx.step;
     in.maximum = maximum;
     in.macrocells = ctx.macrocells;  // skipping (PreparedVolume builds the grid for mip / minip)
+    if (fast) {
+        fast_copies_ = std::make_unique<FloatCopies>();
+        fast_voxels(v, *fast_copies_, &in.voxels, &in.voxel_type);
+        in.fast = true;
+    }
     packet_ = in;
 }
+
+ExtremumIntegrator::~ExtremumIntegrator() = default;
 
 void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
                                           int count) const {
@@ -37,12 +60,20 @@ void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Int
 }
 
 PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    if (packet_ && packet_->fast) {  // the fast profile has only its packet path
+        PixelValue out;
+        integrate_packet(&ray, &intervals, &out, 1);
+        return out;
+    }
     NoRecording rec;
     return integrate_impl(ray, intervals, rec);
 }
 
 PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                 SampleRecorder& recorder) const {
+    if (packet_ && packet_->fast)
+        throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
+                    "render.profile \"reference\"");
     Recording rec{recorder};
     return integrate_impl(ray, intervals, rec);
 }

@@ -3,6 +3,7 @@
 // Segments.h); the pixel is the classification's colour and opacity at that sample (the first of
 // equal extrema), premultiplied: (a c, a), unshaded. A ray with no interval is (0, 0, 0, 0).
 #pragma once
+#include <memory>
 #include <optional>
 
 #include "core/integrate/Integrator.h"
@@ -11,9 +12,12 @@
 
 namespace volref {
 
+struct FloatCopies;
+
 class ExtremumIntegrator final : public Integrator {
 public:
     ExtremumIntegrator(const IntegrationContext& ctx, bool maximum);
+    ~ExtremumIntegrator() override;
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                 SampleRecorder& recorder) const override;
@@ -27,6 +31,7 @@ private:
     PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
     std::optional<PacketExtremumInputs> packet_;
+    std::unique_ptr<FloatCopies> fast_copies_;  // the fast profile's float voxels, when needed
 };
 
 }  // namespace volref

@@ -28,6 +28,12 @@
 // front, tricubic or nearest, pre-classification, Levoy's classifiers, shells) takes the scalar
 // path. Each lane walks its segments with ForwardSegmentWalk (SegmentWalk.h), so empty-space
 // skipping passes over the same segments as in the scalar path.
+//
+// The fast profile (render.profile "fast", FastProfile.h) runs the same kernel on float lanes (twice
+// as many rays per vector): positions, reconstruction, transfer function, gradients and shading in
+// float, the tables and voxels as float copies where needed; compositing keeps the transmittance as
+// a float product, Tr *= 1 - alpha with alpha = -expm1((d / l) log1p(-a)), C += Tr alpha c, and stops
+// a ray once Tr <= fast_cutoff.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -41,6 +47,18 @@ namespace volref {
 
 class MacrocellGrid;
 
+// The kernel's tables in its lane type T (double: the classifier's own rows; float: copies).
+template <typename T>
+struct PacketTables {
+    const T* color_x = nullptr;  // color rows: x sorted, y = r, g, b per row
+    const T* color_y = nullptr;
+    const T* opacity_x = nullptr;  // opacity rows
+    const T* opacity_y = nullptr;
+    const T* gradient_opacity_x = nullptr;  // gradient-magnitude opacity rows [|grad f|, factor]
+    const T* gradient_opacity_y = nullptr;
+    const void* cached_gradient[3] = {nullptr, nullptr, nullptr};  // Cached: per-voxel components (T)
+};
+
 // Everything the kernel reads, as plain arrays.
 struct PacketCompositeInputs {
     const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
@@ -49,29 +67,30 @@ struct PacketCompositeInputs {
     double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
     bool normalized = false;  // transfer coordinate (v - lo) * inv_width, else v
     double lo = 0.0, inv_width = 1.0;
-    const double* color_x = nullptr;  // color rows: x sorted, y = r, g, b per row
-    const double* color_y = nullptr;
+    PacketTables<double> tables_double;  // the reference profile's
+    PacketTables<float> tables_float;    // the fast profile's
+    template <typename T>
+    const PacketTables<T>& tables() const {
+        if constexpr (sizeof(T) == sizeof(double)) return tables_double;
+        else return tables_float;
+    }
     int color_rows = 0;
-    const double* opacity_x = nullptr;  // opacity rows
-    const double* opacity_y = nullptr;
     int opacity_rows = 0;
     double unit_distance = 1.0;
     double step = 1.0;
     bool terminate = false;  // early termination at alpha > threshold
     double threshold = 1.0;
     const MacrocellGrid* macrocells = nullptr;  // empty-space skipping (SegmentWalk.h), or none
+    bool fast = false;         // the fast profile: float lanes (voxels: 32-bit-gathered types only)
+    double fast_cutoff = 0.0;  // fast: a ray stops once its transmittance is <= this
 
-    // Gradient-magnitude opacity rows [|grad f|, factor], or none (rows 0).
-    const double* gradient_opacity_x = nullptr;
-    const double* gradient_opacity_y = nullptr;
-    int gradient_opacity_rows = 0;
+    int gradient_opacity_rows = 0;  // gradient-magnitude opacity rows, or none (0)
 
     // Gradients, when shading or gradient opacity needs them (GradientField.h).
     enum class Gradient { None, Central, Forward, Cached };
     Gradient gradient = Gradient::None;
     double spacing[3] = {1, 1, 1};
     double domain_lo[3] = {0, 0, 0}, domain_hi[3] = {0, 0, 0};
-    const double* cached_gradient[3] = {nullptr, nullptr, nullptr};  // Cached: per-voxel components
 
     // Shading (Shader.h), when `shaded`.
     static constexpr int kMaxPacketLights = 8;

@@ -16,18 +16,24 @@ namespace HWY_NAMESPACE {
 namespace {
 using namespace packet;
 
+template <typename T>
 void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count) {
+    using D = hn::ScalableTag<T>;
+    using V = hn::Vec<D>;
+    using M = hn::Mask<D>;
     const D d;
+    constexpr std::size_t kLanes = RayPacketT<T>::kLanes;
     // Each lane's extremum so far for the walk's skipping (NaN before its first sample).
-    HWY_ALIGN double extremum[RayPacket::kLanes];
+    HWY_ALIGN double extremum[kLanes];
+    HWY_ALIGN T lane_best[kLanes];
     for (double& e : extremum) e = std::numeric_limits<double>::quiet_NaN();
-    RayPacket packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum);
-    const V nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinear trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
     const V zero = hn::Zero(d);
+    const V nan = hn::Set(d, std::numeric_limits<T>::quiet_NaN());
     V best = zero, t_best = zero, seen = zero;
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm);
@@ -38,23 +44,35 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
         const M take = hn::And(alive, hn::Or(hn::Eq(seen, zero), better));
         best = hn::IfThenElse(take, v, best);
         t_best = hn::IfThenElse(take, t, t_best);
-        seen = hn::IfThenElse(alive, hn::Set(d, 1.0), seen);
-        if (in.macrocells) hn::Store(hn::IfThenElse(hn::Gt(seen, zero), best, nan), d, extremum);
+        seen = hn::IfThenElse(alive, hn::Set(d, T(1)), seen);
+        if (in.macrocells) {
+            hn::Store(hn::IfThenElse(hn::Gt(seen, zero), best, nan), d, lane_best);
+            for (std::size_t l = 0; l < kLanes; ++l) extremum[l] = double(lane_best[l]);
+        }
     }
-    HWY_ALIGN double b[RayPacket::kLanes], tb[RayPacket::kLanes], s[RayPacket::kLanes];
+    HWY_ALIGN T b[kLanes], tb[kLanes], s[kLanes];
     hn::Store(best, d, b);
     hn::Store(t_best, d, tb);
     hn::Store(seen, d, s);
-    for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != 0.0, b[l], tb[l]};
+    for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != T(0), double(b[l]), double(tb[l])};
+}
+
+template <typename T>
+void extremum_all(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                  RayExtremum* out, int count) {
+    const int L = int(hn::Lanes(hn::ScalableTag<T>()));
+    for (int first = 0; first < count; first += L)
+        extremum_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first));
 }
 
 }  // namespace
 
 void ExtremumPacket(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count) {
-    const int L = int(hn::Lanes(D()));
-    for (int first = 0; first < count; first += L)
-        extremum_lanes(in, rays + first, intervals + first, out + first, std::min(L, count - first));
+    if (in.fast)
+        extremum_all<float>(in, rays, intervals, out, count);
+    else
+        extremum_all<double>(in, rays, intervals, out, count);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -25,6 +25,8 @@ struct PacketExtremumInputs {
     // Skipping (null: none): macrocells whose values cannot beat a ray's extremum so far are passed
     // over (SegmentWalk.h, extremum mode); the result is bitwise the same.
     const MacrocellGrid* macrocells = nullptr;
+    // The fast profile (FastProfile.h): float lanes; the voxels a 32-bit-gathered type.
+    bool fast = false;
 };
 
 struct RayExtremum {

@@ -1,6 +1,8 @@
 // Pieces shared by the SIMD packet kernels (PacketComposite.cpp, PacketExtremum.cpp), compiled once
 // per Highway target: the lane walk over intervals and segments (Segments.h placement) and the
 // trilinear reconstruction of a packet of points, term by term as VolumeSampler::trilinear.
+// Each is a template over the lane type T: double for the reference profile (the scalar path's
+// arithmetic), float for the fast profile (FastProfile.h: twice the lanes, float rounding).
 // Per-target include guard (Highway's pattern for -inl headers).
 #if defined(VOLREF_PACKET_KERNELS_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef VOLREF_PACKET_KERNELS_INL_H_
@@ -13,6 +15,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "core/camera/Ray.h"
@@ -25,36 +28,47 @@ namespace HWY_NAMESPACE {
 namespace packet {
 namespace hn = hwy::HWY_NAMESPACE;
 
+// The double lanes of the reference profile.
 using D = hn::ScalableTag<double>;
 using DI = hn::RebindToSigned<D>;
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
+// A vector of 32-bit values (float or int32, as many lanes as D) as D's lane type: exact for double
+// and for float from float; int32 -> float rounds above 2^24 (the fast profile only).
+template <class DT, class V32>
+HWY_INLINE hn::Vec<DT> to_lanes(DT d, V32 v) {
+    if constexpr (std::is_same_v<hn::TFromD<DT>, double>) return hn::PromoteTo(d, v);
+    else if constexpr (std::is_same_v<hn::TFromV<V32>, float>) return v;
+    else return hn::ConvertTo(d, v);
+}
+
 // The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
 // segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
-// never become active.
-struct RayPacket {
-    static constexpr std::size_t kLanes = HWY_LANES(double);
-    HWY_ALIGN double ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
-    HWY_ALIGN double tm[kLanes], len[kLanes], live[kLanes];
+// never become active. The walk is in double; the lanes hold its values rounded to T.
+template <typename T>
+struct RayPacketT {
+    static constexpr std::size_t kLanes = HWY_LANES(T);
+    HWY_ALIGN T ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
+    HWY_ALIGN T tm[kLanes], len[kLanes], live[kLanes];
     ForwardSegmentWalk walk[kLanes];
     bool active[kLanes];
     std::size_t lanes = 0;
 
     // `extremum` (mip / minip skipping, SegmentWalk.h's extremum mode): each lane's running extremum,
     // kLanes values the caller keeps up to date (NaN before a lane's first sample).
-    RayPacket(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
-              const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true) {
-        lanes = hn::Lanes(D());
+    RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
+               const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true) {
+        lanes = hn::Lanes(hn::ScalableTag<T>());
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
             const Ray& r = rays[real ? l : 0];
-            ox[l] = r.origin.x;
-            oy[l] = r.origin.y;
-            oz[l] = r.origin.z;
-            dx[l] = r.direction.x;
-            dy[l] = r.direction.y;
-            dz[l] = r.direction.z;
+            ox[l] = T(r.origin.x);
+            oy[l] = T(r.origin.y);
+            oz[l] = T(r.origin.z);
+            dx[l] = T(r.direction.x);
+            dy[l] = T(r.direction.y);
+            dz[l] = T(r.direction.z);
             active[l] = real;
             if (real)
                 walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum)
@@ -69,19 +83,20 @@ struct RayPacket {
             Segment s;
             if (active[l] && !walk[l].next(s)) active[l] = false;
             if (active[l]) {
-                tm[l] = s.midpoint();
-                len[l] = s.length();
-                live[l] = 1.0;
+                tm[l] = T(s.midpoint());
+                len[l] = T(s.length());
+                live[l] = T(1);
                 any = true;
             } else {
-                tm[l] = 0.0;
-                len[l] = 0.0;
-                live[l] = 0.0;
+                tm[l] = T(0);
+                len[l] = T(0);
+                live[l] = T(0);
             }
         }
         return any;
     }
 };
+using RayPacket = RayPacketT<double>;
 
 // Trilinear reconstruction of a regular grid for packets of world points (VolumeSampler::trilinear:
 // u = clamp((x - origin) inv_spacing, 0, n - 1), cell min(floor(u), n - 2), Levoy's sum in order).
@@ -94,10 +109,18 @@ struct RayPacket {
 //     buffer, so the bytes before the first sample are inside the allocation; little-endian hosts),
 //     shifted right by 16 or 24 bits (logical for unsigned, arithmetic for signed types);
 //   anything else (a volume of 2^31 samples or bytes or more, or a big-endian host): lane by lane.
-struct PacketTrilinear {
+// With float lanes (the fast profile) the position, weights and sum are float, the corner index is
+// computed in int32, and the storage must be one of the 32-bit-gathered kinds (f32, i32, u32, u16,
+// i16, u8, i8: FastProfile.h converts anything else to f32 first).
+template <typename T>
+struct PacketTrilinearT {
+    using D = hn::ScalableTag<T>;
+    using DI = hn::RebindToSigned<D>;
+    using V = hn::Vec<D>;
     using DI32 = hn::Rebind<std::int32_t, D>;
     using DU32 = hn::Rebind<std::uint32_t, D>;
     using DF32 = hn::Rebind<float, D>;
+    static constexpr bool kFloat = std::is_same_v<T, float>;
     enum class Kind { F64, F32, I32, U32, U16, I16, U8, I8, Lanes };
 
     const void* voxels;
@@ -107,27 +130,27 @@ struct PacketTrilinear {
     bool flat[3];
     V nx, nxy;
     hn::Vec<DI> offx, offy, offz;
-    hn::Vec<DI32> offx32, offy32, offz32;
+    hn::Vec<DI32> offx32, offy32, offz32, nx32, nxy32;
 
-    PacketTrilinear(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
-                    const double inv_spacing[3]) {
+    PacketTrilinearT(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
+                     const double inv_spacing[3]) {
         const D d;
         const DI di;
         const DI32 di32;
         voxels = data;
         type = data_type;
         for (int a = 0; a < 3; ++a) {
-            org[a] = hn::Set(d, origin[a]);
-            inv[a] = hn::Set(d, inv_spacing[a]);
-            maxi[a] = hn::Set(d, double(dims[a] - 1));
-            top[a] = hn::Set(d, double(dims[a] - 2));
+            org[a] = hn::Set(d, T(origin[a]));
+            inv[a] = hn::Set(d, T(inv_spacing[a]));
+            maxi[a] = hn::Set(d, T(dims[a] - 1));
+            top[a] = hn::Set(d, T(dims[a] - 2));
             flat[a] = dims[a] == 1;
         }
-        nx = hn::Set(d, double(dims[0]));
-        nxy = hn::Set(d, double(dims[0] * dims[1]));
+        nx = hn::Set(d, T(dims[0]));
+        nxy = hn::Set(d, T(dims[0] * dims[1]));
         offx = hn::Set(di, flat[0] ? 0 : 1);
-        offy = hn::Set(di, flat[1] ? 0 : dims[0]);
-        offz = hn::Set(di, flat[2] ? 0 : dims[0] * dims[1]);
+        offy = hn::Set(di, flat[1] ? 0 : hn::TFromD<DI>(dims[0]));
+        offz = hn::Set(di, flat[2] ? 0 : hn::TFromD<DI>(dims[0] * dims[1]));
         const std::uint64_t count = std::uint64_t(dims[0]) * std::uint64_t(dims[1]) * std::uint64_t(dims[2]);
         const bool fits32 = count * scalar_type_size(type) < (std::uint64_t(1) << 31) - 64;
         const std::int64_t unit = std::int64_t(scalar_type_size(type) < 4 ? scalar_type_size(type) : 1);
@@ -135,6 +158,8 @@ struct PacketTrilinear {
         offx32 = hn::Set(di32, std::int32_t(fits32 ? (flat[0] ? 0 : 1) * unit : 0));
         offy32 = hn::Set(di32, std::int32_t(fits32 ? (flat[1] ? 0 : dims[0]) * unit : 0));
         offz32 = hn::Set(di32, std::int32_t(fits32 ? (flat[2] ? 0 : dims[0] * dims[1]) * unit : 0));
+        nx32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] : 0));
+        nxy32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] * dims[1] : 0));
         constexpr bool little = std::endian::native == std::endian::little;
         switch (type) {
             case ScalarType::F64: kind = Kind::F64; break;
@@ -172,8 +197,8 @@ struct PacketTrilinear {
         const DU32 du32;
         const auto* base = reinterpret_cast<const std::int32_t*>(static_cast<const char*>(voxels) - (4 - (32 - kShift) / 8));
         const auto word = hn::GatherOffset(di32, base, byte_offset);
-        if constexpr (kSigned) return hn::PromoteTo(d, hn::ShiftRight<kShift>(word));
-        else return hn::PromoteTo(d, hn::BitCast(di32, hn::ShiftRight<kShift>(hn::BitCast(du32, word))));
+        if constexpr (kSigned) return to_lanes(d, hn::ShiftRight<kShift>(word));
+        else return to_lanes(d, hn::BitCast(di32, hn::ShiftRight<kShift>(hn::BitCast(du32, word))));
     }
 
     HWY_INLINE void corners(V cell0, V cell1, V cell2, V f[8]) const {
@@ -181,7 +206,12 @@ struct PacketTrilinear {
         const DI di;
         const DI32 di32;
         const DF32 df32;
-        if (kind == Kind::F64 || kind == Kind::Lanes) {
+        if constexpr (kFloat) {
+            if (kind == Kind::F64 || kind == Kind::Lanes) {  // excluded by FastProfile.h
+                for (int c = 0; c < 8; ++c) f[c] = hn::Zero(d);
+                return;
+            }
+        } else if (kind == Kind::F64 || kind == Kind::Lanes) {
             // i + nx j + nx ny k, exact in double.
             const auto idx = hn::Add(hn::ConvertTo(di, hn::Add(cell0, hn::Mul(nx, cell1))), hn::ConvertTo(di, hn::Mul(nxy, cell2)));
             if (kind == Kind::F64) {
@@ -192,26 +222,34 @@ struct PacketTrilinear {
             }
             return;
         }
-        // The same index, exact in double and < 2^31, as int32 (in bytes for the 1- and 2-byte types).
-        V index = hn::Add(hn::Add(cell0, hn::Mul(nx, cell1)), hn::Mul(nxy, cell2));
-        if (kind == Kind::U16 || kind == Kind::I16) index = hn::Add(index, index);
-        const auto idx = hn::DemoteTo(di32, index);
+        // The same index, exact in double and < 2^31, as int32 (in bytes for the 1- and 2-byte types);
+        // float lanes compute it in int32 (a float holds integers exactly only up to 2^24).
+        hn::Vec<DI32> idx;
+        if constexpr (kFloat) {
+            idx = hn::Add(hn::Add(hn::ConvertTo(di32, cell0), hn::Mul(nx32, hn::ConvertTo(di32, cell1))),
+                          hn::Mul(nxy32, hn::ConvertTo(di32, cell2)));
+            if (kind == Kind::U16 || kind == Kind::I16) idx = hn::Add(idx, idx);
+        } else {
+            V index = hn::Add(hn::Add(cell0, hn::Mul(nx, cell1)), hn::Mul(nxy, cell2));
+            if (kind == Kind::U16 || kind == Kind::I16) index = hn::Add(index, index);
+            idx = hn::DemoteTo(di32, index);
+        }
         switch (kind) {
             case Kind::F32: {
                 const auto* p = static_cast<const float*>(voxels);
-                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return hn::PromoteTo(d, hn::GatherIndex(df32, p, i)); }, f);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(df32, p, i)); }, f);
                 break;
             }
             case Kind::I32: {
                 const auto* p = static_cast<const std::int32_t*>(voxels);
-                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return hn::PromoteTo(d, hn::GatherIndex(di32, p, i)); }, f);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(di32, p, i)); }, f);
                 break;
             }
             case Kind::U32: {
                 const auto* p = static_cast<const std::int32_t*>(voxels);
-                const V two32 = hn::Set(d, 4294967296.0), zero = hn::Zero(d);
+                const V two32 = hn::Set(d, T(4294967296.0)), zero = hn::Zero(d);
                 eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR {
-                    const V s = hn::PromoteTo(d, hn::GatherIndex(di32, p, i));
+                    const V s = to_lanes(d, hn::GatherIndex(di32, p, i));
                     return hn::IfThenElse(hn::Lt(s, zero), hn::Add(s, two32), s);
                 }, f);
                 break;
@@ -224,25 +262,25 @@ struct PacketTrilinear {
         }
     }
 
-    // Lane by lane (64-bit indices), any storage type.
+    // Lane by lane (64-bit indices), any storage type (double lanes).
     HWY_INLINE V lanes(hn::Vec<DI> idx) const {
         const D d;
         const DI di;
-        HWY_ALIGN std::int64_t ix[RayPacket::kLanes];
-        HWY_ALIGN double out[RayPacket::kLanes];
+        HWY_ALIGN hn::TFromD<DI> ix[RayPacketT<T>::kLanes];
+        HWY_ALIGN T out[RayPacketT<T>::kLanes];
         hn::Store(idx, di, ix);
         const std::size_t n = hn::Lanes(d);
         dispatch_scalar_type(type, [&](auto tag) {
-            using T = decltype(tag);
-            const T* p = static_cast<const T*>(voxels);
-            for (std::size_t l = 0; l < n; ++l) out[l] = double(p[ix[l]]);
+            using S = decltype(tag);
+            const S* p = static_cast<const S*>(voxels);
+            for (std::size_t l = 0; l < n; ++l) out[l] = T(p[ix[l]]);
         });
         return hn::Load(d, out);
     }
 
     HWY_INLINE V operator()(V x, V y, V z) const {
         const D d;
-        const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+        const V zero = hn::Zero(d), one = hn::Set(d, T(1));
         const V X[3] = {x, y, z};
         V cell[3], frac[3];
         for (int a = 0; a < 3; ++a) {
@@ -271,6 +309,7 @@ struct PacketTrilinear {
         return v;
     }
 };
+using PacketTrilinear = PacketTrilinearT<double>;
 
 }  // namespace packet
 }  // namespace HWY_NAMESPACE

@@ -108,6 +108,7 @@ const Profile& profile(ProfileId id) {
         case ProfileId::GlslBasic: return glsl_basic;
         case ProfileId::Ospray: return ospray;
         case ProfileId::CudaCurvilinear: return cuda_curvilinear;
+        case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
     }
     throw Error("render.profile: unknown profile");
 }

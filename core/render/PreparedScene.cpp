@@ -11,7 +11,7 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
     if (scene.volumes.empty()) throw Error("volumes: expected at least one volume");
     const bool several = scene.volumes.size() > 1;
     if (several && scene.render.profile != ProfileId::Reference)
-        throw Error("render.profile: the mirror profiles render one volume (several volumes: use \"reference\")");
+        throw Error("render.profile: only \"reference\" renders several volumes (the mirror profiles and \"fast\" render one)");
     if (several && scene.render.integrator == IntegrationMethod::Adaptive && scene.render.projection == Projection::Composite)
         throw Error("render.integrator: \"adaptive\" does not mix several volumes in the composite projection yet "
                     "(use \"fixed\"; the other projections combine adaptive volumes)");

@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/grid/ProceduralField.h"
+#include "core/integrate/FastProfile.h"
 #include "core/integrate/ProfileIntegrator.h"
 #include "core/io/VolumeReader.h"
 #include "geometry/ClipPlanes.h"
@@ -56,7 +57,8 @@ bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, c
                                const VolumeSampler* sampler) {
     if (is_shell(vs.bounds) || !sampler || !options.simd) return false;
     if (render.projection != Projection::Mip && render.projection != Projection::Minip) return false;
-    if (render.integrator != IntegrationMethod::Fixed || render.profile != ProfileId::Reference) return false;
+    if (render.integrator != IntegrationMethod::Fixed) return false;
+    if (render.profile != ProfileId::Reference && render.profile != ProfileId::Fast) return false;
     return sampler->interpolation() == Interpolation::Trilinear && all_finite(sampler->volume().values);
 }
 
@@ -151,7 +153,14 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         throw Error(key + ".classify: pre-classification of a transformed volume cannot use |grad f| (it would be "
                           "measured in the volume's own space); use \"post\" or a classification without gradients");
     if (scene.render.profile != ProfileId::Reference && transform)
-        throw Error(key + ".transform: the mirror profiles render untransformed volumes only (use render.profile \"reference\")");
+        throw Error(key + ".transform: only render.profile \"reference\" renders transformed volumes");
+    if (scene.render.profile == ProfileId::Fast) {
+        // The fast profile's float packets (FastProfile.h); the integrators check the volume.
+        const Projection p = scene.render.projection;
+        if (p != Projection::Composite && p != Projection::Mip && p != Projection::Minip)
+            fast_profile_unavailable("this scene's projection is not one of them");
+        if (scene.render.integrator != IntegrationMethod::Fixed) fast_profile_unavailable("this scene asks for the adaptive integrator");
+    }
 
     // Only what the scene uses is built: gradients for shading or gradient-based classification,
     // the pre-classified volume for classify "pre", the shader for shading.
@@ -259,7 +268,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
-    integrator = scene.render.profile == ProfileId::Reference
+    integrator = scene.render.profile == ProfileId::Reference || scene.render.profile == ProfileId::Fast
                      ? make_integrator(*context)
                      : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume, &scene);
     // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed

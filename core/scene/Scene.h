@@ -166,8 +166,9 @@ enum class StepUnits { Voxel, World };
 // How a ray's integral is computed: `Fixed` steps of render.step (conventions section 4), or
 // `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
 enum class IntegrationMethod { Fixed, Adaptive };
-// render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu };
+// render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9);
+// Fast is volref's own float SIMD variant of the reference (core/integrate/FastProfile.h).
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast };
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {
     double density = 1.0;         // the lerp weight is col.a * density

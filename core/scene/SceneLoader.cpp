@@ -797,7 +797,8 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                      {"glsl-basic", ProfileId::GlslBasic},
                                      {"ospray", ProfileId::Ospray},
                                      {"cuda-curvilinear", ProfileId::CudaCurvilinear},
-                                     {"vtk-cpu", ProfileId::VtkCpu}});
+                                     {"vtk-cpu", ProfileId::VtkCpu},
+                                     {"fast", ProfileId::Fast}});
     if (const Json* o = r.find("profile_options")) {
         if (s.profile != ProfileId::CudaCurvilinear) r.fail("profile_options", "only the cuda-curvilinear profile has options");
         ObjectReader po(*o, r.path("profile_options"), ctx);

@@ -1,6 +1,7 @@
 #include "core/integrate/FastProfile.h"
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 
 #include "core/Conventions.h"
@@ -39,7 +40,12 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
         fast_profile_unavailable("the volume's " + std::to_string(n) + " voxels are too many for its 32-bit indices");
     check_memory(n * sizeof(float), "render.profile: the fast profile's float copy of the voxels");
     copies.voxels.resize(n);
-    for (std::size_t i = 0; i < n; ++i) copies.voxels[i] = float(volume.values[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+        copies.voxels[i] = float(volume.values[i]);
+        if (!std::isfinite(copies.voxels[i]))
+            fast_profile_unavailable("voxel " + std::to_string(i) + " (" + std::to_string(volume.values[i]) +
+                                     ") is beyond float's range");
+    }
     *data = copies.voxels.data();
     *type = ScalarType::F32;
 }

@@ -4,7 +4,7 @@
 Each seed is a small valid file of its format, laid out here byte by byte, so the fuzzers start from
 inputs that reach deep into each reader. Run from anywhere: /usr/bin/python3 scripts/make_fuzz_seeds.py
 """
-import base64, os, shutil, struct, zlib
+import base64, json, os, shutil, struct, zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CORPUS = os.path.join(ROOT, 'tests', 'fuzz', 'corpus')
@@ -24,6 +24,15 @@ os.makedirs(os.path.join(CORPUS, 'fuzz_scene'), exist_ok=True)
 for n in sorted(os.listdir(os.path.join(ROOT, 'reference_scenes'))):
     if n.endswith('.json'):
         shutil.copy(os.path.join(ROOT, 'reference_scenes', n), os.path.join(CORPUS, 'fuzz_scene', n))
+# The several-volumes scene with the keys it does not use: a crop preset, a row-major matrix transform,
+# the fast profile.
+with open(os.path.join(ROOT, 'reference_scenes', 'two-volumes-clipped.json')) as f:
+    scene = json.load(f)
+scene['volumes'][0]['crop'] = {'planes': [-10, 10, -12, 12, -8, 8], 'regions': 'inverted-cross'}
+scene['volumes'][1]['transform'] = [1, 0, 0, 6, 0, 2, 0, 4, 0, 0, 0.5, -4, 0, 0, 0, 1]
+scene['render']['profile'] = 'fast'
+with open(os.path.join(CORPUS, 'fuzz_scene', 'two-volumes-crop-matrix.json'), 'w') as f:
+    json.dump(scene, f, indent=1)
 
 # NRRD: raw little-endian float, big-endian short, ascii, gzip.
 hdr = 'NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nspacings: 1 2 3\nendian: little\nencoding: raw\n\n'

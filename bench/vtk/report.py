@@ -56,6 +56,11 @@ def fmt(x, digits=3):
     return "—" if x is None else f"{x:.{digits}g}" if abs(x) < 1000 else f"{x:.0f}"
 
 
+def fps(frame):
+    """Frames per second of a frame time in seconds (None when there is none)."""
+    return 1.0 / frame if frame and frame > 0 else None
+
+
 def fixed(x, decimals):
     return "—" if x is None else f"{x:.{decimals}f}"
 
@@ -264,9 +269,7 @@ def section(out, args):
         for t in threads:
             r = res[(c, t)]
             vf = r["volref_frame"]
-            v_fps = 1.0 / vf if vf and vf > 0 else None
-            f_fps = 1.0 / r["fixed_frame"] if r["fixed_frame"] else None
-            g_fps = 1.0 / r["gpu_frame"] if r["gpu_frame"] else None
+            v_fps, f_fps, g_fps = fps(vf), fps(r["fixed_frame"]), fps(r["gpu_frame"])
             rf = v_fps / f_fps if v_fps and f_fps else None
             rg = v_fps / g_fps if v_fps and g_fps else None
             if rf:
@@ -296,10 +299,8 @@ def section(out, args):
             for t in threads:
                 r = res[(c, t)]
                 ff = r["fast_frame"]
-                q_fps = 1.0 / ff if ff and ff > 0 else None
-                v_fps = 1.0 / r["volref_frame"] if r["volref_frame"] and r["volref_frame"] > 0 else None
-                f_fps = 1.0 / r["fixed_frame"] if r["fixed_frame"] else None
-                g_fps = 1.0 / r["gpu_frame"] if r["gpu_frame"] else None
+                q_fps, v_fps = fps(ff), fps(r["volref_frame"])
+                f_fps, g_fps = fps(r["fixed_frame"]), fps(r["gpu_frame"])
                 rv = q_fps / v_fps if q_fps and v_fps else None
                 rf = q_fps / f_fps if q_fps and f_fps else None
                 rg = q_fps / g_fps if q_fps and g_fps else None

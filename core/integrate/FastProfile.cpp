@@ -38,7 +38,8 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
     }
     if (std::uint64_t(n) * 4 >= kLimit)
         fast_profile_unavailable("the volume's " + std::to_string(n) + " voxels are too many for its 32-bit indices");
-    check_memory(n * sizeof(float), "render.profile: the fast profile's float copy of the voxels");
+    // Held: the volume itself; allocated: its float copy.
+    check_memory(volume.values.bytes() + n * sizeof(float), "render.profile: the fast profile's float copy of the voxels");
     copies.voxels.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         copies.voxels[i] = float(volume.values[i]);
@@ -70,7 +71,10 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
     }
     fast_voxels(volume, copies, &in.voxels, &in.voxel_type);
     if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
-        check_memory(3 * volume.values.size() * sizeof(float), "render.profile: the fast profile's float gradient cache");
+        // Held: the volume, its f64 gradient cache and any float voxels; allocated: the float cache.
+        check_memory(volume.values.bytes() + 3 * volume.values.size() * (sizeof(double) + sizeof(float)) +
+                         copies.voxels.size() * sizeof(float),
+                     "render.profile: the fast profile's float gradient cache");
         for (int a = 0; a < 3; ++a) {
             const VoxelArray& c = cached[a]->values;
             copies.cached_gradient[a].resize(c.size());

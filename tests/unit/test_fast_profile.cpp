@@ -15,6 +15,7 @@
 #include "TestScenes.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/explain/PixelTrace.h"
 #include "core/grid/ProceduralField.h"
 #include "core/io/NrrdWriter.h"
@@ -238,4 +239,24 @@ TEST(FastProfile, UnservedScenesAreErrors) {
     s.render.profile = ProfileId::Fast;
     const PreparedScene prepared(s, RenderOptions{});
     EXPECT_THROW(explain::trace_pixel(prepared, 10, 10), Error);
+}
+
+// The float copy of f64 voxels is checked against the memory limit with the volume it copies: a
+// 32^3 f64 field (256 KiB) renders under a 300 KiB limit with the reference, and the fast profile,
+// which would add 128 KiB of floats, is refused before allocating them.
+TEST(FastProfile, FloatCopyRespectsTheMemoryLimit) {
+    Scene s = field_scene(constant_field(0.5, {32, 32, 32}));
+    s.volume().transfer.opacity = {{0.0, 0.1}};
+    s.image.width = s.image.height = 4;
+    const std::size_t saved = memory_limit();
+    set_memory_limit(300 << 10);
+    std::string message;
+    EXPECT_NO_THROW(render_with(s, ProfileId::Reference));
+    try {
+        render_with(s, ProfileId::Fast);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    set_memory_limit(saved);
+    EXPECT_EQ(message.rfind("render.profile: the fast profile's float copy of the voxels: needs 384 KiB", 0), 0u) << message;
 }

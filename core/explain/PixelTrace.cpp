@@ -98,8 +98,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     if (x < 0 || x >= scene.scene.image.width || y < 0 || y >= scene.scene.image.height)
         throw Error("--pixel: (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
                     std::to_string(scene.scene.image.width) + " x " + std::to_string(scene.scene.image.height) + " image");
-    if (scene.volumes.size() > 1) throw Error("trace: a scene of several volumes is not traced yet (trace one volume at a time)");
-    const PreparedVolume& v = scene.volume();
+    const PreparedVolume& v = scene.traced_volume();
     PixelTrace t;
     t.x = x;
     t.y = y;

@@ -1,6 +1,6 @@
 #include "core/integrate/CompositeIntegrator.h"
 
-#include "core/Error.h"
+#include "core/integrate/FastProfile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -71,9 +71,7 @@ PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Inte
 
 PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                  SampleRecorder& recorder) const {
-    if (packet_ && packet_->fast)
-        throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
-                    "render.profile \"reference\"");
+    if (packet_ && packet_->fast) fast_profile_not_traced();
     Recording rec{recorder};
     return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
                                                             : back_to_front(ray, intervals, rec);

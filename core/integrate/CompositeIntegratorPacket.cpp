@@ -130,7 +130,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     in.macrocells = ctx.macrocells;
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();
-        make_fast(in, v, cached, 3, *fast_copies_);
+        make_fast(in, v, cached, *fast_copies_);
     }
     packet_ = in;
 }

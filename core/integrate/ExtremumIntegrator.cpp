@@ -1,6 +1,5 @@
 #include "core/integrate/ExtremumIntegrator.h"
 
-#include "core/Error.h"
 #include "core/integrate/FastProfile.h"
 #include "core/integrate/Segments.h"
 
@@ -71,9 +70,7 @@ PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Inter
 
 PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                 SampleRecorder& recorder) const {
-    if (packet_ && packet_->fast)
-        throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
-                    "render.profile \"reference\"");
+    if (packet_ && packet_->fast) fast_profile_not_traced();
     Recording rec{recorder};
     return integrate_impl(ray, intervals, rec);
 }

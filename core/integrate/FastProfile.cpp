@@ -25,6 +25,11 @@ std::vector<float> to_float(const double* p, std::size_t n) {
                 "grids classified by a transfer function; " + reason + " (use \"reference\")");
 }
 
+[[noreturn]] void fast_profile_not_traced() {
+    throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
+                "render.profile \"reference\"");
+}
+
 void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, ScalarType* type) {
     const ScalarType t = volume.values.type();
     const std::size_t n = volume.values.size();
@@ -51,11 +56,10 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
     *type = ScalarType::F32;
 }
 
-void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], int color_stride,
-               FloatCopies& copies) {
+void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies) {
     const PacketTables<double>& td = in.tables_double;
     copies.color_x = to_float(td.color_x, std::size_t(in.color_rows));
-    copies.color_y = to_float(td.color_y, std::size_t(in.color_rows) * std::size_t(color_stride));
+    copies.color_y = to_float(td.color_y, std::size_t(in.color_rows) * 3);  // r, g, b per row
     copies.opacity_x = to_float(td.opacity_x, std::size_t(in.opacity_rows));
     copies.opacity_y = to_float(td.opacity_y, std::size_t(in.opacity_rows));
     PacketTables<float>& tf = in.tables_float;

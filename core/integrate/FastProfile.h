@@ -36,11 +36,13 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
 
 // Fills in.tables_float (and the float voxels and cached gradients) from the double inputs; sets
 // in.fast and in.fast_cutoff. `cached` are the cached gradient components (Cached) or null.
-void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], int color_rows_stride,
-               FloatCopies& copies);
+void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies);
 
 // "render.profile: \"fast\" ...: <reason>; use \"reference\"" (the one-line error of a scene the
 // fast path does not take).
 [[noreturn]] void fast_profile_unavailable(const std::string& reason);
+
+// The error of `volref trace` / `explain ray` on the fast profile (its packets are its only path).
+[[noreturn]] void fast_profile_not_traced();
 
 }  // namespace volref

@@ -54,9 +54,12 @@ void PreparedScene::integrate(const Ray* rays, int count, PixelValue* out, bool 
             for (int i = 0; i < count; ++i) values[i] = v.integrator->integrate(scratch.rays[k][std::size_t(i)], scratch.intervals[k][std::size_t(i)]);
     }
     if (!multi) return;
-    std::vector<Ray> ray_list(n);
-    std::vector<std::vector<Interval>> interval_list(n);
-    std::vector<PixelValue> value_list(n);
+    std::vector<Ray>& ray_list = scratch.pixel_rays;
+    std::vector<std::vector<Interval>>& interval_list = scratch.pixel_intervals;
+    std::vector<PixelValue>& value_list = scratch.pixel_values;
+    ray_list.resize(n);
+    interval_list.resize(n);
+    value_list.resize(n);
     for (int i = 0; i < count; ++i) {
         for (std::size_t k = 0; k < n; ++k) {
             ray_list[k] = scratch.rays[k][std::size_t(i)];
@@ -84,10 +87,15 @@ PixelValue PreparedScene::render_pixel(int x, int y) const {
     return out;
 }
 
-PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) const {
+const PreparedVolume& PreparedScene::traced_volume() const {
     if (volumes.size() > 1) throw Error("trace: a scene of several volumes is not traced yet (trace one volume at a time)");
-    const Ray ray = volume().volume_ray(pixel_ray(x, y));
-    return integrator().integrate_traced(ray, intervals(pixel_ray(x, y)), recorder);
+    return volume();
+}
+
+PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) const {
+    const PreparedVolume& v = traced_volume();
+    const Ray ray = pixel_ray(x, y);
+    return v.integrator->integrate_traced(v.volume_ray(ray), intervals(ray), recorder);
 }
 
 }  // namespace volref

@@ -45,11 +45,18 @@ struct PreparedScene {
         std::vector<std::array<Ray, kMaxPacketRays>> rays;
         std::vector<std::array<std::vector<Interval>, kMaxPacketRays>> intervals;
         std::vector<std::array<PixelValue, kMaxPacketRays>> values;
+        // One pixel's rays, intervals and values across the volumes, for the mix (several volumes).
+        std::vector<Ray> pixel_rays;
+        std::vector<std::vector<Interval>> pixel_intervals;
+        std::vector<PixelValue> pixel_values;
     };
     // The pixels of `count` world rays (count <= kMaxPacketRays): every volume's intervals, then its
     // integrator (the SIMD packet path when `simd` and the volume allows it), then for several volumes
     // the mix. The result does not depend on `simd` beyond the packet path's documented rounding.
     void integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const;
+
+    // The one volume `volref trace` and `volref explain ray` follow; an Error for several volumes.
+    const PreparedVolume& traced_volume() const;
 
     // Pixel (x, y)'s ray (x right, y down from the top-left corner).
     Ray pixel_ray(int x, int y) const { return camera->pixel_ray(x, y); }

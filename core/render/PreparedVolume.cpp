@@ -52,14 +52,16 @@ bool skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const Clas
 }
 
 // mip / minip skip macrocells whose values cannot beat a ray's extremum so far: on the SIMD path of
-// the fixed step (ExtremumIntegrator's packets: Cartesian trilinear, finite voxels), reference profile.
+// the fixed step (ExtremumIntegrator's packets: Cartesian trilinear), reference or fast profile. A
+// volume with non-finite voxels gets the grid too but ExtremumIntegrator takes its scalar path and
+// never reads it (the rare case pays for a grid; the common one does not scan the voxels twice).
 bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const RenderOptions& options,
                                const VolumeSampler* sampler) {
     if (is_shell(vs.bounds) || !sampler || !options.simd) return false;
     if (render.projection != Projection::Mip && render.projection != Projection::Minip) return false;
     if (render.integrator != IntegrationMethod::Fixed) return false;
     if (render.profile != ProfileId::Reference && render.profile != ProfileId::Fast) return false;
-    return sampler->interpolation() == Interpolation::Trilinear && all_finite(sampler->volume().values);
+    return sampler->interpolation() == Interpolation::Trilinear;
 }
 
 // "volume" for a scene of one volume, "volumes[i]" otherwise (the key path in messages).
@@ -125,22 +127,13 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     // stretch of an axis).
     double voxel = model.voxel;
     if (transform) {
-        if (model.cartesian) {
-            voxel = std::numeric_limits<double>::infinity();
-            for (int a = 0; a < 3; ++a) {
-                glm::dvec3 e(0.0);
-                e[a] = volume.spacing[a];
-                voxel = std::min(voxel, transform->world_length(e));
-            }
-        } else {
-            double stretch = std::numeric_limits<double>::infinity();
-            for (int a = 0; a < 3; ++a) {
-                glm::dvec3 e(0.0);
-                e[a] = 1.0;
-                stretch = std::min(stretch, transform->world_length(e));
-            }
-            voxel *= stretch;
+        double shortest = std::numeric_limits<double>::infinity();  // min over axes of |A e_a s_a| (shells: s_a = 1)
+        for (int a = 0; a < 3; ++a) {
+            glm::dvec3 e(0.0);
+            e[a] = model.cartesian ? volume.spacing[a] : 1.0;
+            shortest = std::min(shortest, transform->world_length(e));
         }
+        voxel = model.cartesian ? shortest : voxel * shortest;
     }
     step = scene.render.step_units == StepUnits::World ? scene.render.step : scene.render.step * voxel;
 

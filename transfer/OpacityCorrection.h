@@ -8,19 +8,22 @@
 #pragma once
 #include <cmath>
 
+#include "core/Lanes.h"
+
 namespace volref {
+
+// optical_depth<L> and segment_alpha<L>, for every lane type.
+#include "transfer/OpacityCorrection-inl.h"
 
 inline double extinction(double a, double unit_distance) { return -std::log1p(-a) / unit_distance; }
 
 // The segment's optical depth sigma d = -(d / l) log1p(-a) (+inf for a = 1); alpha_d = -expm1(-sigma d).
-inline double optical_depth(double a, double d, double unit_distance) {
-    return -(d / unit_distance) * std::log1p(-a);
-}
+inline double optical_depth(double a, double d, double unit_distance) { return optical_depth<Scalar>(a, d, unit_distance); }
 
 inline double opacity_for_length(double a, double d, double unit_distance) {
     if (d <= 0.0) return 0.0;
     if (a >= 1.0) return 1.0;
-    return -std::expm1((d / unit_distance) * std::log1p(-a));
+    return segment_alpha<Scalar>(optical_depth(a, d, unit_distance));
 }
 
 }  // namespace volref

@@ -8,8 +8,10 @@
 #include "core/integrate/AdaptiveCellWalk.h"
 #include "core/integrate/AdaptiveQuadrature.h"
 #include "core/integrate/CompensatedSum.h"
+#include "geometry/ShellCoordinates.h"
+#include "core/integrate/march/Accumulators.h"
+#include "transfer/OpacityCorrection.h"
 #include "core/integrate/Segments.h"
-#include "core/render/PreparedScene.h"  // ShellField: the beam-space grid behind the pipeline's sampler
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/TransferFunction.h"
@@ -34,7 +36,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
     if (r.early_termination)
         throw Error("render.integrator: \"adaptive\" integrates the whole ray; it cannot be combined with render.early_termination");
     cartesian_ = ctx.pipeline.cartesian_sampler();
-    if (const auto* shell = dynamic_cast<const ShellField*>(&ctx.pipeline.sampler())) shell_grid_ = &shell->shell_sampler().grid();
+    shell_grid_ = ctx.pipeline.stages().shell_grid;
     if (cartesian_) {
         cut_cells_ = true;
         const Interpolation interp = cartesian_->interpolation();
@@ -44,7 +46,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
     // Rows of a post-classified transfer function (nearest: the value is constant between cuts).
     const bool nearest = cartesian_ && cartesian_->interpolation() == Interpolation::Nearest;
     if (!ctx.pipeline.preclassified() && !nearest)
-        if (const auto* tf = dynamic_cast<const TransferFunction*>(&ctx.pipeline.classifier())) {
+        if (const TransferFunction* tf = ctx.pipeline.stages().transfer_function) {
             rows_ = tf;
             for (double x : tf->color_function().xs()) row_values_.push_back(x);
             for (double x : tf->opacity_function().xs()) row_values_.push_back(x);
@@ -234,8 +236,8 @@ struct CompositeState {
     double tolerance;  // render.tolerance
     double safety;     // 1, or kAdaptiveWeakSafety where kinks inside pieces are not located
     double total;      // length of all intervals
-    CompensatedSum tau;
-    CompensatedSum C[3];
+    // The pieces composite front to back with compensated colour sums (march/Accumulators.h).
+    FrontToBack<Scalar, TransmittanceRule::OpticalDepthSum, true> acc;
     double colour_bound = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
     std::vector<LeafRecord> leaves;
 
@@ -248,7 +250,7 @@ struct CompositeState {
             c = glm::dvec3(0.0);
             return;
         }
-        sigma = -std::log1p(-a) / l;
+        sigma = extinction(a, l);
         c = p.color;
     }
 
@@ -298,7 +300,7 @@ struct CompositeState {
     // narrow feature between nodes, an unlocated kink).
     void process(double a, double b, int depth, const Rule& P) {
         const double m = 0.5 * (a + b);
-        const double T = std::exp(-tau.value());
+        const double T = acc.transmittance();
         if (!(m > a && m < b) || depth >= conventions::kAdaptiveMaxDepth) {
             commit(T, P.ek, P.tk, 0.0, safety * P.em_error(), safety * P.tau_error());
             return;
@@ -319,9 +321,8 @@ struct CompositeState {
     }
     void commit(double T, const glm::dvec3& E, double dtau0, double dtau1, double e_e, double e_t) {
         const glm::dvec3 contribution = T * E;
-        for (int ch = 0; ch < 3; ++ch) C[ch].add(contribution[ch]);
-        tau.add(dtau0);
-        tau.add(dtau1);
+        const double e[3] = {E.r, E.g, E.b};
+        acc.add_emission(e, dtau0, dtau1);
         leaves.push_back({contribution, T * e_e, e_t});
     }
     void integrate(double a, double b) { process(a, b, 0, evaluate(a, b)); }
@@ -332,7 +333,7 @@ struct CompositeState {
 PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals) const {
     PixelValue out;
     CompositeState st{&ctx_.pipeline, &ray, ctx_.pipeline.classifier().unit_distance(), ctx_.render.tolerance,
-                      weak_ ? conventions::kAdaptiveWeakSafety : 1.0, 0.0, {}, {}, 1.0, {}};
+                      weak_ ? conventions::kAdaptiveWeakSafety : 1.0, 0.0, {}, 1.0, {}};
     for (const Interval& iv : intervals) st.total += iv.length();
     if (!(st.total > 0.0)) return out;
     bool opaque = false;
@@ -351,8 +352,9 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
             if (pm.opacity >= 1.0 && std::isfinite(pm.value)) {  // opaque piece: the ray ends at a
                 const PipelineSample ps = ctx_.pipeline.sample(ray, a + conventions::kAdaptiveOpaqueColourOffset * (b - a),
                                                                SamplePipeline::Use::Composite);
-                opaque_colour = std::exp(-st.tau.value()) * ps.color;
-                for (int ch = 0; ch < 3; ++ch) st.C[ch].add(opaque_colour[ch]);
+                opaque_colour = st.acc.transmittance() * ps.color;
+                const double c[3] = {ps.color.r, ps.color.g, ps.color.b};
+                st.acc.add_opaque(c);
                 opaque = true;
                 break;
             }
@@ -360,8 +362,8 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
         }
         if (opaque) break;
     }
-    const double T_end = opaque ? 0.0 : std::exp(-st.tau.value());
-    out.rgba = glm::dvec4(st.C[0].value(), st.C[1].value(), st.C[2].value(), opaque ? 1.0 : -std::expm1(-st.tau.value()));
+    const double T_end = opaque ? 0.0 : st.acc.transmittance();
+    out.rgba = glm::dvec4(st.acc.color(0), st.acc.color(1), st.acc.color(2), st.acc.alpha());
     // Posterior error: leaf i's tau error scales everything emitted behind it.
     glm::dvec3 behind = opaque_colour;
     double colour_err = 0.0, tau_err = 0.0;
@@ -464,17 +466,9 @@ PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<I
 
 PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals) const {
     const bool maximum = ctx_.render.projection == Projection::Mip;
-    bool any = false;
-    double best = 0.0, t_best = 0.0;
-    auto consider = [&](double t) {
-        const double v = ctx_.field(ray, t);
-        if (!std::isfinite(v)) return;  // non-finite values are ignored
-        if (!any || (maximum ? v > best : v < best)) {
-            best = v;
-            t_best = t;
-        }
-        any = true;
-    };
+    // The extremum over the candidates (march/Accumulators.h; non-finite values are ignored).
+    Extremum<Scalar> acc(maximum);
+    auto consider = [&](double t) { acc.add(true, ctx_.field(ray, t), t); };
     const Volume& v = cartesian_->volume();
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
@@ -493,8 +487,8 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
         }
     }
     PixelValue out;
-    if (any) {
-        const PipelineSample p = ctx_.pipeline.sample(ray, t_best, SamplePipeline::Use::Unshaded);
+    if (acc.any()) {
+        const PipelineSample p = ctx_.pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
         out.rgba = glm::dvec4(p.opacity * p.color, p.opacity);
     }
     out.error = rounding_bound(out.rgba);

@@ -1,18 +1,15 @@
 // CompensatedSum: Neumaier's variant of Kahan summation. The running error of each addition is kept
 // in `c`, so a sum of a million terms of 1e-9 keeps (nearly) full double precision.
-//   t = s + x;  c += (|s| >= |x|) ? (s - t) + x : (x - t) + s;  s = t;  value = s + c.
+//   t = s + x;  c += (|s| >= |x|) ? (s - t) + x : (x - t) + s;  s = t;  value = s + c
+// (compensated_add, march/Accumulators.h, the one copy of the formula).
 #pragma once
-#include <cmath>
+#include "core/integrate/march/Accumulators.h"
 
 namespace volref {
 
 class CompensatedSum {
 public:
-    void add(double x) {
-        const double t = s_ + x;
-        c_ += std::fabs(s_) >= std::fabs(x) ? (s_ - t) + x : (x - t) + s_;
-        s_ = t;
-    }
+    void add(double x) { compensated_add<Scalar>(s_, c_, x, true); }
     double value() const { return s_ + c_; }
 
 private:

@@ -7,9 +7,8 @@
 #include <limits>
 #include <type_traits>
 
-#include "core/integrate/CompensatedSum.h"
 #include "core/integrate/SegmentWalk.h"
-#include "transfer/OpacityCorrection.h"
+#include "core/integrate/march/Accumulators.h"
 
 namespace volref {
 
@@ -77,16 +76,22 @@ PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vect
                                                             : back_to_front(ray, intervals, rec);
 }
 
+// The termination the scene asks for (render.early_termination: A > threshold).
+Termination CompositeIntegrator::termination() const {
+    Termination t;
+    t.test_alpha_above = ctx_.render.early_termination.has_value();
+    t.alpha_above = ctx_.render.early_termination.value_or(1.0);
+    return t;
+}
+
 // With Rec::kOn the loops below also fill one SampleRecord per visited segment; every statement of
-// the plain loop is unchanged (the records only read its state).
+// the plain loop is unchanged (the records only read its state). The compositing is the
+// accumulators' (march/Accumulators.h).
 template <class Rec>
 PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    const bool terminate = ctx_.render.early_termination.has_value();
-    const double threshold = terminate ? *ctx_.render.early_termination : 0.0;
-    CompensatedSum tau;
-    glm::dvec3 C(0.0);
-    bool opaque = false;
+    const Termination stop = termination();
+    FrontToBack<Scalar> acc;
     ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step);
     Segment s;
     while (walk.next(s)) {
@@ -96,60 +101,40 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
             rec.begin(r, s.t0, s.t1);
             p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
             r.composited = true;
+            r.transmittance_before = acc.transmittance();
         } else {
             p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
         }
-        const double a = p.opacity;
-        if (a <= 0.0) {
+        if (!(p.opacity > 0.0)) {
             if constexpr (Rec::kOn) {  // nothing changes
-                r.transmittance_before = r.transmittance_after = std::exp(-tau.value());
-                r.accumulated = glm::dvec4(C, -std::expm1(-tau.value()));
+                r.transmittance_after = acc.transmittance();
+                r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.partial_alpha());
                 rec.recorder.record(r);
             }
             continue;
         }
-        const double T = std::exp(-tau.value());
-        if (a >= 1.0) {  // opaque: alpha = 1, nothing behind is visible
-            C += T * p.color;
-            opaque = true;
-            if constexpr (Rec::kOn) {
-                r.tau = std::numeric_limits<double>::infinity();
-                r.alpha = 1.0;
-                r.transmittance_before = T;
-                r.transmittance_after = 0.0;
-                r.accumulated = glm::dvec4(C, 1.0);
-                rec.recorder.record(r);
-            }
-            break;
-        }
-        const double tau_k = optical_depth(a, s.length(), l);
-        const double alpha = -std::expm1(-tau_k);
-        C += (T * alpha) * p.color;
-        tau.add(tau_k);
+        const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
+        const double c[3] = {p.color.r, p.color.g, p.color.b};
+        acc.add(true, o.solid, o.tau, o.alpha, c);
         if constexpr (Rec::kOn) {
-            r.tau = tau_k;
-            r.alpha = alpha;
-            r.transmittance_before = T;
-            r.transmittance_after = std::exp(-tau.value());
-            r.accumulated = glm::dvec4(C, -std::expm1(-tau.value()));
+            r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
+            r.alpha = o.alpha;
+            r.transmittance_after = o.solid ? 0.0 : acc.transmittance();
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        if (terminate && -std::expm1(-tau.value()) > threshold) break;
+        if (o.solid || acc.stops(o.partial, stop)) break;  // opaque: nothing behind is visible
     }
     PixelValue out;
-    out.rgba = glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value()));
+    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
     return out;
 }
 
 template <class Rec>
 PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    CompensatedSum tau;
-    glm::dvec3 C(0.0);
-    bool opaque = false;
-    // The transmittance of what is composited so far (0 once a sample was opaque); records only.
-    [[maybe_unused]] auto transmittance = [&] { return opaque ? 0.0 : std::exp(-tau.value()); };
-    [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value())); };
+    BackToFront<Scalar> acc;
+    [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
     for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, [&](const Segment& s) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         PipelineSample p;
@@ -157,46 +142,28 @@ PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<
             rec.begin(r, s.t0, s.t1);
             p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
             r.composited = true;
-            r.transmittance_before = transmittance();
+            r.transmittance_before = acc.transmittance();
         } else {
             p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
         }
-        const double a = p.opacity;
-        if (a <= 0.0) {
+        if (p.opacity > 0.0) {
+            const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
+            const double c[3] = {p.color.r, p.color.g, p.color.b};
+            acc.add(true, o.solid, o.tau, o.alpha, c);
             if constexpr (Rec::kOn) {
-                r.transmittance_after = transmittance();
-                r.accumulated = accumulated();
-                rec.recorder.record(r);
+                r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
+                r.alpha = o.alpha;
             }
-            return true;
         }
-        if (a >= 1.0) {
-            C = p.color;
-            opaque = true;
-            if constexpr (Rec::kOn) {
-                r.tau = std::numeric_limits<double>::infinity();
-                r.alpha = 1.0;
-                r.transmittance_after = 0.0;
-                r.accumulated = accumulated();
-                rec.recorder.record(r);
-            }
-            return true;
-        }
-        const double tau_k = optical_depth(a, s.length(), l);
-        const double alpha = -std::expm1(-tau_k);
-        C = alpha * p.color + (1.0 - alpha) * C;
-        tau.add(tau_k);
         if constexpr (Rec::kOn) {
-            r.tau = tau_k;
-            r.alpha = alpha;
-            r.transmittance_after = transmittance();
+            r.transmittance_after = acc.transmittance();
             r.accumulated = accumulated();
             rec.recorder.record(r);
         }
         return true;
     });
     PixelValue out;
-    out.rgba = glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value()));
+    out.rgba = accumulated();
     return out;
 }
 

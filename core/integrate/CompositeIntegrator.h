@@ -26,6 +26,7 @@
 #include "core/integrate/Integrator.h"
 #include "core/integrate/PacketComposite.h"
 #include "core/integrate/SampleRecorder.h"
+#include "core/integrate/march/Accumulators.h"
 
 namespace volref {
 
@@ -46,6 +47,7 @@ public:
 
 private:
     // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h.
+    Termination termination() const;
     template <class Rec>
     PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>

@@ -20,7 +20,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     auto unavailable = [&](const char* reason) {
         if (fast) fast_profile_unavailable(reason);
     };
-    const auto* tf = dynamic_cast<const TransferFunction*>(&p.classifier());
+    const TransferFunction* tf = p.stages().transfer_function;
     const VolumeSampler* sampler = p.cartesian_sampler();
     if (!tf) {
         unavailable("this volume is classified otherwise");
@@ -51,7 +51,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     PacketCompositeInputs in;
     const Volume* cached[3] = {nullptr, nullptr, nullptr};
     if (tf->needs_gradient() || p.shaded()) {
-        const auto* field = dynamic_cast<const GradientField*>(p.gradient_source());
+        const GradientField* field = p.stages().grid_gradient;
         if (!field) {
             unavailable("this volume's gradient is not a grid's");
             return;
@@ -125,8 +125,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     in.opacity_rows = int(tf->opacity_function().xs().size());
     in.unit_distance = tf->unit_distance();
     in.step = ctx.step;
-    in.terminate = ctx.render.early_termination.has_value();
-    in.threshold = ctx.render.early_termination.value_or(1.0);
+    in.termination = termination();
     in.macrocells = ctx.macrocells;
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();

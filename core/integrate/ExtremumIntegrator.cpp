@@ -2,6 +2,7 @@
 
 #include "core/integrate/FastProfile.h"
 #include "core/integrate/Segments.h"
+#include "core/integrate/march/Accumulators.h"
 
 #include <algorithm>
 #include <cmath>
@@ -80,8 +81,7 @@ PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vecto
 // call at the same point).
 template <class Rec>
 PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
-    bool any = false;
-    double best = 0.0, t_best = 0.0;
+    Extremum<Scalar> acc(maximum_);
     [[maybe_unused]] glm::dvec4 so_far(0.0);
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
@@ -92,20 +92,16 @@ PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<
         } else {
             v = ctx_.field(ray, s.midpoint());
         }
-        if (std::isfinite(v) && (!any || (maximum_ ? v > best : v < best))) {  // non-finite values are ignored
-            best = v;
-            t_best = s.midpoint();
-            if constexpr (Rec::kOn) so_far = pixel(ray, true, t_best).rgba;
-        }
-        any = any || std::isfinite(v);
+        [[maybe_unused]] const bool taken = acc.add(true, v, s.midpoint());
         if constexpr (Rec::kOn) {
-            r.running = best;
+            if (taken) so_far = pixel(ray, true, acc.where()).rgba;
+            r.running = acc.value();
             r.accumulated = so_far;
             rec.recorder.record(r);
         }
         return true;
     });
-    return pixel(ray, any, t_best);
+    return pixel(ray, acc.any(), acc.where());
 }
 
 PixelValue ExtremumIntegrator::pixel(const Ray& ray, bool any, double t_best) const {

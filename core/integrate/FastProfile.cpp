@@ -87,7 +87,8 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
         }
     }
     in.fast = true;
-    in.fast_cutoff = conventions::kFastTransmittanceCutoff;
+    in.termination.test_transmittance = true;
+    in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;
 }
 
 }  // namespace volref

@@ -35,7 +35,7 @@ struct FloatCopies {
 void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, ScalarType* type);
 
 // Fills in.tables_float (and the float voxels and cached gradients) from the double inputs; sets
-// in.fast and in.fast_cutoff. `cached` are the cached gradient components (Cached) or null.
+// in.fast and the transmittance cutoff of in.termination. `cached` are the cached gradient components (Cached) or null.
 void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies);
 
 // "render.profile: \"fast\" ...: <reason>; use \"reference\"" (the one-line error of a scene the

@@ -4,6 +4,7 @@
 
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/Segments.h"
+#include "core/integrate/march/Accumulators.h"
 
 namespace volref {
 
@@ -24,25 +25,25 @@ template <class Rec>
 PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     PixelValue out;
     if (intervals.empty()) return out;
-    CompensatedSum integral, length;
+    LineIntegral<CompensatedSum> acc;
+    auto result = [&] { return mean_ ? acc.mean() : ctx_.render.gain * acc.integral(); };
     for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
         const double v = ctx_.field(ray, s.midpoint());
         const double coordinate = ctx_.pipeline.classifier().coordinate(v);
-        integral.add(std::isfinite(coordinate) ? coordinate * s.length() : 0.0);  // non-finite: 0 (docs/accuracy.md)
-        length.add(s.length());
+        acc.add(std::isfinite(coordinate) ? coordinate * s.length() : 0.0, s.length());  // non-finite: 0 (docs/accuracy.md)
         if constexpr (Rec::kOn) {
             SampleRecord r;
             rec.begin(r, s.t0, s.t1);
             r.sample.position = ray.at(s.midpoint());
             r.sample.value = v;
             r.coordinate = coordinate;
-            r.running = mean_ ? integral.value() / length.value() : ctx_.render.gain * integral.value();
+            r.running = result();
             r.accumulated = glm::dvec4(r.running, r.running, r.running, 1.0);
             rec.recorder.record(r);
         }
         return true;
     });
-    const double g = mean_ ? integral.value() / length.value() : ctx_.render.gain * integral.value();
+    const double g = result();
     out.rgba = glm::dvec4(g, g, g, 1.0);
     return out;
 }

@@ -7,7 +7,7 @@
 #include "core/integrate/CompensatedSum.h"
 #include "core/integrate/SamplePipeline.h"
 #include "core/integrate/Segments.h"
-#include "transfer/OpacityCorrection.h"
+#include "core/integrate/march/Accumulators.h"
 
 namespace volref {
 
@@ -101,50 +101,41 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         return m;
     };
 
-    CompensatedSum tau;
-    glm::dvec3 C(0.0);
-    bool opaque = false;
+    // The mixed segments composite as one medium's (march/Accumulators.h): opaque, or optical depth
+    // m.tau with alpha = -expm1(-m.tau).
+    auto add = [](auto& acc, const Mixed& m) {
+        const double c[3] = {m.color.r, m.color.g, m.color.b};
+        acc.add(true, m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), c);
+    };
+    PixelValue out;
     if (render_.order == CompositeOrder::FrontToBack) {
-        const bool terminate = render_.early_termination.has_value();
-        const double threshold = terminate ? *render_.early_termination : 0.0;
+        Termination stop;
+        stop.test_alpha_above = render_.early_termination.has_value();
+        stop.alpha_above = render_.early_termination.value_or(1.0);
+        FrontToBack<Scalar> acc;
         bool done = false;
         for (const Piece& p : ps) {
             const std::int64_t n = segment_count(p.span, step_);
             for (std::int64_t k = 0; k < n && !done; ++k) {
                 const Mixed m = mix(p.present, segment(p.span, step_, k, n));
-                if (m.opaque) {
-                    C += std::exp(-tau.value()) * m.color;
-                    opaque = done = true;
-                    break;
-                }
-                if (!(m.tau > 0.0)) continue;
-                const double T = std::exp(-tau.value());
-                const double alpha = -std::expm1(-m.tau);
-                C += (T * alpha) * m.color;
-                tau.add(m.tau);
-                if (terminate && -std::expm1(-tau.value()) > threshold) done = true;
+                if (!m.opaque && !(m.tau > 0.0)) continue;
+                add(acc, m);
+                done = m.opaque || acc.stops(true, stop);
             }
             if (done) break;
         }
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
     } else {
+        BackToFront<Scalar> acc;
         for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
             const std::int64_t n = segment_count(it->span, step_);
             for (std::int64_t k = n - 1; k >= 0; --k) {
                 const Mixed m = mix(it->present, segment(it->span, step_, k, n));
-                if (m.opaque) {
-                    C = m.color;
-                    opaque = true;
-                    continue;
-                }
-                if (!(m.tau > 0.0)) continue;
-                const double alpha = -std::expm1(-m.tau);
-                C = alpha * m.color + (1.0 - alpha) * C;
-                tau.add(m.tau);
+                if (m.opaque || m.tau > 0.0) add(acc, m);
             }
         }
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
     }
-    PixelValue out;
-    out.rgba = glm::dvec4(C, opaque ? 1.0 : -std::expm1(-tau.value()));
     return out;
 }
 

@@ -191,12 +191,12 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
 
     const V zero = hn::Zero(d), one = hn::Set(d, T(1));
-    // Reference: C and the Neumaier sum (tau_s, tau_c) of the optical depth. Fast: C and the
-    // transmittance Tr, a product of (1 - alpha) in float.
-    V Cr = zero, Cg = zero, Cb = zero, tau_s = zero, tau_c = zero, opaque = zero, Tr = one;
+    // The reference composites with the compensated optical depth, the fast profile with a
+    // transmittance product in float (march/Accumulators.h).
+    using SL = SimdLanes<T>;
+    constexpr TransmittanceRule kRule = kFast ? TransmittanceRule::Product : TransmittanceRule::OpticalDepthSum;
+    FrontToBack<SL, kRule> acc;
     const V l_unit = hn::Set(d, T(in.unit_distance));
-    const V threshold = hn::Set(d, T(in.threshold));
-    const V cutoff = hn::Set(d, T(in.fast_cutoff));
 
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
@@ -218,8 +218,8 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen);
             a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
         }
-        const M visible = hn::And(alive, hn::Gt(a, zero));
-        if (!hn::AllFalse(d, visible)) {
+        const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
+        if (!hn::AllFalse(d, o.visible)) {
             const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x);
             V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x),
                       table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x),
@@ -228,51 +228,15 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 if (!have_gradient) gradient(P, v, g);
                 shade<T>(in, m, g, view, t);
             }
-            const V cr = m[0], cg = m[1], cb = m[2];
-            const M solid = hn::And(visible, hn::Ge(a, one));
-            const M partial = hn::AndNot(solid, visible);
-            M stop = solid;
-            if constexpr (kFast) {
-                // alpha = -expm1((d / l) log1p(-a)) (opaque: 1); C += Tr alpha c; Tr *= 1 - alpha.
-                const V log_keep = hn::Log1p(d, hn::Neg(hn::IfThenElseZero(partial, a)));
-                const V alpha = hn::IfThenElse(solid, one, hn::Neg(hn::Expm1(d, hn::Mul(hn::Div(seg, l_unit), log_keep))));
-                const V w = hn::IfThenElseZero(visible, hn::Mul(Tr, alpha));
-                Cr = hn::Add(Cr, hn::Mul(w, cr));
-                Cg = hn::Add(Cg, hn::Mul(w, cg));
-                Cb = hn::Add(Cb, hn::Mul(w, cb));
-                Tr = hn::IfThenElse(visible, hn::Mul(Tr, hn::Sub(one, alpha)), Tr);
-                opaque = hn::IfThenElse(solid, one, opaque);
-                stop = hn::Or(stop, hn::And(partial, hn::Le(Tr, cutoff)));
-                if (in.terminate) stop = hn::Or(stop, hn::And(partial, hn::Gt(hn::Sub(one, Tr), threshold)));
-            } else {
-                const V T_ = hn::Exp(d, hn::Neg(hn::Add(tau_s, tau_c)));
-                // Partial: tau_k = -(d / l) log1p(-a), alpha = -expm1(-tau_k); opaque: alpha = 1.
-                const V tau_k = hn::Mul(hn::Neg(hn::Div(seg, l_unit)), hn::Log1p(d, hn::Neg(hn::IfThenElseZero(partial, a))));
-                const V alpha = hn::IfThenElse(solid, one, hn::Neg(hn::Expm1(d, hn::Neg(tau_k))));
-                const V w = hn::IfThenElseZero(visible, hn::Mul(T_, alpha));
-                Cr = hn::Add(Cr, hn::IfThenElseZero(visible, hn::Mul(w, cr)));
-                Cg = hn::Add(Cg, hn::IfThenElseZero(visible, hn::Mul(w, cg)));
-                Cb = hn::Add(Cb, hn::IfThenElseZero(visible, hn::Mul(w, cb)));
-                // Neumaier: t = s + x; c += |s| >= |x| ? (s - t) + x : (x - t) + s; s = t.
-                const V sum = hn::Add(tau_s, tau_k);
-                const V comp = hn::IfThenElse(hn::Ge(hn::Abs(tau_s), hn::Abs(tau_k)), hn::Add(hn::Sub(tau_s, sum), tau_k),
-                                              hn::Add(hn::Sub(tau_k, sum), tau_s));
-                tau_c = hn::IfThenElse(partial, hn::Add(tau_c, comp), tau_c);
-                tau_s = hn::IfThenElse(partial, sum, tau_s);
-                opaque = hn::IfThenElse(solid, one, opaque);
-                if (in.terminate)
-                    stop = hn::Or(stop, hn::And(partial, hn::Gt(hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))), threshold)));
-            }
+            acc.add(o.visible, o.solid, o.tau, o.alpha, m);
+            const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));
             hn::Store(hn::IfThenElseZero(stop, one), d, buf);
             for (std::size_t l = 0; l < L; ++l)
                 if (buf[l] != T(0)) packet.active[l] = false;
         }
     }
-    V A;
-    if constexpr (kFast)
-        A = hn::IfThenElse(hn::Gt(opaque, zero), one, hn::Sub(one, Tr));
-    else
-        A = hn::IfThenElse(hn::Gt(opaque, zero), one, hn::Neg(hn::Expm1(d, hn::Neg(hn::Add(tau_s, tau_c)))));
+    const V A = acc.alpha();
+    const V Cr = acc.color(0), Cg = acc.color(1), Cb = acc.color(2);
     HWY_ALIGN T r_[RayPacketT<T>::kLanes], g_[RayPacketT<T>::kLanes], b_[RayPacketT<T>::kLanes], a_[RayPacketT<T>::kLanes];
     hn::Store(Cr, d, r_);
     hn::Store(Cg, d, g_);

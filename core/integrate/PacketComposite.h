@@ -33,7 +33,7 @@
 // as many rays per vector): positions, reconstruction, transfer function, gradients and shading in
 // float, the tables and voxels as float copies where needed; compositing keeps the transmittance as
 // a float product, Tr *= 1 - alpha with alpha = -expm1((d / l) log1p(-a)), C += Tr alpha c, and stops
-// a ray once Tr <= fast_cutoff.
+// a ray once Tr <= kFastTransmittanceCutoff (termination.transmittance_at_most).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -41,6 +41,7 @@
 #include "core/camera/Ray.h"
 #include "core/grid/VoxelArray.h"
 #include "core/integrate/Integrator.h"
+#include "core/integrate/march/Accumulators.h"
 #include "geometry/RayIntervals.h"
 
 namespace volref {
@@ -78,11 +79,9 @@ struct PacketCompositeInputs {
     int opacity_rows = 0;
     double unit_distance = 1.0;
     double step = 1.0;
-    bool terminate = false;  // early termination at alpha > threshold
-    double threshold = 1.0;
+    Termination termination;  // early termination (and the fast profile's cutoff: march/Accumulators.h)
     const MacrocellGrid* macrocells = nullptr;  // empty-space skipping (SegmentWalk.h), or none
     bool fast = false;         // the fast profile: float lanes (voxels: 32-bit-gathered types only)
-    double fast_cutoff = 0.0;  // fast: a ray stops once its transmittance is <= this
 
     int gradient_opacity_rows = 0;  // gradient-magnitude opacity rows, or none (0)
 

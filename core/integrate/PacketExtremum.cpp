@@ -32,28 +32,22 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
     const PacketTrilinearT<T> trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
-    const V zero = hn::Zero(d);
     const V nan = hn::Set(d, std::numeric_limits<T>::quiet_NaN());
-    V best = zero, t_best = zero, seen = zero;
+    Extremum<SimdLanes<T>> acc(in.maximum);
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm);
-        const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+        const M alive = hn::Gt(hn::Load(d, packet.live), hn::Zero(d));
         const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
-        // Scalar: if (!any || (maximum ? v > best : v < best)) take v.
-        const M better = in.maximum ? hn::Gt(v, best) : hn::Lt(v, best);
-        const M take = hn::And(alive, hn::Or(hn::Eq(seen, zero), better));
-        best = hn::IfThenElse(take, v, best);
-        t_best = hn::IfThenElse(take, t, t_best);
-        seen = hn::IfThenElse(alive, hn::Set(d, T(1)), seen);
+        acc.add(alive, v, t);
         if (in.macrocells) {
-            hn::Store(hn::IfThenElse(hn::Gt(seen, zero), best, nan), d, lane_best);
+            hn::Store(hn::IfThenElse(acc.any(), acc.value(), nan), d, lane_best);
             for (std::size_t l = 0; l < kLanes; ++l) extremum[l] = double(lane_best[l]);
         }
     }
     HWY_ALIGN T b[kLanes], tb[kLanes], s[kLanes];
-    hn::Store(best, d, b);
-    hn::Store(t_best, d, tb);
-    hn::Store(seen, d, s);
+    hn::Store(acc.value(), d, b);
+    hn::Store(acc.where(), d, tb);
+    hn::Store(hn::IfThenElseZero(acc.any(), hn::Set(d, T(1))), d, s);
     for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != T(0), double(b[l]), double(tb[l])};
 }
 

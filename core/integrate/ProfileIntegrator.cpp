@@ -12,6 +12,7 @@
 
 #include "core/Error.h"
 #include "core/integrate/Segments.h"
+#include "core/integrate/march/Accumulators.h"
 #include "transfer/OpacityCorrection.h"
 
 namespace volref {
@@ -193,8 +194,13 @@ PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<I
 template <class Rec>
 PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     if (p_.lerp_back_to_front) return composite_lerp(ray, intervals, rec);
-    glm::dvec3 C(0.0);
-    double A = 0.0;
+    // A GPU shader's compositing: A += (1 - A) alpha, C += (1 - A) alpha c (march/Accumulators.h),
+    // stopping as the profile says after every sample.
+    FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
+    Termination stop;
+    stop.test_alpha_above = stop.test_alpha_at_least = true;
+    stop.alpha_above = p_.terminate_above;
+    stop.alpha_at_least = p_.terminate_at;
     const Shader* shader = ctx_.pipeline.shader();
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
@@ -202,7 +208,7 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         if constexpr (Rec::kOn) begin_record(rec, r, x, t, d, v);
         const Lookup k = std::isfinite(v) ? lookup(v, d) : Lookup{};
-        const double A_before = A;
+        [[maybe_unused]] const double T_before = acc.transmittance();
         if (k.alpha > 0.0) {
             glm::dvec3 c = k.color;
             if (shader) {
@@ -218,8 +224,8 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
                 }
                 if (p_.clamp_shaded) c = glm::clamp(c, 0.0, 1.0);
             }
-            C += (1.0 - A) * k.alpha * c;
-            A += (1.0 - A) * k.alpha;
+            const double cc[3] = {c.r, c.g, c.b};
+            acc.add(true, false, 0.0, k.alpha, cc);
             if constexpr (Rec::kOn) r.sample.color = c;
         } else if constexpr (Rec::kOn) {
             r.sample.color = k.color;
@@ -231,15 +237,15 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
             r.composited = true;
             r.alpha = k.alpha;
             r.tau = k.alpha < 1.0 ? -std::log1p(-k.alpha) : std::numeric_limits<double>::infinity();
-            r.transmittance_before = 1.0 - A_before;
-            r.transmittance_after = 1.0 - A;
-            r.accumulated = glm::dvec4(C, A);
+            r.transmittance_before = T_before;
+            r.transmittance_after = acc.transmittance();
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        return !(A > p_.terminate_above || A >= p_.terminate_at);
+        return !acc.stops(true, stop);
     });
     PixelValue out;
-    out.rgba = glm::dvec4(C, A);
+    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
     return out;
 }
 
@@ -252,7 +258,7 @@ PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<I
         return true;
     });
     const ProfileOptions& o = ctx_.render.profile_options;
-    glm::dvec4 sum(0.0);
+    BackToFront<Scalar, BackToFrontRule::Lerp> acc;
     for (auto it = samples.rbegin(); it != samples.rend(); ++it) {
         const auto [t, d] = *it;
         const glm::dvec3 x = ray.at(t);
@@ -260,7 +266,8 @@ PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<I
         const bool used = std::isfinite(v) && !(p_.iso_skip && normalised(v) < o.iso_threshold);
         const Lookup k = used ? lookup(v, d) : Lookup{};
         const double w = k.opacity * o.density;
-        if (used) sum += (glm::dvec4(k.color, k.opacity) - sum) * w;
+        const double c[3] = {k.color.r, k.color.g, k.color.b};
+        acc.lerp(used, w, c, k.opacity);
         if constexpr (Rec::kOn) {
             SampleRecord r{};
             begin_record(rec, r, x, t, d, v);
@@ -270,20 +277,19 @@ PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<I
             r.sample.color = k.color;
             r.composited = true;
             r.alpha = used ? w : 0.0;
-            r.accumulated = sum;
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
     }
     PixelValue out;
-    out.rgba = sum;
+    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
     return out;
 }
 
 template <class Rec>
 PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum,
                                        Rec& rec) const {
-    bool any = false;
-    double best = 0.0;
+    Extremum<Scalar> acc(maximum);
     auto pixel = [&](double v) {
         const Lookup k = lookup(v, step_);
         return glm::dvec4(k.opacity * k.color, k.opacity);
@@ -291,8 +297,7 @@ PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interva
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
         const double v = value(x);
-        if (std::isfinite(v) && (!any || (maximum ? v > best : v < best))) best = v;
-        any = any || std::isfinite(v);
+        acc.add(true, v, t);
         if constexpr (Rec::kOn) {
             SampleRecord r{};
             begin_record(rec, r, x, t, d, v);
@@ -303,28 +308,30 @@ PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interva
                 r.sample.opacity = k.opacity;
                 r.sample.color = k.color;
             }
-            r.running = best;
-            r.accumulated = any ? pixel(best) : glm::dvec4(0.0);
+            r.running = acc.value();
+            r.accumulated = acc.any() ? pixel(acc.value()) : glm::dvec4(0.0);
             rec.recorder.record(r);
         }
         (void)d;
         return true;
     });
     PixelValue out;
-    if (any) out.rgba = pixel(best);
+    if (acc.any()) out.rgba = pixel(acc.value());
     return out;
 }
 
 template <class Rec>
 PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean,
                                             Rec& rec) const {
-    double sum = 0.0, length = 0.0;
+    // A shader's plain sums (march/Accumulators.h); x-ray maximum: the largest normalised value.
+    LineIntegral<PlainSum> acc;
+    Extremum<Scalar> largest(true);
     const Classifier& c = ctx_.pipeline.classifier();
     const bool weighted = mean && p_.average_opacity_weighted;
-    double maximum = -std::numeric_limits<double>::infinity();
     auto result = [&]() {
-        if (!mean && p_.xray_maximum) return ctx_.render.profile_options.brightness * (length > 0.0 ? maximum : 0.0);
-        return mean ? (length > 0.0 ? sum / length : 0.0) : ctx_.render.gain * sum;
+        if (!mean && p_.xray_maximum)
+            return ctx_.render.profile_options.brightness * (acc.length() > 0.0 ? largest.value() : 0.0);
+        return mean ? (acc.length() > 0.0 ? acc.mean() : 0.0) : ctx_.render.gain * acc.integral();
     };
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
@@ -332,9 +339,8 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
         [[maybe_unused]] double s = 0.0;
         if (std::isfinite(v)) {
             s = weighted ? lookup(v, d).opacity * normalised(v) : c.coordinate(v);
-            sum += weighted ? s : s * d;
-            maximum = std::max(maximum, normalised(v));
-            length += weighted ? 1.0 : d;
+            acc.add(weighted ? s : s * d, weighted ? 1.0 : d);
+            largest.add(true, normalised(v), t);
         }
         if constexpr (Rec::kOn) {
             SampleRecord r{};

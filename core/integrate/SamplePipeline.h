@@ -19,6 +19,20 @@
 
 namespace volref {
 
+class GradientField;
+class ShellGrid;
+class TransferFunction;
+
+// The concrete stages behind the pipeline's interfaces, as the scene built them (PreparedVolume), for
+// the paths that read them as plain arrays (the SIMD packet kernels) or cut rays at their cells and
+// rows (the adaptive integrator). Null where the scene uses another kind of stage.
+struct PipelineStages {
+    const VolumeSampler* cartesian = nullptr;             // a Cartesian grid's sampler (null for shells)
+    const ShellGrid* shell_grid = nullptr;                 // a shell's beam-space grid
+    const TransferFunction* transfer_function = nullptr;  // null for Levoy's classifiers
+    const GradientField* grid_gradient = nullptr;          // the Cartesian grid's gradients, when used
+};
+
 struct PipelineSample {
     double value = 0.0;
     glm::dvec3 color{0.0};  // shaded when the scene is shaded; not premultiplied
@@ -34,9 +48,9 @@ public:
     // vectors, grad_world = A^-T grad_local, V = -A d_local.
     SamplePipeline(const FieldSampler& sampler, const Classifier& classifier, const GradientSource* gradient,
                    const PreClassifiedVolume* preclassified, const Shader* shader,
-                   const VolumeTransform* transform = nullptr)
+                   const VolumeTransform* transform = nullptr, const PipelineStages& stages = {})
         : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader),
-          transform_(transform) {}
+          transform_(transform), stages_(stages) {}
 
     double value(const Ray& ray, double t) const { return sampler_.value(ray.at(t)); }
 
@@ -56,7 +70,8 @@ public:
     const Classifier& classifier() const { return classifier_; }
     const FieldSampler& sampler() const { return sampler_; }
     // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
-    const VolumeSampler* cartesian_sampler() const { return dynamic_cast<const VolumeSampler*>(&sampler_); }
+    const VolumeSampler* cartesian_sampler() const { return stages_.cartesian; }
+    const PipelineStages& stages() const { return stages_; }
     bool shaded() const { return shader_ != nullptr; }
     const Shader* shader() const { return shader_; }
     const GradientSource* gradient_source() const { return gradient_; }
@@ -116,6 +131,7 @@ private:
     const PreClassifiedVolume* pre_;
     const Shader* shader_;
     const VolumeTransform* transform_;
+    PipelineStages stages_;
 };
 
 }  // namespace volref

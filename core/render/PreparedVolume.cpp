@@ -1,5 +1,7 @@
 #include "core/render/PreparedVolume.h"
 
+#include "transfer/TransferFunction.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -195,8 +197,14 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         shader = std::make_unique<Shader>(*vs.shading, scene.lights,
                                           conventions::kZeroGradientRelative * std::max(std::fabs(vmin), std::fabs(vmax)) / voxel);
     }
+    PipelineStages stages;
+    stages.cartesian = model.cartesian.get();
+    stages.shell_grid = model.shell_grid.get();
+    // make_classifier builds a TransferFunction exactly when the spec names no other classification.
+    stages.transfer_function = vs.classification ? nullptr : static_cast<const TransferFunction*>(classifier.get());
+    stages.grid_gradient = gradient_field.get();
     pipeline = std::make_unique<SamplePipeline>(sampler, *classifier, gradient, preclassified.get(), shader.get(),
-                                                transform ? &*transform : nullptr);
+                                                transform ? &*transform : nullptr, stages);
     // The macrocell grid of empty-space skipping, kept only if some macrocell is empty; for mip and
     // minip (the fixed step's SIMD path), the grid's value bounds (SegmentWalk.h, extremum mode).
     if (options.empty_space_skipping && skipping_applies(vs, scene.render, *classifier, volume)) {

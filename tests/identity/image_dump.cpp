@@ -7,9 +7,19 @@
 // For each case OUT_DIR/name.img receives a text header (width, height, channel names) followed by the
 // pixels as IEEE-754 doubles in the host's byte order; a case whose scene or render is refused gets
 // OUT_DIR/name.err with volref's one-line message instead (refusals must not change either).
+// Each case renders in a child process (fork) given VOLREF_IMAGE_DUMP_TIMEOUT seconds (default 20);
+// a case that takes longer is killed and gets OUT_DIR/name.slow (the adaptive integrator can run away
+// on some scenes: issue 18), which scripts/image-identity.sh counts but cannot compare.
 // Only the public API (load_scene, render_scene) is used, so the same source builds before and after a
 // refactor of the renderer.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <thread>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -72,6 +82,29 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
+        const char* limit = std::getenv("VOLREF_IMAGE_DUMP_TIMEOUT");
+        const double timeout = limit ? std::atof(limit) : 20.0;
+        std::cout.flush();
+        const pid_t child = fork();
+        if (child < 0) {
+            std::cerr << "volref_image_dump: fork failed\n";
+            return 2;
+        }
+        if (child > 0) {  // the parent never renders (no threads to fork with): it waits
+            const auto start = std::chrono::steady_clock::now();
+            int status = 0;
+            while (waitpid(child, &status, WNOHANG) == 0) {
+                if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout) {
+                    kill(child, SIGKILL);
+                    waitpid(child, &status, 0);
+                    std::ofstream(out_dir + "/" + name + ".slow") << "over " << timeout << " s\n";
+                    break;
+                }
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
+            ++count;
+            continue;
+        }
         try {
             const volref::Scene scene = volref::load_scene(f[1], overrides);
             const volref::Image image = volref::render_scene(scene, options);
@@ -84,7 +117,7 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
             std::ofstream(out_dir + "/" + name + ".err") << e.what() << "\n";
         }
-        ++count;
+        std::_Exit(0);
     }
     std::cerr << "volref_image_dump: " << count << " cases\n";
     return 0;

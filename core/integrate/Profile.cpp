@@ -20,22 +20,23 @@ Profile make_vtk_gpu() {
     p.correction = Profile::Correction::Power;
     p.correction_floor = 1e-4;
     p.table_entries = 1024;
-    p.terminate_above = 1.0 - 1.0 / 255.0;
+    p.termination.test_alpha_above = true;
+    p.termination.alpha_above = 1.0 - 1.0 / 255.0;
     p.gradient_offset = 1.0;
     p.normal_along_gradient = true;
     p.clamp_shaded = true;
-    p.average_opacity_weighted = true;
+    p.average = Profile::Average::MeanOpacityTimesNormalised;
     return p;
 }
 
 // vtkFixedPointVolumeRayCastMapper of VTK 9.1, its CPU mapper: 15-bit fixed point throughout, on an
-// internal image drawn as a stretched texture. Too much for the fields above: VtkCpuProfile.h has it
+// internal image drawn as a stretched texture: its own renderer (VtkCpuProfile.h has it;
 // (conventions section 9 states each formula).
 Profile make_vtk_cpu() {
     Profile p;
     p.id = ProfileId::VtkCpu;
     p.name = "vtk-cpu";
-    p.vtk_fixed_point = true;
+    p.renderer = Profile::Renderer::VtkFixedPoint;
     return p;
 }
 
@@ -49,7 +50,8 @@ Profile make_glsl_basic() {
     p.placement = Profile::Placement::FromEntry;
     p.first = 0.0;
     p.correction = Profile::Correction::None;
-    p.terminate_at = 1.0;
+    p.termination.test_alpha_at_least = true;
+    p.termination.alpha_at_least = 1.0;
     p.gradient_offset = 0.0;
     p.gradient_offset_texture = 0.1;
     return p;
@@ -67,7 +69,8 @@ Profile make_ospray() {
     p.placement = Profile::Placement::Midpoints;
     p.correction = Profile::Correction::Extinction;
     p.density_scale = 1.0;
-    p.terminate_at = 1.0 - 0.001;
+    p.termination.test_alpha_at_least = true;
+    p.termination.alpha_at_least = 1.0 - 0.001;
     p.gradient_offset = 1.0;
     p.forward_gradient = true;
     return p;
@@ -86,12 +89,12 @@ Profile make_cuda_curvilinear() {
     p.first = 0.0;
     p.correction = Profile::Correction::None;
     p.table_entries = 9;
-    p.lerp_back_to_front = true;
-    p.scaled_table = true;
-    p.iso_skip = true;
-    p.xray_maximum = true;
-    p.step_size_over_n = true;
-    p.shells = true;
+    p.compositing = Profile::Compositing::BackToFrontLerp;
+    p.table_coordinate = Profile::TableCoordinate::DataRangeTimesTransferScale;
+    p.sample_filter = Profile::SampleFilter::AtOrAboveIsoThreshold;
+    p.xray = Profile::Xray::BrightnessTimesMaximum;
+    p.voxel_length = Profile::VoxelLength::ExtentOverSamples;
+    p.grids = Profile::Grids::CartesianAndShells;
     return p;
 }
 

@@ -2,11 +2,13 @@
 // to the same scene by ProfileIntegrator. A profile never changes the scene (volume, transfer
 // functions, camera, lights, step); it changes where samples are taken, how a transfer-function
 // opacity becomes a sample's alpha, whether the transfer function is read through a table, the
-// gradient scheme, the compositing formula and when a ray stops. Every number here is one renderer's
+// gradient scheme, the compositing rule and when a ray stops: each a rule named below, read by one
+// renderer (ProfileIntegrator, or VtkFixedPointRenderer for VTK's fixed-point mapper). Every number here is one renderer's
 // convention, with its source; docs/conventions.md section 9 gives the formulas.
 #pragma once
 #include <string>
 
+#include "core/integrate/march/Accumulators.h"
 #include "core/scene/Scene.h"
 
 namespace volref {
@@ -15,6 +17,18 @@ struct Profile {
     ProfileId id = ProfileId::Reference;
     const char* name = "reference";
 
+    // Which renderer reads the rest: a ray caster over the scene's rays (ProfileIntegrator), or VTK's
+    // image-space fixed-point caster (VtkFixedPointRenderer.h: its own internal image, 15-bit fixed
+    // point, texture display; the fields below are not read).
+    enum class Renderer { RayCaster, VtkFixedPoint };
+    Renderer renderer = Renderer::RayCaster;
+
+    // The grids the renderer reads: Cartesian only (texture reads clamped to the domain), or beam-space
+    // shells as well (no clamping: the intervals stay inside; no gradients).
+    enum class Grids { Cartesian, CartesianAndShells };
+    Grids grids = Grids::Cartesian;
+
+    // --- sample placement -------------------------------------------------------------------------
     // Where the samples of one interval [t0, t1] (length L, step h) lie.
     enum class Placement {
         // The reference: segments of h, sampled at their midpoints, weighted by their lengths.
@@ -26,7 +40,28 @@ struct Profile {
     };
     Placement placement = Placement::Midpoints;
     double first = 0.0;  // FromEntry: the first sample's distance from the entry, in steps
+    // What render.step_units "voxel" means: the grid spacing (the reference), or size / n (the extent
+    // over the sample count: the step is multiplied by (n - 1) / n, n the dims of the grid's axis of
+    // smallest spacing (Cartesian) or the largest dims (shells)).
+    enum class VoxelLength { Spacing, ExtentOverSamples };
+    VoxelLength voxel_length = VoxelLength::Spacing;
 
+    // --- classification ---------------------------------------------------------------------------
+    // The transfer function read exactly (table_entries 0) or through 1-D tables of `table_entries`
+    // entries built at min + j (max - min) / (N - 1) over the volume's data range [min, max] and read
+    // with linear filtering at texel position u N - 0.5 (clamped to the edge texels, as an OpenGL
+    // texture with GL_LINEAR and CLAMP_TO_EDGE does), u by the table coordinate rule.
+    int table_entries = 0;
+    enum class TableCoordinate {
+        DataRange,                  // u = s = (v - min) / (max - min)
+        DataRangeTimesTransferScale,  // u = clamp(s * render.profile_options.transfer_scale, 0, 1)
+    };
+    TableCoordinate table_coordinate = TableCoordinate::DataRange;
+    // Which samples are composited: all, or those with s >= render.profile_options.iso_threshold.
+    enum class SampleFilter { All, AtOrAboveIsoThreshold };
+    SampleFilter sample_filter = SampleFilter::All;
+
+    // --- opacity correction -----------------------------------------------------------------------
     // How a transfer-function opacity a (per unit distance l) becomes the alpha of one sample.
     enum class Correction {
         Power,       // alpha = 1 - (1 - a)^(h / l) applied to the table entries with a > floor (VTK GPU)
@@ -37,20 +72,23 @@ struct Profile {
     double correction_floor = 0.0;  // Power: entries with a <= floor are left as they are
     double density_scale = 1.0;     // Extinction
 
-    // The transfer function read through 1-D tables of `table_entries` entries built at
-    // min + j (max - min) / (N - 1) over the volume's data range [min, max] and read with linear
-    // filtering at texel position s N - 0.5 (s = (v - min) / (max - min), clamped to the edge
-    // texels, as an OpenGL texture with GL_LINEAR and CLAMP_TO_EDGE does). 0: the exact function.
-    int table_entries = 0;
+    // --- compositing and termination (march/Accumulators.h) -----------------------------------------
+    enum class Compositing {
+        // Front to back, premultiplied: C += (1 - A) alpha c, A += (1 - A) alpha (the opacity-sum
+        // rule), stopping by `termination` after every sample.
+        FrontToBackOpacitySum,
+        // Seed 001: back to front, sum = lerp(sum, (c, a), a density) on R, G, B, A (density:
+        // render.profile_options.density); no termination.
+        BackToFrontLerp,
+    };
+    Compositing compositing = Compositing::FrontToBackOpacitySum;
+    // When a front-to-back ray stops: A > alpha_above (VTK GPU: 1 - 1/255), A >= alpha_at_least (a
+    // textbook shader: 1; OSPRay: T <= 0.001, i.e. A >= 0.999).
+    Termination termination{};
 
-    // Front to back, premultiplied: C += (1 - A) alpha c, A += (1 - A) alpha; the ray stops once
-    // A > terminate_above (VTK GPU: 1 - 1/255) or A >= terminate_at (a textbook shader: 1;
-    // OSPRay: T <= 0.001, i.e. A >= 0.999). Values above 1 never stop.
-    double terminate_above = 2.0;
-    double terminate_at = 2.0;
-
-    // Shading. Central differences of the clamped field at +-gradient_offset voxels (per axis), or
-    // forward differences f(x + h) - f(x) when `forward`. normal_along_gradient: the renderer's
+    // --- gradients and shading --------------------------------------------------------------------
+    // Central differences of the clamped field at +-gradient_offset voxels (per axis), or forward
+    // differences f(x + h) - f(x) when `forward_gradient`. normal_along_gradient: the renderer's
     // normal is +grad f (VTK's GLSL) rather than this contract's -grad f. clamp_shaded: the shaded
     // colour is clamped to [0, 1] before compositing.
     double gradient_offset = 1.0;  // voxels
@@ -59,29 +97,17 @@ struct Profile {
     bool normal_along_gradient = false;
     bool clamp_shaded = false;
 
-    // Back to front with sum = lerp(sum, col, col.a * density) (RGBA, col = (c, a) from the table;
-    // render.profile_options.density) instead of front-to-back compositing; no termination.
-    bool lerp_back_to_front = false;
-    // Tables read at s * render.profile_options.transfer_scale instead of s.
-    bool scaled_table = false;
-    // Composite skips samples with s < render.profile_options.iso_threshold.
-    bool iso_skip = false;
-    // X-ray: g = brightness * max_k s_k instead of the line integral.
-    bool xray_maximum = false;
-    // step_units "voxel": a voxel is size / n (extent over the sample count) rather than the spacing
-    // size / (n - 1): the step is multiplied by (n - 1) / n, n the dims of the grid's axis of smallest
-    // spacing (Cartesian) or the largest dims (shells).
-    bool step_size_over_n = false;
-    // The profile renders beam-space (shell) grids too: no domain clamping, no gradients.
-    bool shells = false;
-
-    // vtkFixedPointVolumeRayCastMapper (VtkCpuProfile.h): the whole discretisation (internal image,
-    // 15-bit fixed-point ray casting, texture display) is that file's; the fields above are unused.
-    bool vtk_fixed_point = false;
-
-    // Average projection: VTK's GPU shader averages opacity(v) * s (s the value normalised over the
-    // data range, opacity the uncorrected table) over the samples and writes it as grey, alpha 1.
-    bool average_opacity_weighted = false;
+    // --- the projections of values ----------------------------------------------------------------
+    enum class Average {
+        MeanCoordinate,              // g = the length-weighted mean of the transfer function's coordinate
+        MeanOpacityTimesNormalised,  // VTK's GPU shader: g = mean_k opacity(v_k) s_k (uncorrected table)
+    };
+    Average average = Average::MeanCoordinate;
+    enum class Xray {
+        LineIntegral,            // g = gain sum_k coordinate(v_k) d_k
+        BrightnessTimesMaximum,  // seed 001: g = brightness max_k s_k
+    };
+    Xray xray = Xray::LineIntegral;
 };
 
 // The profile a scene names (render.profile).

@@ -28,13 +28,13 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
     const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
-    if (!cartesian && !p_.shells) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
-    if (p_.shells && ctx.pipeline.shaded() && r.projection == Projection::Composite)
+    if (!cartesian && p_.grids == Profile::Grids::Cartesian) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
+    if (p_.grids == Profile::Grids::CartesianAndShells && ctx.pipeline.shaded() && r.projection == Projection::Composite)
         throw Error(where + "does not shade (remove volume.shading)");
     if (ctx.pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
     if (ctx.pipeline.classifier().needs_gradient())
         throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
-    if (p_.vtk_fixed_point) {
+    if (p_.renderer == Profile::Renderer::VtkFixedPoint) {
         if (!scene) throw Error(where + "needs the scene's camera and image (construct ProfileIntegrator with the scene)");
         if (scene->volumes.size() != 1) throw Error(where + "renders one volume: volumes");
         const BoundsSpec& b = scene->volume().bounds;
@@ -48,7 +48,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
     domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
     step_ = ctx.step;
-    if (p_.step_size_over_n && r.step_units == StepUnits::Voxel) {
+    if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && r.step_units == StepUnits::Voxel) {
         int axis = 0;
         for (int a = 1; a < 3; ++a)
             if (cartesian ? volume.spacing[a] < volume.spacing[axis] : volume.dims[a] > volume.dims[axis]) axis = a;
@@ -104,7 +104,7 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
     }
     // GL_LINEAR over N texels with CLAMP_TO_EDGE: texel position s N - 0.5.
     const int n = p_.table_entries;
-    const double u = p_.scaled_table ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
+    const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
                                      : normalised(v);
     const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
     const int i = std::min(int(pos), n - 2);
@@ -193,14 +193,10 @@ PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<I
 
 template <class Rec>
 PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
-    if (p_.lerp_back_to_front) return composite_lerp(ray, intervals, rec);
+    if (p_.compositing == Profile::Compositing::BackToFrontLerp) return composite_lerp(ray, intervals, rec);
     // A GPU shader's compositing: A += (1 - A) alpha, C += (1 - A) alpha c (march/Accumulators.h),
     // stopping as the profile says after every sample.
     FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
-    Termination stop;
-    stop.test_alpha_above = stop.test_alpha_at_least = true;
-    stop.alpha_above = p_.terminate_above;
-    stop.alpha_at_least = p_.terminate_at;
     const Shader* shader = ctx_.pipeline.shader();
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
@@ -242,7 +238,7 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        return !acc.stops(true, stop);
+        return !acc.stops(true, p_.termination);
     });
     PixelValue out;
     out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
@@ -263,7 +259,7 @@ PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<I
         const auto [t, d] = *it;
         const glm::dvec3 x = ray.at(t);
         const double v = value(x);
-        const bool used = std::isfinite(v) && !(p_.iso_skip && normalised(v) < o.iso_threshold);
+        const bool used = std::isfinite(v) && !(p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold && normalised(v) < o.iso_threshold);
         const Lookup k = used ? lookup(v, d) : Lookup{};
         const double w = k.opacity * o.density;
         const double c[3] = {k.color.r, k.color.g, k.color.b};
@@ -327,9 +323,9 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
     LineIntegral<PlainSum> acc;
     Extremum<Scalar> largest(true);
     const Classifier& c = ctx_.pipeline.classifier();
-    const bool weighted = mean && p_.average_opacity_weighted;
+    const bool weighted = mean && p_.average == Profile::Average::MeanOpacityTimesNormalised;
     auto result = [&]() {
-        if (!mean && p_.xray_maximum)
+        if (!mean && p_.xray == Profile::Xray::BrightnessTimesMaximum)
             return ctx_.render.profile_options.brightness * (acc.length() > 0.0 ? largest.value() : 0.0);
         return mean ? (acc.length() > 0.0 ? acc.mean() : 0.0) : ctx_.render.gain * acc.integral();
     };

@@ -8,11 +8,13 @@
 //   composite: C += (1 - A) alpha_k c_k, A += (1 - A) alpha_k, front to back, stopping as the profile
 //              says; c_k shaded (and clamped when the profile clamps) when the scene is shaded;
 //   mip/minip: v* = max/min v_k, pixel (a(v*) c(v*), a(v*)) with the uncorrected opacity;
-//   average:   profile.average_opacity_weighted: g = mean_k a(v_k) s_k; otherwise g = the weighted
-//              mean of the transfer function's coordinate; pixel (g, g, g, 1);
-//   xray:      g = gain * sum_k coordinate(v_k) d_k (xray_maximum: brightness * max_k s_k); pixel (g, g, g, 1).
-//   composite with lerp_back_to_front: sum = lerp(sum, (c, a), a density) from the far end, pixel sum.
-//   vtk-cpu (profile.vtk_fixed_point): VtkCpuProfile.h's caster renders the pixel the ray belongs to
+//   average:   Average::MeanOpacityTimesNormalised: g = mean_k a(v_k) s_k; MeanCoordinate: g = the
+//              weighted mean of the transfer function's coordinate; pixel (g, g, g, 1);
+//   xray:      g = gain * sum_k coordinate(v_k) d_k (BrightnessTimesMaximum: brightness * max_k s_k);
+//              pixel (g, g, g, 1).
+//   composite with Compositing::BackToFrontLerp: sum = lerp(sum, (c, a), a density) from the far end.
+// Every formula is an accumulator's (march/Accumulators.h).
+//   vtk-cpu (Renderer::VtkFixedPoint): VtkCpuProfile.h's caster renders the pixel the ray belongs to
 //              (its internal rays, then the texture display); needs the scene's camera and image.
 #pragma once
 #include <memory>

@@ -1,20 +1,8 @@
 // volref: the whole public API in one include (installed as <volref/volref.h>'s folder on the path:
-// #include "volref.h"). See README.md and docs/architecture.md.
+// #include "volref.h"): the core (volref_core.h, libvolref_core) and writing image files
+// (core/film/ImageWriter.h, libvolref_tools): link volref::volref (both) or volref::volref_tools.
+// A program that only renders to memory includes "volref_core.h" and links volref::volref_core.
+// See README.md and docs/architecture.md.
 #pragma once
-#include "core/Conventions.h"
-#include "core/Error.h"
-#include "core/camera/Camera.h"
-#include "core/film/Image.h"
+#include "volref_core.h"
 #include "core/film/ImageWriter.h"
-#include "core/grid/ProceduralField.h"
-#include "core/grid/Volume.h"
-#include "core/integrate/Integrator.h"
-#include "core/io/VolumeReader.h"
-#include "core/render/Renderer.h"
-#include "core/sample/Trilinear.h"
-#include "core/sample/VolumeSampler.h"
-#include "core/scene/Scene.h"
-#include "core/scene/SceneLoader.h"
-#include "geometry/BoundingGeometry.h"
-#include "transfer/OpacityCorrection.h"
-#include "transfer/TransferFunction.h"

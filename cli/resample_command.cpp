@@ -25,14 +25,13 @@
 #include "core/grid/Resample.h"
 #include "core/io/NrrdWriter.h"
 #include "core/io/VolumeReader.h"
-#include "core/scene/JsonReader.h"
+#include "core/scene/SceneLoader.h"
 #include "geometry/ShellCoordinates.h"
 
 namespace volref::cli {
 
 namespace {
 
-namespace jr = volref::json_reader;
 namespace fs = std::filesystem;
 
 constexpr const char* kBoundsKey = "volref_bounds";
@@ -103,84 +102,14 @@ Interpolation parse_interpolation(const std::string& s) {
                 "'");
 }
 
-// ---- the shell, as the scene's volume.bounds object ----
+// ---- the shell, as the scene's volume.bounds object (read by the scene loader's parse_shell) ----
 
-struct Shell {
-    bool spherical = false;
-    CylindricalShell cylinder;
-    SphericalShell sphere;
-};
-
-std::array<double, 2> read_range(jr::ObjectReader& r, std::string_view key, std::array<double, 2> fallback,
-                                 bool required) {
-    const jr::Json* v = required ? &r.required(key) : r.find(key);
-    if (!v) return fallback;
-    const std::vector<double> x = jr::read_numbers(*v, r.path(key), r.context(), 2);
-    return {x[0], x[1]};
-}
-
-std::string range_json(const jr::Json& v) { return jr::describe(v); }
-
-Shell parse_shell(const jr::Json& json, const jr::Context& ctx) {
-    enum class Type { Cylindrical, Spherical };
-    jr::ObjectReader r(json, "", ctx);
-    const Type type = r.required_choice<Type>("type", {{"cylindrical", Type::Cylindrical}, {"spherical", Type::Spherical}});
-    Shell s;
-    s.spherical = type == Type::Spherical;
-    if (const jr::Json* t = r.find("tessellate"))  // a rendering option: accepted, not used here
-        jr::read_integer(*t, r.path("tessellate"), ctx, jr::Range::at_least(1));
-    const auto radius_ok = [](const std::array<double, 2>& x) { return 0.0 <= x[0] && x[0] < x[1]; };
-    const auto angle_ok = [](const std::array<double, 2>& x) { return x[0] < x[1] && x[1] - x[0] <= 360.0; };
-    if (!s.spherical) {
-        r.allow({"type", "center", "radius", "angle", "height", "tessellate"}, "for a cylindrical shell");
-        CylindricalShell& c = s.cylinder;
-        c.center = r.vec3("center", glm::dvec3(0.0));
-        const auto radius = read_range(r, "radius", {0, 1}, true);
-        if (!radius_ok(radius))
-            r.fail("radius", "expected [r0, r1] with 0 <= r0 < r1, got " + range_json(*r.find("radius")));
-        const auto angle = read_range(r, "angle", {0, 360}, false);
-        if (!angle_ok(angle))
-            r.fail("angle", "expected [a0, a1] in degrees with a0 < a1 <= a0 + 360, got " + range_json(*r.find("angle")));
-        const auto height = read_range(r, "height", {0, 1}, true);
-        if (!(height[0] < height[1]))
-            r.fail("height", "expected [h0, h1] with h0 < h1, got " + range_json(*r.find("height")));
-        c.r0 = radius[0], c.r1 = radius[1], c.a0 = angle[0], c.a1 = angle[1], c.h0 = height[0], c.h1 = height[1];
-        check_shell(c);
-        return s;
-    }
-    r.allow({"type", "center", "radius", "longitude", "latitude", "axes", "tessellate"}, "for a spherical shell");
-    SphericalShell& p = s.sphere;
-    p.center = r.vec3("center", glm::dvec3(0.0));
-    const auto radius = read_range(r, "radius", {0, 1}, true);
-    if (!radius_ok(radius)) r.fail("radius", "expected [r0, r1] with 0 <= r0 < r1, got " + range_json(*r.find("radius")));
-    const auto lon = read_range(r, "longitude", {0, 360}, false);
-    if (!angle_ok(lon))
-        r.fail("longitude", "expected [l0, l1] in degrees with l0 < l1 <= l0 + 360, got " + range_json(*r.find("longitude")));
-    const auto lat = read_range(r, "latitude", {-90, 90}, false);
-    if (!(-90.0 <= lat[0] && lat[0] < lat[1] && lat[1] <= 90.0))
-        r.fail("latitude", "expected [b0, b1] in degrees with -90 <= b0 < b1 <= 90, got " + range_json(*r.find("latitude")));
-    p.r0 = radius[0], p.r1 = radius[1], p.lon0 = lon[0], p.lon1 = lon[1], p.lat0 = lat[0], p.lat1 = lat[1];
-    if (const jr::Json* a = r.find("axes")) {
-        const std::string path = r.path("axes");
-        const std::string expected = "expected a permutation of [\"longitude\", \"latitude\", \"radius\"], got ";
-        if (jr::read_array_size(*a, path, ctx) != 3) ctx.fail(path, expected + jr::describe(*a));
-        std::array<bool, 3> seen{false, false, false};
-        for (std::size_t g = 0; g < 3; ++g) {
-            const std::string name = jr::read_string(jr::element(*a, g), jr::index_path(path, g), ctx);
-            const int c = name == "longitude" ? 0 : name == "latitude" ? 1 : name == "radius" ? 2 : -1;
-            if (c < 0 || seen[std::size_t(c)]) ctx.fail(path, expected + jr::describe(*a));
-            seen[std::size_t(c)] = true;
-            p.axes[g] = c;
-        }
-    }
-    check_shell(p);
-    return s;
-}
+bool is_spherical(const BoundsSpec& s) { return s.type == BoundsSpec::Type::Spherical; }
 
 // The shell as the scene's volume.bounds object (every key explicit), for the output's header.
-std::string shell_json(const Shell& s) {
+std::string shell_json(const BoundsSpec& s) {
     nlohmann::ordered_json j;
-    if (!s.spherical) {
+    if (!is_spherical(s)) {
         const CylindricalShell& c = s.cylinder;
         j["type"] = "cylindrical";
         j["center"] = {c.center.x, c.center.y, c.center.z};
@@ -234,26 +163,16 @@ std::string nrrd_key_value(const fs::path& path, const std::string& key) {
     return "";
 }
 
-Shell read_shell(const ResampleArgs& args) {
+BoundsSpec read_shell(const ResampleArgs& args) {
     const std::string text = trim(args.shell);
-    if (!text.empty() && text.front() == '{') {
-        const jr::Context ctx("--shell");
-        return parse_shell(jr::parse_json(text, "--shell"), ctx);
-    }
-    if (!text.empty()) {
-        const std::string name = args.shell;
-        const std::string json = read_text_file(args.shell, " (the --shell file)");
-        const jr::Context ctx(name);
-        return parse_shell(jr::parse_json(json, name), ctx);
-    }
+    if (!text.empty() && text.front() == '{') return parse_shell(text, "--shell");
+    if (!text.empty()) return parse_shell(read_text_file(args.shell, " (the --shell file)"), args.shell);
     // No --shell: the input's own description (--to cartesian).
     const std::string stored = nrrd_key_value(args.input, kBoundsKey);
     if (stored.empty())
         throw Error(args.input.string() + ": no '" + kBoundsKey +
                     "' key in the header to place the beam-space samples; give --shell");
-    const std::string name = args.input.string() + " (" + kBoundsKey + ")";
-    const jr::Context ctx(name);
-    return parse_shell(jr::parse_json(stored, name), ctx);
+    return parse_shell(stored, args.input.string() + " (" + kBoundsKey + ")");
 }
 
 }  // namespace
@@ -287,38 +206,39 @@ int run_resample(const ResampleArgs& args) {
     if (!to_cartesian && trim(args.shell).empty()) throw Error("--to " + args.to + " needs --shell");
     check_nrrd_output_path(args.output);
 
-    const Shell shell = read_shell(args);
-    if (!to_cartesian && shell.spherical != (args.to == "spherical"))
+    const BoundsSpec shell = read_shell(args);
+    const bool spherical = is_spherical(shell);
+    if (!to_cartesian && spherical != (args.to == "spherical"))
         throw Error(std::string(trim(args.shell).front() == '{' ? "--shell" : args.shell) +
                     ": type: expected \"" + args.to + "\" for --to " + args.to + ", got \"" +
-                    (shell.spherical ? "spherical" : "cylindrical") + "\"");
+                    (spherical ? "spherical" : "cylindrical") + "\"");
     if (!to_cartesian) {
         // Checks the grid (dims against the shell) before reading the input.
-        if (shell.spherical) static_cast<void>(ShellGrid(shell.sphere, dims));
+        if (spherical) static_cast<void>(ShellGrid(shell.sphere, dims));
         else static_cast<void>(ShellGrid(shell.cylinder, dims));
     }
 
     const Volume input = read_volume(args.input, args.format);
     Volume result;
-    const std::string kind = shell.spherical ? "spherical" : "cylindrical";
+    const std::string kind = spherical ? "spherical" : "cylindrical";
     if (to_cartesian) {
         if (!origin) {
             // The shell's bounding box, sampled by dims (spacing 1 on an axis with one sample).
-            const auto box = shell.spherical ? bounding_box(shell.sphere) : bounding_box(shell.cylinder);
+            const auto box = spherical ? bounding_box(shell.sphere) : bounding_box(shell.cylinder);
             origin = box[0];
             spacing = glm::dvec3(1.0);
             for (int a = 0; a < 3; ++a)
                 if (dims[std::size_t(a)] > 1 && box[1][a] > box[0][a])
                     (*spacing)[a] = (box[1][a] - box[0][a]) / double(dims[std::size_t(a)] - 1);
         }
-        result = shell.spherical
+        result = spherical
                      ? resample_to_cartesian(input, shell.sphere, interpolation, *origin, *spacing, dims, fill)
                      : resample_to_cartesian(input, shell.cylinder, interpolation, *origin, *spacing, dims, fill);
         out.comments.push_back("volref resample: a Cartesian grid from the " + kind + " beam-space volume " +
                                args.input.filename().string());
     } else {
-        result = shell.spherical ? resample_to_spherical(input, interpolation, shell.sphere, dims, fill)
-                                 : resample_to_cylindrical(input, interpolation, shell.cylinder, dims, fill);
+        result = spherical ? resample_to_spherical(input, interpolation, shell.sphere, dims, fill)
+                           : resample_to_cylindrical(input, interpolation, shell.cylinder, dims, fill);
         out.comments.push_back("volref resample: a " + kind + " beam-space grid from " + args.input.filename().string() +
                                "; " + kBoundsKey + " places its samples (origin and spacing are grid indices)");
         out.key_values.emplace_back(kBoundsKey, shell_json(shell));

@@ -51,7 +51,7 @@ inline constexpr double kGradientCacheBreakEven = 2.0;
 // Pixel (x, y) is sampled through its centre (x + 0.5, y + 0.5); row 0 is the top row.
 inline constexpr double kPixelCentre = 0.5;
 
-// The fast profile (render.profile "fast", core/integrate/FastProfile.h) stops a ray once its
+// The fast profile (render.profile "fast", core/integrate/packet/FastProfile.h) stops a ray once its
 // transmittance Tr is at most this: what it leaves out is at most Tr times the brightest colour
 // behind, 2^-10 < 0.5 / 255, below half a step of an 8-bit image.
 inline constexpr double kFastTransmittanceCutoff = 0x1p-10;

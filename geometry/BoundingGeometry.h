@@ -22,8 +22,8 @@
 #include <glm/vec3.hpp>
 
 #include "core/camera/Ray.h"
+#include "core/scene/ShellSpec.h"
 #include "geometry/RayIntervals.h"
-#include "geometry/ShellSpec.h"
 #include "geometry/TriangleMesh.h"
 
 namespace volref {
@@ -43,7 +43,7 @@ public:
     // A closed triangle mesh (see check_closed; it is checked again and oriented outward here, an
     // Error naming "bounding mesh" if it is not closed) and the data domain.
     int add_mesh(const TriangleMesh& mesh, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi);
-    // Curvilinear shells (geometry/ShellSpec.h): the shell is also the data domain.
+    // Curvilinear shells (core/scene/ShellSpec.h): the shell is also the data domain.
     int add_cylindrical_shell(const CylindricalShell& shell);
     int add_spherical_shell(const SphericalShell& shell);
 

@@ -1,4 +1,4 @@
-// Shell coordinates of the curvilinear shells (geometry/ShellSpec.h, docs/shells.md) and the mapping
+// Shell coordinates of the curvilinear shells (core/scene/ShellSpec.h, docs/shells.md) and the mapping
 // of a shell point to the continuous index of its beam-space grid.
 //
 //   cylindrical: p - center = (r cos theta, h, -r sin theta); r = |(x, z)| >= 0,
@@ -27,7 +27,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "geometry/ShellSpec.h"
+#include "core/scene/ShellSpec.h"
 
 namespace volref {
 

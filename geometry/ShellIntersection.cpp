@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "core/Angles.h"
 #include "core/Error.h"
 
 namespace volref {
@@ -31,19 +32,6 @@ struct Splits {
 };
 
 }  // namespace
-
-void cos_sin_degrees(double deg, double& c, double& s) {
-    const double k = deg / 90.0;
-    if (k == std::floor(k) && std::abs(k) < 1e15) {
-        const long long q = ((static_cast<long long>(k) % 4) + 4) % 4;
-        static constexpr double cs[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
-        c = cs[q][0];
-        s = cs[q][1];
-        return;
-    }
-    c = std::cos(deg * kDegree);
-    s = std::sin(deg * kDegree);
-}
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Analytic ray intervals in the curvilinear shells of geometry/ShellSpec.h, in double precision.
+// Analytic ray intervals in the curvilinear shells of core/scene/ShellSpec.h, in double precision.
 //
 // Cylindrical region (relative to the centre, axis y, theta = atan2(-z, x)):
 //   r0 <= sqrt(x^2 + z^2) <= r1, h0 <= y <= h1, theta in [a0, a1] (mod 360; no limit when a1 - a0 >= 360).
@@ -24,8 +24,8 @@
 #include <glm/vec3.hpp>
 
 #include "core/camera/Ray.h"
+#include "core/scene/ShellSpec.h"
 #include "geometry/RayIntervals.h"
-#include "geometry/ShellSpec.h"
 
 namespace volref {
 
@@ -84,8 +84,5 @@ private:
 
 // theta = atan2(-z, x) in degrees, in [0, 360).
 double azimuth_degrees(double x, double z);
-
-// cos and sin of an angle in degrees; exact (0, +-1) at multiples of 90.
-void cos_sin_degrees(double degrees, double& c, double& s);
 
 }  // namespace volref

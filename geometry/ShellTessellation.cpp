@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/Angles.h"
 #include "core/Error.h"
 #include "geometry/ShellIntersection.h"
 

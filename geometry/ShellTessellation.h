@@ -23,7 +23,7 @@
 // atan(tan(b) / cos(pi / n)) (away from the equator). A ray crossing the boundary at incidence angle
 // phi from the normal moves its crossing by at most error / cos(phi).
 #pragma once
-#include "geometry/ShellSpec.h"
+#include "core/scene/ShellSpec.h"
 #include "geometry/TriangleMesh.h"
 
 namespace volref {

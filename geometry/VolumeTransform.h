@@ -38,9 +38,4 @@ private:
     glm::dmat3 a_inv_, normal_;
 };
 
-// The rotation by `degrees` about the unit `axis` (right-handed), by Rodrigues' formula
-// R = c I + s [axis]x + (1 - c) axis axis^T; multiples of 90 degrees use exact cosines and sines
-// (0, +-1), so a grid rotated by them lands exactly on a grid.
-glm::dmat3 rotation_matrix(const glm::dvec3& axis, double degrees);
-
 }  // namespace volref

@@ -14,7 +14,7 @@
 #include "core/camera/Ray.h"
 #include "core/explain/Explanation.h"
 #include "core/scene/Scene.h"
-#include "geometry/ShellSpec.h"
+#include "core/scene/ShellSpec.h"
 
 namespace volref {
 

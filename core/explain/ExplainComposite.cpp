@@ -8,8 +8,8 @@
 
 #include "core/Error.h"
 #include "core/explain/Explain.h"
-#include "core/integrate/CompositeIntegrator.h"
-#include "core/integrate/SamplePipeline.h"
+#include "core/integrate/fixed/CompositeIntegrator.h"
+#include "core/integrate/march/SamplePipeline.h"
 #include "transfer/OpacityCorrection.h"
 
 namespace volref::explain {

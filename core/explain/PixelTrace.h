@@ -1,7 +1,7 @@
 // PixelTrace: one pixel of a prepared scene, sample by sample (`volref trace`, `volref explain ray`).
 //
 // The samples are recorded by the integrator's own loop (Integrator::integrate_traced,
-// core/integrate/SampleRecorder.h), so the last sample's accumulated RGBA is the pixel that
+// core/integrate/march/SampleRecorder.h), so the last sample's accumulated RGBA is the pixel that
 // PreparedScene::render_pixel gives, bit for bit (and the rendered image's pixel, up to the SIMD
 // path's documented rounding). Each sample is also located on the grid: the continuous index u of its
 // position and the cell and local coordinates that reconstruction uses (VolumeSampler::locate on a
@@ -18,7 +18,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/integrate/Integrator.h"
-#include "core/integrate/SampleRecorder.h"
+#include "core/integrate/march/SampleRecorder.h"
 #include "geometry/RayIntervals.h"
 
 namespace volref {

@@ -19,7 +19,7 @@
 
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
-#include "geometry/ShellSpec.h"
+#include "core/scene/ShellSpec.h"
 
 namespace volref {
 

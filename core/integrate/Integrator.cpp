@@ -1,11 +1,11 @@
 #include "core/integrate/Integrator.h"
 
 #include "core/Error.h"
-#include "core/integrate/AdaptiveIntegrator.h"
-#include "core/integrate/CompositeIntegrator.h"
-#include "core/integrate/ExtremumIntegrator.h"
-#include "core/integrate/FirstHitIntegrator.h"
-#include "core/integrate/LineIntegralIntegrator.h"
+#include "core/integrate/adaptive/AdaptiveIntegrator.h"
+#include "core/integrate/fixed/CompositeIntegrator.h"
+#include "core/integrate/fixed/ExtremumIntegrator.h"
+#include "core/integrate/fixed/FirstHitIntegrator.h"
+#include "core/integrate/fixed/LineIntegralIntegrator.h"
 
 namespace volref {
 

@@ -10,7 +10,7 @@
 
 #include "core/Error.h"
 #include "core/camera/Ray.h"
-#include "core/integrate/SamplePipeline.h"
+#include "core/integrate/march/SamplePipeline.h"
 #include "core/scene/Scene.h"
 #include "geometry/RayIntervals.h"
 

@@ -13,8 +13,8 @@
 
 #include "core/camera/Camera.h"
 #include "core/integrate/Integrator.h"
-#include "core/integrate/MultiVolumeIntegrator.h"
-#include "core/integrate/SampleRecorder.h"
+#include "core/integrate/mix/MultiVolumeIntegrator.h"
+#include "core/integrate/march/SampleRecorder.h"
 #include "core/render/PreparedVolume.h"
 #include "core/render/Renderer.h"
 #include "core/scene/Scene.h"

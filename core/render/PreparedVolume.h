@@ -19,7 +19,7 @@
 #include "core/camera/Ray.h"
 #include "core/grid/Volume.h"
 #include "core/integrate/Integrator.h"
-#include "core/integrate/SamplePipeline.h"
+#include "core/integrate/march/SamplePipeline.h"
 #include "core/render/Renderer.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/MacrocellGrid.h"

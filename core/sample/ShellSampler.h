@@ -27,8 +27,8 @@
 
 #include "core/grid/Volume.h"
 #include "core/scene/Scene.h"
+#include "core/scene/ShellSpec.h"
 #include "geometry/ShellCoordinates.h"
-#include "geometry/ShellSpec.h"
 
 namespace volref {
 

@@ -12,7 +12,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "geometry/ShellSpec.h"
+#include "core/scene/ShellSpec.h"
 
 namespace volref {
 
@@ -166,8 +166,8 @@ enum class StepUnits { Voxel, World };
 // How a ray's integral is computed: `Fixed` steps of render.step (conventions section 4), or
 // `Adaptive` error-controlled integration to render.tolerance (docs/accuracy.md).
 enum class IntegrationMethod { Fixed, Adaptive };
-// render.profile: whose discretisation to reproduce (core/integrate/Profile.h, conventions section 9);
-// Fast is volref's own float SIMD variant of the reference (core/integrate/FastProfile.h).
+// render.profile: whose discretisation to reproduce (core/integrate/profiles/Profile.h, conventions section 9);
+// Fast is volref's own float SIMD variant of the reference (core/integrate/packet/FastProfile.h).
 enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast };
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {

@@ -18,10 +18,10 @@
 #include <glm/matrix.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Angles.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/scene/JsonReader.h"
-#include "geometry/VolumeTransform.h"
 
 namespace volref {
 
@@ -311,68 +311,80 @@ std::array<double, 2> read_angle_range(ObjectReader& r, std::string_view key) {
     return a;
 }
 
+// The keys of a cylindrical or spherical shell (b.type already read): the one reader of a shell, for
+// a scene's volume.bounds and for parse_shell (volref resample --shell). radius is required, and height
+// for a cylinder (a shell places the samples: no unit default); ranges are [lo, hi] with lo < hi,
+// radius >= 0, angle and longitude spans at most 360, latitude in [-90, 90]; tessellate >= 3.
+void read_shell(ObjectReader& r, BoundsSpec& b) {
+    using T = BoundsSpec::Type;
+    const Range radius = Range::non_negative();
+    if (b.type == T::Cylindrical) {
+        r.allow({"type", "center", "radius", "angle", "height", "tessellate"}, "for bounds type \"cylindrical\"");
+        CylindricalShell& c = b.cylinder;
+        c.center = r.vec3("center", glm::dvec3(0.0));
+        r.required("radius");
+        const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
+        const auto a = read_angle_range(r, "angle");
+        r.required("height");
+        const auto h = read_range(r, "height", {0.0, 1.0});
+        c.r0 = rr[0];
+        c.r1 = rr[1];
+        c.a0 = a[0];
+        c.a1 = a[1];
+        c.h0 = h[0];
+        c.h1 = h[1];
+    } else {
+        r.allow({"type", "center", "radius", "longitude", "latitude", "axes", "tessellate"},
+                "for bounds type \"spherical\"");
+        SphericalShell& s = b.sphere;
+        s.center = r.vec3("center", glm::dvec3(0.0));
+        r.required("radius");
+        const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
+        const auto lon = read_angle_range(r, "longitude");
+        const auto lat = read_range(r, "latitude", {-90.0, 90.0}, Range::closed(-90.0, 90.0));
+        s.r0 = rr[0];
+        s.r1 = rr[1];
+        s.lon0 = lon[0];
+        s.lon1 = lon[1];
+        s.lat0 = lat[0];
+        s.lat1 = lat[1];
+        if (const Json* ax = r.find("axes")) {
+            const std::string p = r.path("axes");
+            const Context& ctx = r.context();
+            if (!ax->is_array() || ax->size() != 3)
+                ctx.fail(p, "expected 3 names, a permutation of \"longitude\", \"latitude\", \"radius\"");
+            std::array<bool, 3> used{false, false, false};
+            for (std::size_t i = 0; i < 3; ++i) {
+                const Json& e = (*ax)[i];
+                const std::string ep = p + "[" + std::to_string(i) + "]";
+                const std::string name = e.is_string() ? e.get<std::string>() : "";
+                const int k = name == "longitude" ? 0 : name == "latitude" ? 1 : name == "radius" ? 2 : -1;
+                if (k < 0) ctx.fail(ep, "expected \"longitude\", \"latitude\" or \"radius\", got " + describe(e));
+                if (used[std::size_t(k)]) ctx.fail(ep, "\"" + name + "\" is given twice");
+                used[std::size_t(k)] = true;
+                s.axes[i] = k;
+            }
+        }
+    }
+    b.tessellate = int(r.integer("tessellate", 0, Range::at_least(3)));
+}
+
 BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     using T = BoundsSpec::Type;
     ObjectReader r(v, path, ctx);
     BoundsSpec b;
     b.type = r.choice<T>("type", T::Box,
                          {{"box", T::Box}, {"mesh", T::Mesh}, {"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
-    const Range radius = Range::non_negative();
     switch (b.type) {
         case T::Box: break;
         case T::Mesh:
             r.allow({"type", "file"}, "for bounds type \"mesh\"");
             b.mesh = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
             return b;
-        case T::Cylindrical: {
-            r.allow({"type", "center", "radius", "angle", "height", "tessellate"}, "for bounds type \"cylindrical\"");
-            CylindricalShell& c = b.cylinder;
-            c.center = r.vec3("center", glm::dvec3(0.0));
-            const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
-            const auto a = read_angle_range(r, "angle");
-            const auto h = read_range(r, "height", {0.0, 1.0});
-            c.r0 = rr[0];
-            c.r1 = rr[1];
-            c.a0 = a[0];
-            c.a1 = a[1];
-            c.h0 = h[0];
-            c.h1 = h[1];
-            b.tessellate = int(r.integer("tessellate", 0, Range::at_least(3)));
+        case T::Cylindrical:
+        case T::Spherical:
+            read_shell(r, b);
             return b;
-        }
-        case T::Spherical: {
-            r.allow({"type", "center", "radius", "longitude", "latitude", "axes", "tessellate"},
-                    "for bounds type \"spherical\"");
-            SphericalShell& s = b.sphere;
-            s.center = r.vec3("center", glm::dvec3(0.0));
-            const auto rr = read_range(r, "radius", {0.0, 1.0}, radius);
-            const auto lon = read_angle_range(r, "longitude");
-            const auto lat = read_range(r, "latitude", {-90.0, 90.0}, Range::closed(-90.0, 90.0));
-            s.r0 = rr[0];
-            s.r1 = rr[1];
-            s.lon0 = lon[0];
-            s.lon1 = lon[1];
-            s.lat0 = lat[0];
-            s.lat1 = lat[1];
-            if (const Json* ax = r.find("axes")) {
-                const std::string p = r.path("axes");
-                if (!ax->is_array() || ax->size() != 3)
-                    ctx.fail(p, "expected 3 names, a permutation of \"longitude\", \"latitude\", \"radius\"");
-                std::array<bool, 3> used{false, false, false};
-                for (std::size_t i = 0; i < 3; ++i) {
-                    const Json& e = (*ax)[i];
-                    const std::string ep = p + "[" + std::to_string(i) + "]";
-                    const std::string name = e.is_string() ? e.get<std::string>() : "";
-                    const int k = name == "longitude" ? 0 : name == "latitude" ? 1 : name == "radius" ? 2 : -1;
-                    if (k < 0) ctx.fail(ep, "expected \"longitude\", \"latitude\" or \"radius\", got " + describe(e));
-                    if (used[std::size_t(k)]) ctx.fail(ep, "\"" + name + "\" is given twice");
-                    used[std::size_t(k)] = true;
-                    s.axes[i] = k;
-                }
-            }
-            b.tessellate = int(r.integer("tessellate", 0, Range::at_least(3)));
-            return b;
-        }
     }
     r.allow({"type", "min", "max"}, "for bounds type \"box\"");
     b.min = r.optional_vec3("min");
@@ -844,6 +856,17 @@ std::string read_text(const fs::path& path, const Context& ctx) {
 fs::path absolute_dir(const fs::path& dir) { return dir.empty() ? fs::current_path() : fs::absolute(dir); }
 
 }  // namespace
+
+BoundsSpec parse_shell(const std::string& json_text, const std::string& name) {
+    using T = BoundsSpec::Type;
+    const Context ctx(name);
+    const Json json = json_reader::parse_json(json_text, name);
+    ObjectReader r(json, "", ctx);
+    BoundsSpec b;
+    b.type = r.required_choice<T>("type", {{"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
+    read_shell(r, b);
+    return b;
+}
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& base_dir, const std::string& name,
                   const std::vector<std::string>& overrides) {

@@ -19,4 +19,10 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<std::strin
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& base_dir,
                   const std::string& name, const std::vector<std::string>& overrides = {});
 
+// A curvilinear shell on its own (`volref resample --shell`, the `volref_bounds` key of its NRRD files):
+// the scene's volume.bounds object with "type" "cylindrical" or "spherical" (required here), read by the
+// same function and rules as in a scene. `name` is used in messages: "--shell: radius: required".
+// Returns type, cylinder or sphere, and tessellate.
+BoundsSpec parse_shell(const std::string& json_text, const std::string& name);
+
 }  // namespace volref

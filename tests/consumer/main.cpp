@@ -1,9 +1,9 @@
-// Renders a constant box with the installed library and checks the closed form
-// alpha = 1 - (1 - a)^(L / l) = 1 - 0.5^2 = 0.75 for a chord of 2, a = 0.5, l = 1.
+// Renders a constant box to memory with the installed core library (volref::volref_core alone) and
+// checks the closed form alpha = 1 - (1 - a)^(L / l) = 1 - 0.5^2 = 0.75 for a chord of 2, a = 0.5, l = 1.
 #include <cmath>
 #include <cstdio>
 
-#include "volref.h"
+#include "volref_core.h"
 
 int main() {
     volref::Scene s;

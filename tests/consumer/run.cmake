@@ -1,4 +1,5 @@
-# ctest: install the built volref into a scratch prefix, then configure, build and run the consumer.
+# ctest: install the built volref into a scratch prefix, then configure, build and run the consumer,
+# which links volref::volref_core alone: it must load none of the tools' libraries.
 #   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -P run.cmake
 file(REMOVE_RECURSE ${WORK_DIR})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix
@@ -18,4 +19,18 @@ endif()
 execute_process(COMMAND ${WORK_DIR}/build/consumer RESULT_VARIABLE rc)
 if(rc)
   message(FATAL_ERROR "the consumer's render was wrong: ${rc}")
+endif()
+find_program(LDD ldd)
+if(LDD)
+  execute_process(COMMAND ${LDD} ${WORK_DIR}/build/consumer OUTPUT_VARIABLE libs RESULT_VARIABLE rc)
+  if(rc)
+    message(FATAL_ERROR "ldd failed on the consumer: ${rc}")
+  endif()
+  string(REGEX MATCHALL "[^\n]*(volref_tools|OpenImageIO|OpenEXR|Imath|ceres|glog|gflags)[^\n]*" bad "${libs}")
+  if(bad)
+    message(FATAL_ERROR "the consumer links only volref::volref_core but loads: ${bad}")
+  endif()
+  if(NOT libs MATCHES "libvolref_core\\.so")
+    message(FATAL_ERROR "the consumer does not load libvolref_core.so:\n${libs}")
+  endif()
 endif()

@@ -10,9 +10,9 @@
 
 #include "TestScenes.h"
 #include "core/Error.h"
-#include "core/integrate/AdaptiveQuadrature.h"
-#include "core/integrate/CellCubic.h"
-#include "core/integrate/StepDoubling.h"
+#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/integrate/adaptive/CellCubic.h"
+#include "core/integrate/fixed/StepDoubling.h"
 #include "core/render/PreparedScene.h"
 #include "core/sample/Trilinear.h"
 #include "core/scene/SceneLoader.h"

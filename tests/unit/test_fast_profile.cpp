@@ -1,4 +1,4 @@
-// The fast profile (render.profile "fast", core/integrate/FastProfile.h): the reference's scene and
+// The fast profile (render.profile "fast", core/integrate/packet/FastProfile.h): the reference's scene and
 // formulas on float SIMD lanes, with early termination at kFastTransmittanceCutoff. Checked against
 // the reference render (a second method, double precision throughout) and against a closed form.
 #include <gtest/gtest.h>

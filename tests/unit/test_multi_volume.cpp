@@ -6,12 +6,12 @@
 #include <string>
 
 #include "TestScenes.h"
+#include "core/Angles.h"
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 #include "geometry/CropRegions.h"
-#include "geometry/VolumeTransform.h"
 
 using namespace volref;
 using namespace volref::test;

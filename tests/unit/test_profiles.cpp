@@ -1,4 +1,4 @@
-// Mirror profiles (render.profile, core/integrate/Profile.h) against hand calculations: a constant or
+// Mirror profiles (render.profile, core/integrate/profiles/Profile.h) against hand calculations: a constant or
 // linear box seen along -z by one orthographic pixel, each profile's formula worked out below.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 
 #include "TestScenes.h"
 #include "core/Error.h"
-#include "core/integrate/SampleRecorder.h"
+#include "core/integrate/march/SampleRecorder.h"
 #include "core/render/PreparedScene.h"
 
 using namespace volref;

@@ -1151,10 +1151,16 @@ TEST(SceneLoaderBounds, ShellsAndMeshes) {
     EXPECT_EQ(c.volume().bounds.cylinder.a1, 420.0);
     EXPECT_EQ(c.volume().bounds.cylinder.h0, -1.0);
     EXPECT_EQ(c.volume().bounds.tessellate, 64);
-    const Scene d = parse(volume_with(R"("bounds": {"type": "cylindrical"})"));
-    EXPECT_EQ(d.volume().bounds.cylinder.r1, 1.0);
+    const Scene d = parse(volume_with(R"("bounds": {"type": "cylindrical", "radius": [0, 1], "height": [0, 2]})"));
+    EXPECT_EQ(d.volume().bounds.cylinder.center, glm::dvec3(0.0));
+    EXPECT_EQ(d.volume().bounds.cylinder.a0, 0.0);
     EXPECT_EQ(d.volume().bounds.cylinder.a1, 360.0);
+    EXPECT_EQ(d.volume().bounds.cylinder.h1, 2.0);
     EXPECT_EQ(d.volume().bounds.tessellate, 0);
+    const Scene e = parse(volume_with(R"("bounds": {"type": "spherical", "radius": [0, 1]})"));
+    EXPECT_EQ(e.volume().bounds.sphere.lon1, 360.0);
+    EXPECT_EQ(e.volume().bounds.sphere.lat0, -90.0);
+    EXPECT_EQ(e.volume().bounds.sphere.axes, (std::array<int, 3>{0, 1, 2}));
     const Scene s = parse(volume_with(
         R"("bounds": {"type": "spherical", "radius": [1, 2], "longitude": [0, 90], "latitude": [-30, 60], "axes": ["radius", "longitude", "latitude"]})"));
     EXPECT_EQ(s.volume().bounds.type, BoundsSpec::Type::Spherical);
@@ -1168,23 +1174,86 @@ TEST(SceneLoaderBounds, ShellsAndMeshes) {
 }
 
 TEST(SceneLoaderBounds, Errors) {
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [2, 1]})"), "volume.bounds.radius",
-                           "lo < hi"));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [-1, 1]})"),
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [2, 1], "height": [0, 1]})"),
+                           "volume.bounds.radius", "lo < hi"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [-1, 1], "height": [0, 1]})"),
                            "volume.bounds.radius[0]", ">= 0"));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "angle": [0, 400]})"), "volume.bounds.angle",
-                           "at most 360"));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "latitude": [-100, 0]})"),
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "angle": [0, 400]})"),
+                           "volume.bounds.angle", "at most 360"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "radius": [0, 1], "latitude": [-100, 0]})"),
                            "volume.bounds.latitude[0]", ""));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "axes": ["radius", "radius", "latitude"]})"),
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "radius": [0, 1], "axes": ["radius", "radius", "latitude"]})"),
                            "volume.bounds.axes[1]", "given twice"));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "height": [0, 1]})"), "volume.bounds.height",
-                           "unknown key"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical", "radius": [0, 1], "height": [0, 1]})"),
+                           "volume.bounds.height", "unknown key"));
+    // A shell places the samples: its extent has no default.
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "height": [0, 1]})"), "volume.bounds.radius",
+                           "required"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [0, 1]})"), "volume.bounds.height",
+                           "required"));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "spherical"})"), "volume.bounds.radius", "required"));
+    // An unknown key is reported before a missing one (it may be the missing one, misspelt).
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radious": [0, 1]})"),
+                           "volume.bounds.radious", "unknown key"));
     EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "mesh"})"), "volume.bounds.file", "required"));
     EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "box", "tessellate": 8})"), "volume.bounds.tessellate",
                            "unknown key"));
-    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "tessellate": 2})"),
-                           "volume.bounds.tessellate", ""));
+    EXPECT_TRUE(fails_with(volume_with(R"("bounds": {"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "tessellate": 2})"),
+                           "volume.bounds.tessellate", ">= 3"));
+}
+
+// volref resample --shell (and the volref_bounds key of its files) and a scene's volume.bounds read a
+// shell with one function: the same input is accepted or rejected alike, and a rejection is the same
+// message after the path, "--shell: <key>: <problem>" against "scene.json: volume.bounds.<key>: <problem>".
+TEST(SceneLoaderBounds, ShellAloneReadsAsInAScene) {
+    const std::vector<std::string> bad = {
+        R"({"type": "cylindrical", "radius": [2, 1], "height": [0, 1]})",
+        R"({"type": "cylindrical", "radius": [-1, 1], "height": [0, 1]})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [1, 1]})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "angle": [0, 400]})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "longitude": [0, 90]})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "tessellate": 2})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "tessellate": 4.5})",
+        R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "center": [0, 0]})",
+        R"({"type": "cylindrical", "height": [0, 1]})",
+        R"({"type": "cylindrical", "radius": [0, 1]})",
+        R"({"type": "cylindrical", "radious": [0, 1], "height": [0, 1]})",
+        R"({"type": "spherical"})",
+        R"({"type": "spherical", "radius": [0, 1], "latitude": [-100, 0]})",
+        R"({"type": "spherical", "radius": [0, 1], "latitude": [10, 0]})",
+        R"({"type": "spherical", "radius": [0, 1], "longitude": [0, 361]})",
+        R"({"type": "spherical", "radius": [0, 1], "axes": ["radius", "radius", "latitude"]})",
+        R"({"type": "spherical", "radius": [0, 1], "axes": ["radius", "longitude"]})",
+        R"({"type": "spherical", "radius": [0, 1], "axes": ["radius", "longitude", 3]})",
+        R"({"type": "spherical", "radius": [0, 1], "height": [0, 1]})",
+        R"({"type": "spherical", "radius": [0, "1"]})",
+    };
+    for (const std::string& shell : bad) {
+        const std::string in_scene = message_of(volume_with(R"("bounds": )" + shell));
+        const std::string alone = error_of([&] { parse_shell(shell, "--shell"); });
+        const std::string scene_prefix = "scene.json: volume.bounds.", shell_prefix = "--shell: ";
+        ASSERT_EQ(in_scene.rfind(scene_prefix, 0), 0u) << shell << "\n" << in_scene;
+        ASSERT_EQ(alone.rfind(shell_prefix, 0), 0u) << shell << "\n" << alone;
+        EXPECT_EQ(alone.substr(shell_prefix.size()), in_scene.substr(scene_prefix.size())) << shell;
+    }
+    // Accepted alike, with the same values.
+    const std::string good =
+        R"({"type": "spherical", "center": [1, 2, 3], "radius": [0.5, 2], "longitude": [300, 420], "latitude": [-30, 60], "axes": ["radius", "longitude", "latitude"], "tessellate": 16})";
+    const BoundsSpec a = parse_shell(good, "--shell"), b = parse(volume_with(R"("bounds": )" + good)).volume().bounds;
+    EXPECT_EQ(a.type, BoundsSpec::Type::Spherical);
+    EXPECT_EQ(a.type, b.type);
+    EXPECT_EQ(a.sphere.center, b.sphere.center);
+    EXPECT_EQ(a.sphere.r0, b.sphere.r0);
+    EXPECT_EQ(a.sphere.lon1, b.sphere.lon1);
+    EXPECT_EQ(a.sphere.lat0, b.sphere.lat0);
+    EXPECT_EQ(a.sphere.axes, b.sphere.axes);
+    EXPECT_EQ(a.tessellate, b.tessellate);
+    // Alone, the type is required and must be a shell.
+    EXPECT_EQ(error_of([] { parse_shell(R"({"radius": [0, 1]})", "--shell"); }), "--shell: type: required");
+    EXPECT_EQ(error_of([] { parse_shell(R"({"type": "box"})", "s.json"); }),
+              "s.json: type: expected one of \"cylindrical\", \"spherical\", got \"box\"");
+    EXPECT_EQ(error_of([] { parse_shell("[1]", "--shell"); }).rfind("--shell: ", 0), 0u);
+    EXPECT_EQ(error_of([] { parse_shell(R"({"type": "spherical")", "--shell"); }).rfind("--shell: line 1", 0), 0u);
 }
 }  // namespace
 }  // namespace volref

@@ -24,6 +24,7 @@
 #include "core/grid/Resample.h"
 #include "core/io/NrrdWriter.h"
 #include "core/io/VolumeReader.h"
+#include "core/scene/SceneLoader.h"
 #include "core/sample/ShellSampler.h"
 #include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"
@@ -788,7 +789,7 @@ TEST_F(ResampleCommand, BadInputIsOneLineAndNoOutput) {
                  "--shell: line 1", out);
     expect_error(base + " --to cylindrical --dims 4,4,4 --shell '{\"type\": \"cylindrical\", \"radius\": [2, 1], "
                         "\"height\": [0, 1]}'",
-                 "--shell: radius: expected [r0, r1] with 0 <= r0 < r1", out);
+                 "--shell: radius: expected [lo, hi] with lo < hi, got [2,1]", out);
     expect_error(base + " --to cylindrical --dims 4,4,4 --shell '{\"type\": \"cylindrical\", \"radius\": [1, 2], "
                         "\"height\": [0, 1], \"longitude\": [0, 90]}'",
                  "longitude", out);
@@ -796,7 +797,7 @@ TEST_F(ResampleCommand, BadInputIsOneLineAndNoOutput) {
                  "expected \"cylindrical\" for --to cylindrical", out);
     expect_error(base + " --to spherical --dims 4,4,4 --shell '{\"type\": \"spherical\", \"radius\": [1, 2], "
                         "\"axes\": [\"radius\", \"radius\", \"latitude\"]}'",
-                 "--shell: axes: expected a permutation", out);
+                 "--shell: axes[1]: \"radius\" is given twice", out);
     expect_error(base + " --to cylindrical --dims 4,4,4 --shell " + (dir_ / "none.json").string(), "none.json: cannot read file",
                  out);
     expect_error(base + " --to cylindrical --dims 4,4,4 --interpolation cubic" + shell, "--interpolation", out);
@@ -820,6 +821,33 @@ TEST_F(ResampleCommand, BadInputIsOneLineAndNoOutput) {
     const Result r = run("resample " + in.string() + " " + in.string() + " --to cylindrical --dims 4,4,4 --type f16" + shell);
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(fs::file_size(in), before);
+}
+
+// --shell is read by the scene loader's shell reader (parse_shell): a bad shell fails as in a scene, with
+// the same problem after the path, and the radius (and a cylinder's height) is required in both.
+TEST_F(ResampleCommand, ShellErrorsAreTheScenesErrors) {
+    const fs::path in = write_cartesian(), out = dir_ / "out.nrrd";
+    const std::string base = "resample " + in.string() + " " + out.string();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"cylindrical", R"({"type": "cylindrical", "radius": [0, 1]})"},
+        {"cylindrical", R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "tessellate": 1})"},
+        {"cylindrical", R"({"type": "cylindrical", "radius": [0, 1], "height": [0, 1], "colour": 1})"},
+        {"spherical", R"({"type": "spherical", "radius": [0, 1], "latitude": [-100, 0]})"},
+        {"spherical", R"({"type": "spherical", "radius": [0, 1], "axes": ["radius", "longitude", "up"]})"},
+    };
+    for (const auto& [to, shell] : cases) {
+        const std::string alone = error_of([&] { parse_shell(shell, "--shell"); });
+        const std::string in_scene = error_of([&] {
+            parse_scene(R"({"volume": {"source": "v.nrrd", "bounds": )" + shell + "}}", dir_, "scene.json");
+        });
+        const std::string scene_prefix = "scene.json: volume.bounds.";
+        ASSERT_EQ(in_scene.rfind(scene_prefix, 0), 0u) << in_scene;
+        EXPECT_EQ(alone, "--shell: " + in_scene.substr(scene_prefix.size()));
+        const Result r = run(base + " --to " + to + " --dims 4,4,4 --shell '" + shell + "'");
+        EXPECT_EQ(r.status, 1) << shell;
+        EXPECT_EQ(r.err, "volref: error: " + alone + "\n") << shell;
+        EXPECT_FALSE(fs::exists(out));
+    }
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 #include <hwy/targets.h>
 
 #include "TestScenes.h"
-#include "core/integrate/CompositeIntegrator.h"
+#include "core/integrate/fixed/CompositeIntegrator.h"
 #include "core/render/PreparedScene.h"
 
 using namespace volref;

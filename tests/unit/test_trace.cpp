@@ -1,5 +1,5 @@
 // volref trace: every sample of one pixel's ray, recorded by the integrator's own loop
-// (Integrator::integrate_traced, core/integrate/SampleRecorder.h; core/explain/PixelTrace.h).
+// (Integrator::integrate_traced, core/integrate/march/SampleRecorder.h; core/explain/PixelTrace.h).
 // The last row is the rendered pixel; the rows follow the closed forms of sample placement
 // (conventions section 4) and of the optical model (section 3).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The vtk-cpu profile (core/integrate/VtkCpuProfile.h): vtkFixedPointVolumeRayCastMapper's 15-bit
+// The vtk-cpu profile (core/integrate/profiles/VtkCpuProfile.h): vtkFixedPointVolumeRayCastMapper's 15-bit
 // arithmetic checked against numbers worked out by hand in the comments (integer arithmetic, one
 // unit = 1/32768), VTK's own clipping range (printed by python3-vtk9), and `volref trace` for every
 // mirror profile (the last row is the rendered pixel, bit for bit). The images themselves are
@@ -11,7 +11,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/explain/PixelTrace.h"
-#include "core/integrate/VtkCpuProfile.h"
+#include "core/integrate/profiles/VtkCpuProfile.h"
 #include "core/render/PreparedScene.h"
 #include "core/render/Renderer.h"
 #include "transfer/Classifier.h"

@@ -1,0 +1,147 @@
+// CompositeIntegrator's SIMD side: when the scene allows the packet path (PacketComposite.h), and
+// the hand-over of packets to it.
+#include "core/integrate/fixed/CompositeIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/integrate/packet/FastProfile.h"
+#include "core/sample/GradientField.h"
+#include "transfer/Shader.h"
+#include "transfer/TransferFunction.h"
+
+namespace volref {
+
+CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+    const SamplePipeline& p = ctx.pipeline;
+    const bool fast = ctx.render.profile == ProfileId::Fast;
+    // Where the packet path does not apply the reference takes the scalar path; the fast profile has
+    // no scalar path and says why (FastProfile.h).
+    auto unavailable = [&](const char* reason) {
+        if (fast) fast_profile_unavailable(reason);
+    };
+    const TransferFunction* tf = p.stages().transfer_function;
+    const VolumeSampler* sampler = p.cartesian_sampler();
+    if (!tf) {
+        unavailable("this volume is classified otherwise");
+        return;
+    }
+    if (!sampler) {
+        unavailable("this volume is not on a Cartesian grid");
+        return;
+    }
+    if (p.preclassified()) {
+        unavailable("this volume is pre-classified");
+        return;
+    }
+    if (sampler->interpolation() != Interpolation::Trilinear) {
+        unavailable("this volume is not trilinear");
+        return;
+    }
+    if (ctx.render.order != CompositeOrder::FrontToBack) {
+        unavailable("this scene composites back to front");
+        return;
+    }
+    const Volume& v = sampler->volume();
+    // Non-finite voxels: the scalar path, whose pipeline makes them transparent (docs/accuracy.md).
+    if (!all_finite(v.values)) {
+        unavailable("this volume has non-finite voxels");
+        return;
+    }
+    PacketCompositeInputs in;
+    const Volume* cached[3] = {nullptr, nullptr, nullptr};
+    if (tf->needs_gradient() || p.shaded()) {
+        const GradientField* field = p.stages().grid_gradient;
+        if (!field) {
+            unavailable("this volume's gradient is not a grid's");
+            return;
+        }
+        if (field->cached_component(0)) {
+            in.gradient = PacketCompositeInputs::Gradient::Cached;
+            for (int a = 0; a < 3; ++a) {
+                cached[a] = field->cached_component(a);
+                in.tables_double.cached_gradient[a] = cached[a]->values.data<double>();
+            }
+        } else if (field->scheme() == GradientSpec::Scheme::Central) {
+            in.gradient = PacketCompositeInputs::Gradient::Central;
+        } else if (field->scheme() == GradientSpec::Scheme::Forward) {
+            in.gradient = PacketCompositeInputs::Gradient::Forward;
+        } else {
+            unavailable("this volume's gradient scheme is not central or forward differences");
+            return;
+        }
+        for (int a = 0; a < 3; ++a) {
+            in.spacing[a] = v.spacing[a];
+            in.domain_lo[a] = v.domain_min()[a];
+            in.domain_hi[a] = v.domain_max()[a];
+        }
+    }
+    if (tf->needs_gradient()) {
+        in.tables_double.gradient_opacity_x = tf->gradient_opacity_function().xs().data();
+        in.tables_double.gradient_opacity_y = tf->gradient_opacity_function().ys().front().data();
+        in.gradient_opacity_rows = int(tf->gradient_opacity_function().xs().size());
+    }
+    if (const Shader* shader = p.shader()) {
+        const ShadingSpec& s = shader->spec();
+        if (shader->lights().size() > std::size_t(PacketCompositeInputs::kMaxPacketLights)) {
+            unavailable("this scene has more than 8 lights");
+            return;
+        }
+        in.shaded = true;
+        in.phong = s.model == ShadingSpec::Model::Phong;
+        in.two_sided = s.two_sided;
+        in.ka = s.ka;
+        in.kd = s.kd;
+        in.ks = s.ks;
+        in.n = s.n;
+        in.kc = s.kc;
+        in.kl = s.kl;
+        in.zero_gradient_tolerance = shader->zero_gradient_tolerance();
+        for (const LightSpec& light : shader->lights()) {
+            PacketCompositeInputs::Light& l = in.lights[in.light_count++];
+            l.headlight = light.type == LightSpec::Type::Headlight;
+            for (int c = 0; c < 3; ++c) {
+                l.direction[c] = light.direction[c];
+                l.color[c] = light.color[c];
+            }
+        }
+    }
+    in.voxels = v.values.raw();
+    in.voxel_type = v.values.type();
+    for (int a = 0; a < 3; ++a) {
+        in.dims[a] = v.dims[a];
+        in.origin[a] = v.origin[a];
+        in.inv_spacing[a] = 1.0 / v.spacing[a];
+    }
+    in.normalized = tf->normalized();
+    in.lo = tf->window()[0];
+    in.inv_width = tf->inverse_window_width();
+    // std::array<double, N> rows are contiguous doubles (N per row).
+    in.tables_double.color_x = tf->color_function().xs().data();
+    in.tables_double.color_y = tf->color_function().ys().front().data();
+    in.color_rows = int(tf->color_function().xs().size());
+    in.tables_double.opacity_x = tf->opacity_function().xs().data();
+    in.tables_double.opacity_y = tf->opacity_function().ys().front().data();
+    in.opacity_rows = int(tf->opacity_function().xs().size());
+    in.unit_distance = tf->unit_distance();
+    in.step = ctx.step;
+    in.termination = termination();
+    in.macrocells = ctx.macrocells;
+    if (fast) {
+        fast_copies_ = std::make_unique<FloatCopies>();
+        make_fast(in, v, cached, *fast_copies_);
+    }
+    packet_ = in;
+}
+
+CompositeIntegrator::~CompositeIntegrator() = default;
+
+void CompositeIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                                           int count) const {
+    if (packet_)
+        composite_packet(*packet_, rays, intervals, out, count);
+    else
+        Integrator::integrate_packet(rays, intervals, out, count);
+}
+
+}  // namespace volref

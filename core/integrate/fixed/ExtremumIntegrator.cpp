@@ -1,0 +1,116 @@
+#include "core/integrate/fixed/ExtremumIntegrator.h"
+
+#include "core/integrate/packet/FastProfile.h"
+#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/Accumulators.h"
+
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+
+namespace volref {
+
+ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
+    const bool fast = ctx.render.profile == ProfileId::Fast;
+    const VolumeSampler* sampler = ctx.pipeline.cartesian_sampler();
+    auto unavailable = [&](const char* reason) {
+        if (fast) fast_profile_unavailable(reason);
+    };
+    if (!sampler) {
+        unavailable("this volume is not on a Cartesian grid");
+        return;
+    }
+    if (sampler->interpolation() != Interpolation::Trilinear) {
+        unavailable("this volume is not trilinear");
+        return;
+    }
+    const Volume& v = sampler->volume();
+    // Non-finite voxels: the scalar path, which ignores them (docs/accuracy.md).
+    if (!all_finite(v.values)) {
+        unavailable("this volume has non-finite voxels");
+        return;
+    }
+    PacketExtremumInputs in;
+    in.voxels = v.values.raw();
+    in.voxel_type = v.values.type();
+    for (int a = 0; a < 3; ++a) {
+        in.dims[a] = v.dims[a];
+        in.origin[a] = v.origin[a];
+        in.inv_spacing[a] = 1.0 / v.spacing[a];
+    }
+    in.step = ctx.step;
+    in.maximum = maximum;
+    in.macrocells = ctx.macrocells;  // skipping (PreparedVolume builds the grid for mip / minip)
+    if (fast) {
+        fast_copies_ = std::make_unique<FloatCopies>();
+        fast_voxels(v, *fast_copies_, &in.voxels, &in.voxel_type);
+        in.fast = true;
+    }
+    packet_ = in;
+}
+
+ExtremumIntegrator::~ExtremumIntegrator() = default;
+
+void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
+                                          int count) const {
+    if (!packet_) return Integrator::integrate_packet(rays, intervals, out, count);
+    RayExtremum e[kMaxPacketRays];
+    extremum_packet(*packet_, rays, intervals, e, count);
+    for (int i = 0; i < count; ++i) out[i] = pixel(rays[i], e[i].any, e[i].t);
+}
+
+PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    if (packet_ && packet_->fast) {  // the fast profile has only its packet path
+        PixelValue out;
+        integrate_packet(&ray, &intervals, &out, 1);
+        return out;
+    }
+    NoRecording rec;
+    return integrate_impl(ray, intervals, rec);
+}
+
+PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                                SampleRecorder& recorder) const {
+    if (packet_ && packet_->fast) fast_profile_not_traced();
+    Recording rec{recorder};
+    return integrate_impl(ray, intervals, rec);
+}
+
+// With Rec::kOn each sample is also classified (unshaded, for the record) and the record carries the
+// extremum so far and the pixel it gives; the value is the one the plain loop reads (the same sampler
+// call at the same point).
+template <class Rec>
+PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    Extremum<Scalar> acc(maximum_);
+    [[maybe_unused]] glm::dvec4 so_far(0.0);
+    for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        double v;
+        if constexpr (Rec::kOn) {
+            rec.begin(r, s.t0, s.t1);
+            v = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Unshaded, r.sample).value;
+        } else {
+            v = ctx_.field(ray, s.midpoint());
+        }
+        [[maybe_unused]] const bool taken = acc.add(true, v, s.midpoint());
+        if constexpr (Rec::kOn) {
+            if (taken) so_far = pixel(ray, true, acc.where()).rgba;
+            r.running = acc.value();
+            r.accumulated = so_far;
+            rec.recorder.record(r);
+        }
+        return true;
+    });
+    return pixel(ray, acc.any(), acc.where());
+}
+
+PixelValue ExtremumIntegrator::pixel(const Ray& ray, bool any, double t_best) const {
+    PixelValue out;
+    if (any) {
+        const PipelineSample p = ctx_.pipeline.sample(ray, t_best, SamplePipeline::Use::Unshaded);
+        out.rgba = glm::dvec4(p.opacity * p.color, p.opacity);
+    }
+    return out;
+}
+
+}  // namespace volref

@@ -1,0 +1,128 @@
+#include "core/integrate/fixed/FirstHitIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/integrate/adaptive/AdaptiveCellWalk.h"
+#include "core/integrate/adaptive/CellCubic.h"
+#include "core/integrate/march/Segments.h"
+#include "core/sample/VolumeSampler.h"
+
+namespace volref {
+
+namespace {
+
+int sign(double x) { return (x > 0.0) - (x < 0.0); }
+
+}  // namespace
+
+std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
+                                           double iso) {
+    // Non-finite values (NaN, +-Inf voxels) never cross: parts with a non-finite end are passed over.
+    auto g = [&](double t) { return sampler.trilinear(ray.at(t)) - iso; };
+    if (g(t0) == 0.0) return t0;
+    std::vector<double> cuts;
+    grid_cuts(ray, t0, t1, sampler.volume(), 0.0, cuts);
+    for (std::size_t p = 0; p + 1 < cuts.size(); ++p) {
+        const double ta = cuts[p], tb = cuts[p + 1];
+        double ex[2];
+        const int ne = cubic_extrema(cell_cubic(sampler, ray, ta, tb), tb - ta, ex);
+        // The monotone parts' ends: ta, ta + extrema, tb.
+        double ts[4];
+        int n = 0;
+        ts[n++] = ta;
+        for (int k = 0; k < ne; ++k)
+            if (ta + ex[k] > ts[n - 1] && ta + ex[k] < tb) ts[n++] = ta + ex[k];
+        ts[n++] = tb;
+        double ga = g(ta);
+        for (int m = 0; m + 1 < n; ++m) {
+            const double a = ts[m], b = ts[m + 1], gb = g(b);
+            if (!std::isfinite(ga) || !std::isfinite(gb)) {
+                ga = gb;
+                continue;
+            }
+            if (ga == 0.0) return a;
+            if (gb == 0.0) return b;
+            if (sign(ga) != sign(gb)) return bisect_to_rounding(g, a, b, sign(ga));
+            ga = gb;
+        }
+    }
+    return std::nullopt;
+}
+
+FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+    const VolumeSampler* s = ctx.pipeline.cartesian_sampler();
+    if (s && s->interpolation() == Interpolation::Trilinear) trilinear_ = s;
+    adaptive_ = ctx.render.integrator == IntegrationMethod::Adaptive;
+    if (adaptive_ && !trilinear_)
+        throw Error("render.integrator: \"adaptive\" first-hit needs a Cartesian grid with trilinear interpolation "
+                    "(the crossing is a root of the cell's cubic)");
+}
+
+PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    const double iso = *ctx_.render.isovalue;
+    auto g = [&](double t) { return ctx_.field(ray, t) - iso; };
+    std::optional<double> hit;
+    for (const Interval& iv : intervals) {
+        if (adaptive_) {
+            hit = first_crossing_exact(*trilinear_, ray, iv.t0, iv.t1, iso);
+            if (hit) break;
+            continue;
+        }
+        const std::int64_t n = segment_count(iv, ctx_.step);
+        double ta = iv.t0, ga = g(ta);
+        if (ga == 0.0) {
+            hit = ta;
+            break;
+        }
+        for (std::int64_t k = 0; k < n && !hit; ++k) {
+            const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
+            if (!std::isfinite(ga) || !std::isfinite(gb)) {  // non-finite values never cross
+                ta = tb;
+                ga = gb;
+                continue;
+            }
+            if (gb == 0.0) {
+                hit = tb;
+            } else if (sign(gb) != sign(ga)) {
+                // Trilinear: the first root of the cell cubics inside the bracket, to rounding.
+                if (trilinear_) hit = first_crossing_exact(*trilinear_, ray, ta, tb, iso);
+                if (!hit) {
+                    // Bisection on [ta, tb]; ga keeps the sign at ta.
+                    double lo = ta, hi = tb, glo = ga;
+                    const double tol = conventions::kFirstHitRelativeTolerance * iv.length();
+                    for (int it = 0; it < 200 && hi - lo > tol; ++it) {
+                        const double m = 0.5 * (lo + hi), gm = g(m);
+                        if (gm == 0.0) {
+                            lo = hi = m;
+                            break;
+                        }
+                        if (sign(gm) == sign(glo)) {
+                            lo = m;
+                            glo = gm;
+                        } else {
+                            hi = m;
+                        }
+                    }
+                    hit = 0.5 * (lo + hi);
+                }
+            }
+            ta = tb;
+            ga = gb;
+        }
+        if (hit) break;
+    }
+    PixelValue out;
+    if (hit) {
+        out.rgba = glm::dvec4(ctx_.pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color, 1.0);
+        out.depth = *hit;
+    }
+    out.error = conventions::kRoundingErrorRelative * (1.0 + std::max({std::fabs(out.rgba.r), std::fabs(out.rgba.g),
+                                                                       std::fabs(out.rgba.b), std::fabs(out.rgba.a)}));
+    return out;
+}
+
+}  // namespace volref

@@ -1,0 +1,27 @@
+// LineIntegralIntegrator: the average and x-ray projections (conventions section 6).
+// With the midpoint samples of Segments.h, I = sum_k s(v_k) d_k (a compensated sum) and L = sum_k d_k,
+// where s is the transfer function's coordinate (the data value, or the normalised value for the
+// normalised domain):
+//   average: g = I / L,          pixel (g, g, g, 1);
+//   xray:    g = gain * I,       pixel (g, g, g, 1).
+// A ray with no interval is (0, 0, 0, 0).
+#pragma once
+#include "core/integrate/Integrator.h"
+#include "core/integrate/march/SampleRecorder.h"
+
+namespace volref {
+
+class LineIntegralIntegrator final : public Integrator {
+public:
+    LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : Integrator(ctx), mean_(mean) {}
+    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
+
+private:
+    template <class Rec>
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    bool mean_;
+};
+
+}  // namespace volref

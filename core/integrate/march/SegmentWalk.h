@@ -1,0 +1,150 @@
+// Walking a ray's segments (Segments.h) with empty-space skipping (conventions section 4): the
+// segments whose midpoints lie in an empty macrocell (MacrocellGrid.h) are passed over, every other
+// segment is visited exactly as without skipping, in the same order. Shared by the scalar
+// CompositeIntegrator and the SIMD packet path, so both visit the same segments.
+//
+// Extremum mode (mip / minip): instead of the empty flag, a macrocell is passed over when no value it
+// can reconstruct beats the ray's extremum so far, *extremum (read each time the walk enters a
+// macrocell; NaN, before the first sample, beats nothing): value_bounds(m).hi <= *extremum for the
+// maximum, value_bounds(m).lo >= *extremum for the minimum. The extremum only takes strictly better
+// values (the first of equal ones wins), so the skipped segments could not have changed it, nor
+// where it was first reached.
+//
+// Per interval, per run: the macrocell m of segment k's midpoint (macrocell_of, the sampler's own
+// placement); the segments up to where the ray leaves m (exit_distance, an estimate); if m is empty
+// the estimate is checked (bisected back when too long, extended by doubling when too short) and the
+// run is skipped: each axis' macrocell index is monotone in k (ray.at, the index map, floor and the
+// midpoints are monotone in floating point), so every segment between two in m is in m.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/camera/Ray.h"
+#include "core/integrate/march/Segments.h"
+#include "core/sample/MacrocellGrid.h"
+
+namespace volref {
+
+namespace segment_walk {
+
+// The smallest k in [0, n] whose midpoint t0 + (k + 1/2) h is >= t, estimated (rounded); the walks
+// below check what they skip against macrocell_at.
+inline std::int64_t segment_at_or_after(const Interval& iv, double step, double t, std::int64_t n) {
+    const double k = std::ceil((t - iv.t0) / step - 0.5);
+    if (!(k > 0.0)) return 0;  // also -inf and NaN
+    if (k >= double(n)) return n;
+    return std::int64_t(k);
+}
+
+// The macrocell in which the pipeline samples segment k (at ray.at(midpoint)).
+inline MacrocellGrid::Index macrocell_of(const MacrocellGrid& grid, const Ray& ray, const Interval& iv, double step,
+                                  std::int64_t k, std::int64_t n) {
+    return grid.macrocell_at(ray.at(segment(iv, step, k, n).midpoint()));
+}
+
+// The segments j of one interval that lie in macrocell m form one run (the macrocell index of the
+// midpoints is monotone in j); given `in` in it and `out` (> in) past it or n, the last one in it.
+template <typename InM>
+std::int64_t last_in_run(std::int64_t in, std::int64_t out, InM&& in_m) {
+    while (out - in > 1) {
+        const std::int64_t mid = in + (out - in) / 2;
+        (in_m(mid) ? in : out) = mid;
+    }
+    return in;
+}
+
+}  // namespace segment_walk
+
+// The segments of `intervals` front to back, without those in empty macrocells (all of them when
+// `grid` is null). Usage: `Segment s; while (walk.next(s)) ...`.
+class ForwardSegmentWalk {
+public:
+    ForwardSegmentWalk() = default;
+    ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step)
+        : grid_(grid), ray_(&ray), intervals_(&intervals), step_(step) {
+        if (!intervals.empty()) n_ = segment_count(intervals[0], step);
+    }
+    // Extremum mode (see the header comment): `extremum` is the ray's running maximum (`maximum`) or
+    // minimum, NaN until its first sample; the caller updates it between calls to next().
+    ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step,
+                       const double* extremum, bool maximum)
+        : ForwardSegmentWalk(grid, ray, intervals, step) {
+        extremum_ = extremum;
+        maximum_ = maximum;
+    }
+
+    bool next(Segment& s) {
+        using namespace segment_walk;
+        while (iv_ < intervals_->size()) {
+            const Interval& iv = (*intervals_)[iv_];
+            if (k_ < end_) {
+                s = segment(iv, step_, k_, n_);
+                ++k_;
+                return true;
+            }
+            if (k_ >= n_) {
+                if (++iv_ < intervals_->size()) n_ = segment_count((*intervals_)[iv_], step_);
+                k_ = end_ = 0;
+                continue;
+            }
+            if (!grid_) {
+                end_ = n_;
+                continue;
+            }
+            const MacrocellGrid::Index m = macrocell_of(*grid_, *ray_, iv, step_, k_, n_);
+            // The estimate: segments k .. end - 1 have their midpoints before the ray leaves m.
+            const std::int64_t end =
+                std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m), n_), k_ + 1, n_);
+            if (!skippable(m)) {
+                end_ = end;
+                if (extremum_) {
+                    // Extremum mode backs off on rays where the checks keep failing (the ray's
+                    // extremum is not yet beyond what the macrocells hold): after f failed checks in a
+                    // row the run is stretched to 2^min(f, 3) times its length, so such a ray pays for
+                    // one check per up to 8 macrocells. Visiting more segments never changes the result.
+                    end_ = std::min(n_, k_ + ((end - k_) << std::min(failed_checks_, 3)));
+                    ++failed_checks_;
+                }
+                continue;
+            }
+            failed_checks_ = 0;
+            auto in_m = [&](std::int64_t j) { return macrocell_of(*grid_, *ray_, iv, step_, j, n_) == m; };
+            std::int64_t in = end - 1, out = n_;  // the run's last segment is in [in, out)
+            if (in > k_ && !in_m(in)) {
+                out = in;  // the estimate is too long
+                in = k_;
+            } else {  // too short? gallop forward
+                for (std::int64_t d = 1; in + d < n_; d *= 2) {
+                    if (!in_m(in + d)) {
+                        out = in + d;
+                        break;
+                    }
+                    in += d;
+                }
+            }
+            k_ = end_ = last_in_run(in, out, in_m) + 1;  // every segment up to there lies in m: opacity 0
+        }
+        return false;
+    }
+
+private:
+    bool skippable(const MacrocellGrid::Index& m) const {
+        if (!extremum_) return grid_->empty(m);
+        const std::array<double, 2> b = grid_->value_bounds(m);
+        return maximum_ ? b[1] <= *extremum_ : b[0] >= *extremum_;  // false for a NaN extremum
+    }
+
+    const MacrocellGrid* grid_ = nullptr;
+    const double* extremum_ = nullptr;  // extremum mode
+    bool maximum_ = true;
+    int failed_checks_ = 0;  // extremum mode: failed checks in a row
+    const Ray* ray_ = nullptr;
+    const std::vector<Interval>* intervals_ = nullptr;
+    double step_ = 1.0;
+    std::size_t iv_ = 0;
+    std::int64_t k_ = 0, n_ = 0, end_ = 0;  // segments [k_, end_) are to be visited
+};
+
+}  // namespace volref

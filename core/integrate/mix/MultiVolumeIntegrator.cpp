@@ -1,0 +1,200 @@
+#include "core/integrate/mix/MultiVolumeIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "core/integrate/march/CompensatedSum.h"
+#include "core/integrate/march/SamplePipeline.h"
+#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/Accumulators.h"
+
+namespace volref {
+
+namespace {
+
+// A piece of the ray on which the same volumes are present.
+struct Piece {
+    Interval span;
+    std::vector<int> present;
+};
+
+// The pieces of the union of the volumes' intervals, front to back.
+std::vector<Piece> pieces(const std::vector<Interval>* intervals, std::size_t n) {
+    std::vector<double> cuts;
+    for (std::size_t k = 0; k < n; ++k)
+        for (const Interval& iv : intervals[k]) {
+            cuts.push_back(iv.t0);
+            cuts.push_back(iv.t1);
+        }
+    std::sort(cuts.begin(), cuts.end());
+    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    std::vector<Piece> out;
+    std::vector<std::size_t> cursor(n, 0);  // each volume's first interval that may contain the piece
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+        Piece p{{cuts[i], cuts[i + 1]}, {}};
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::vector<Interval>& ivs = intervals[k];
+            while (cursor[k] < ivs.size() && ivs[cursor[k]].t1 <= p.span.t0) ++cursor[k];
+            // Interval ends are cuts, so an interval either covers the whole piece or misses it.
+            if (cursor[k] < ivs.size() && ivs[cursor[k]].t0 <= p.span.t0) p.present.push_back(int(k));
+        }
+        if (!p.present.empty()) out.push_back(std::move(p));
+    }
+    return out;
+}
+
+// One segment of the mix: its optical depth and emitted colour, or opaque.
+struct Mixed {
+    double tau = 0.0;
+    glm::dvec3 color{0.0};
+    bool opaque = false;
+};
+
+struct Term {
+    double tau;
+    glm::dvec3 c;
+    bool operator<(const Term& o) const {
+        return std::tie(tau, c.r, c.g, c.b) < std::tie(o.tau, o.c.r, o.c.g, o.c.b);
+    }
+};
+
+}  // namespace
+
+MultiVolumeIntegrator::MultiVolumeIntegrator(std::vector<Member> volumes, const RenderSpec& render, double step)
+    : volumes_(std::move(volumes)), render_(render), step_(step) {}
+
+PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<Interval>* intervals) const {
+    const std::vector<Piece> ps = pieces(intervals, volumes_.size());
+    std::vector<Term> terms, opaque_terms;
+    // The mix at segment s of the volumes `present`.
+    auto mix = [&](const std::vector<int>& present, const Segment& s) {
+        terms.clear();
+        opaque_terms.clear();
+        for (int k : present) {
+            const SamplePipeline& pipeline = *volumes_[std::size_t(k)].pipeline;
+            const PipelineSample p = pipeline.sample(rays[k], s.midpoint(), SamplePipeline::Use::Composite);
+            if (p.opacity <= 0.0) continue;
+            if (p.opacity >= 1.0)
+                opaque_terms.push_back({0.0, p.color});
+            else
+                terms.push_back({optical_depth(p.opacity, s.length(), pipeline.classifier().unit_distance()), p.color});
+        }
+        Mixed m;
+        if (!opaque_terms.empty()) {
+            std::sort(opaque_terms.begin(), opaque_terms.end());
+            for (const Term& t : opaque_terms) m.color += t.c;
+            m.color /= double(opaque_terms.size());
+            m.opaque = true;
+        } else if (terms.size() == 1) {
+            m.tau = terms[0].tau;
+            m.color = terms[0].c;
+        } else if (!terms.empty()) {
+            std::sort(terms.begin(), terms.end());
+            glm::dvec3 weighted(0.0);
+            for (const Term& t : terms) {
+                m.tau += t.tau;
+                weighted += t.tau * t.c;
+            }
+            if (m.tau > 0.0) m.color = weighted / m.tau;
+        }
+        return m;
+    };
+
+    // The mixed segments composite as one medium's (march/Accumulators.h): opaque, or optical depth
+    // m.tau with alpha = -expm1(-m.tau).
+    auto add = [](auto& acc, const Mixed& m) {
+        const double c[3] = {m.color.r, m.color.g, m.color.b};
+        acc.add(true, m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), c);
+    };
+    PixelValue out;
+    if (render_.order == CompositeOrder::FrontToBack) {
+        Termination stop;
+        stop.test_alpha_above = render_.early_termination.has_value();
+        stop.alpha_above = render_.early_termination.value_or(1.0);
+        FrontToBack<Scalar> acc;
+        bool done = false;
+        for (const Piece& p : ps) {
+            const std::int64_t n = segment_count(p.span, step_);
+            for (std::int64_t k = 0; k < n && !done; ++k) {
+                const Mixed m = mix(p.present, segment(p.span, step_, k, n));
+                if (!m.opaque && !(m.tau > 0.0)) continue;
+                add(acc, m);
+                done = m.opaque || acc.stops(true, stop);
+            }
+            if (done) break;
+        }
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    } else {
+        BackToFront<Scalar> acc;
+        for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
+            const std::int64_t n = segment_count(it->span, step_);
+            for (std::int64_t k = n - 1; k >= 0; --k) {
+                const Mixed m = mix(it->present, segment(it->span, step_, k, n));
+                if (m.opaque || m.tau > 0.0) add(acc, m);
+            }
+        }
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    }
+    return out;
+}
+
+PixelValue MultiVolumeIntegrator::combine(const PixelValue* values, const std::vector<Interval>* intervals) const {
+    PixelValue out;
+    bool any = false;
+    CompensatedSum weighted[4], length, error;
+    for (std::size_t k = 0; k < volumes_.size(); ++k) {
+        if (intervals[k].empty()) continue;
+        const PixelValue& v = values[k];
+        switch (render_.projection) {
+            case Projection::Mip:
+            case Projection::Minip:
+                if (!any) {
+                    out.rgba = v.rgba;
+                } else {
+                    for (int c = 0; c < 4; ++c)
+                        out.rgba[c] = render_.projection == Projection::Mip ? std::max(out.rgba[c], v.rgba[c])
+                                                                            : std::min(out.rgba[c], v.rgba[c]);
+                }
+                out.error = std::max(out.error, v.error);
+                break;
+            case Projection::Average: {
+                double L = 0.0;
+                for (const Interval& iv : intervals[k]) L += iv.length();
+                for (int c = 0; c < 4; ++c) weighted[c].add(L * v.rgba[c]);
+                length.add(L);
+                error.add(L * v.error);
+                break;
+            }
+            case Projection::Xray:
+                for (int c = 0; c < 3; ++c) weighted[c].add(v.rgba[c]);
+                error.add(v.error);
+                break;
+            case Projection::FirstHit: {
+                const bool nearer = v.depth < out.depth ||
+                                    (v.depth == out.depth && std::tie(v.rgba.r, v.rgba.g, v.rgba.b, v.rgba.a) <
+                                                                 std::tie(out.rgba.r, out.rgba.g, out.rgba.b, out.rgba.a));
+                if (std::isfinite(v.depth) && (!any || nearer)) {
+                    out = v;
+                    any = true;
+                }
+                if (!std::isfinite(out.depth)) out.error = std::max(out.error, v.error);
+                continue;  // `any` means "a hit" here
+            }
+            case Projection::Composite: break;  // composite() mixes instead
+        }
+        any = true;
+    }
+    if (!any) return out;
+    if (render_.projection == Projection::Average) {
+        const double g = weighted[0].value() / length.value();
+        out.rgba = glm::dvec4(g, g, g, 1.0);
+        out.error = error.value() / length.value();
+    } else if (render_.projection == Projection::Xray) {
+        out.rgba = glm::dvec4(weighted[0].value(), weighted[1].value(), weighted[2].value(), 1.0);
+        out.error = error.value();
+    }
+    return out;
+}
+
+}  // namespace volref

@@ -1,0 +1,94 @@
+#include "core/integrate/packet/FastProfile.h"
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+
+#include "core/Conventions.h"
+#include "core/Error.h"
+#include "core/MemoryLimit.h"
+
+namespace volref {
+
+namespace {
+
+std::vector<float> to_float(const double* p, std::size_t n) {
+    std::vector<float> out(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = float(p[i]);
+    return out;
+}
+
+}  // namespace
+
+[[noreturn]] void fast_profile_unavailable(const std::string& reason) {
+    throw Error("render.profile: \"fast\" runs composite (front to back), mip and minip on Cartesian trilinear "
+                "grids classified by a transfer function; " + reason + " (use \"reference\")");
+}
+
+[[noreturn]] void fast_profile_not_traced() {
+    throw Error("trace: the fast profile is not traced (its float packets are its only path); trace with "
+                "render.profile \"reference\"");
+}
+
+void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, ScalarType* type) {
+    const ScalarType t = volume.values.type();
+    const std::size_t n = volume.values.size();
+    const bool gathered32 = t == ScalarType::F32 || t == ScalarType::I32 || t == ScalarType::U32 ||
+                            t == ScalarType::U16 || t == ScalarType::I16 || t == ScalarType::U8 || t == ScalarType::I8;
+    constexpr std::uint64_t kLimit = (std::uint64_t(1) << 31) - 64;  // PacketTrilinear's 32-bit offsets
+    if (gathered32 && std::endian::native == std::endian::little && std::uint64_t(volume.values.bytes()) < kLimit) {
+        *data = volume.values.raw();
+        *type = t;
+        return;
+    }
+    if (std::uint64_t(n) * 4 >= kLimit)
+        fast_profile_unavailable("the volume's " + std::to_string(n) + " voxels are too many for its 32-bit indices");
+    // Held: the volume itself; allocated: its float copy.
+    check_memory(volume.values.bytes() + n * sizeof(float), "render.profile: the fast profile's float copy of the voxels");
+    copies.voxels.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        copies.voxels[i] = float(volume.values[i]);
+        if (!std::isfinite(copies.voxels[i]))
+            fast_profile_unavailable("voxel " + std::to_string(i) + " (" + std::to_string(volume.values[i]) +
+                                     ") is beyond float's range");
+    }
+    *data = copies.voxels.data();
+    *type = ScalarType::F32;
+}
+
+void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies) {
+    const PacketTables<double>& td = in.tables_double;
+    copies.color_x = to_float(td.color_x, std::size_t(in.color_rows));
+    copies.color_y = to_float(td.color_y, std::size_t(in.color_rows) * 3);  // r, g, b per row
+    copies.opacity_x = to_float(td.opacity_x, std::size_t(in.opacity_rows));
+    copies.opacity_y = to_float(td.opacity_y, std::size_t(in.opacity_rows));
+    PacketTables<float>& tf = in.tables_float;
+    tf.color_x = copies.color_x.data();
+    tf.color_y = copies.color_y.data();
+    tf.opacity_x = copies.opacity_x.data();
+    tf.opacity_y = copies.opacity_y.data();
+    if (in.gradient_opacity_rows > 0) {
+        copies.gradient_opacity_x = to_float(td.gradient_opacity_x, std::size_t(in.gradient_opacity_rows));
+        copies.gradient_opacity_y = to_float(td.gradient_opacity_y, std::size_t(in.gradient_opacity_rows));
+        tf.gradient_opacity_x = copies.gradient_opacity_x.data();
+        tf.gradient_opacity_y = copies.gradient_opacity_y.data();
+    }
+    fast_voxels(volume, copies, &in.voxels, &in.voxel_type);
+    if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
+        // Held: the volume, its f64 gradient cache and any float voxels; allocated: the float cache.
+        check_memory(volume.values.bytes() + 3 * volume.values.size() * (sizeof(double) + sizeof(float)) +
+                         copies.voxels.size() * sizeof(float),
+                     "render.profile: the fast profile's float gradient cache");
+        for (int a = 0; a < 3; ++a) {
+            const VoxelArray& c = cached[a]->values;
+            copies.cached_gradient[a].resize(c.size());
+            for (std::size_t i = 0; i < c.size(); ++i) copies.cached_gradient[a][i] = float(c[i]);
+            tf.cached_gradient[a] = copies.cached_gradient[a].data();
+        }
+    }
+    in.fast = true;
+    in.termination.test_transmittance = true;
+    in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;
+}
+
+}  // namespace volref

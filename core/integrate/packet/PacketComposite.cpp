@@ -1,0 +1,279 @@
+// Highway's per-target compilation: this file is compiled once per instruction set.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/integrate/packet/PacketComposite.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/contrib/math/math-inl.h>
+#include <hwy/highway.h>
+
+#include <type_traits>
+
+#include "core/integrate/packet/PacketComposite.h"
+#include "core/integrate/packet/PacketKernels-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace volref {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+namespace {
+
+using namespace packet;
+
+// A piecewise-linear function of one channel of `ys` (rows of `stride` values) at v, as
+// PiecewiseLinear::operator(): k = the number of rows with x <= v; k = 0 -> y_0, k = R -> y_{R-1},
+// else y_{k-1} + (v - x_{k-1}) / (x_k - x_{k-1}) (y_k - y_{k-1}).
+// Lane types of the kernels below: T = double (reference) or float (fast profile).
+template <typename T>
+using DT = hn::ScalableTag<T>;
+template <typename T>
+using VT = hn::Vec<DT<T>>;
+template <typename T>
+using MT = hn::Mask<DT<T>>;
+
+template <typename T>
+struct TableLookup {
+    VT<T> lo_row, hi_row, lo_x, hi_x;  // row indices as T (exact)
+    MT<T> below, above;
+};
+
+template <typename T>
+HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v) {
+    const hn::RebindToSigned<DT<T>> di;
+    VT<T> k = hn::Zero(d);
+    const VT<T> one = hn::Set(d, T(1));
+    for (int r = 0; r < rows; ++r) k = hn::Add(k, hn::IfThenElseZero(hn::Le(hn::Set(d, xs[r]), v), one));
+    TableLookup<T> t;
+    t.below = hn::Eq(k, hn::Zero(d));
+    t.above = hn::Eq(k, hn::Set(d, T(rows)));
+    t.lo_row = hn::Max(hn::Sub(k, one), hn::Zero(d));
+    t.hi_row = hn::Min(k, hn::Set(d, T(rows - 1)));
+    t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
+    t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
+    return t;
+}
+
+template <typename T>
+HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, int rows, int stride, int channel, VT<T> v) {
+    const hn::RebindToSigned<DT<T>> di;
+    const VT<T> s = hn::Set(d, T(stride)), c = hn::Set(d, T(channel));
+    const VT<T> y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));
+    const VT<T> y1 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.hi_row, s), c)));
+    const VT<T> w = hn::Div(hn::Sub(v, t.lo_x), hn::Sub(t.hi_x, t.lo_x));
+    const VT<T> inner = hn::Add(y0, hn::Mul(w, hn::Sub(y1, y0)));
+    const VT<T> first = hn::Set(d, ys[channel]), last = hn::Set(d, ys[(rows - 1) * stride + channel]);
+    return hn::IfThenElse(t.below, first, hn::IfThenElse(t.above, last, inner));
+}
+
+// grad f at (x, y, z), where f(x, y, z) = fx, by GradientField's scheme, operation by operation.
+template <typename T>
+struct PacketGradient {
+    using D = DT<T>;
+    using V = VT<T>;
+    const PacketCompositeInputs& in;
+    const PacketTrilinearT<T>& f;
+    const PacketTrilinearT<T>* cached[3];
+
+    HWY_INLINE void operator()(const V X[3], V fx, V g[3]) const {
+        const D d;
+        if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
+            for (int a = 0; a < 3; ++a) g[a] = (*cached[a])(X[0], X[1], X[2]);
+            return;
+        }
+        for (int a = 0; a < 3; ++a) {
+            g[a] = hn::Zero(d);
+            if (f.flat[a]) continue;
+            const V h = hn::Set(d, T(in.spacing[a])), lo = hn::Set(d, T(in.domain_lo[a])), hi = hn::Set(d, T(in.domain_hi[a]));
+            const V c = hn::Max(hn::Sub(X[a], h), lo);
+            V P[3] = {X[0], X[1], X[2]};
+            if (in.gradient == PacketCompositeInputs::Gradient::Central) {
+                const V b = hn::Min(hn::Add(X[a], h), hi);
+                P[a] = b;
+                const V fb = f(P[0], P[1], P[2]);
+                P[a] = c;
+                const V fc = f(P[0], P[1], P[2]);
+                g[a] = hn::Div(hn::Sub(fb, fc), hn::Sub(b, c));
+            } else {  // forward where x + h <= hi, else backward over x - c
+                const V xh = hn::Add(X[a], h);
+                P[a] = xh;
+                const V forward = hn::Div(hn::Sub(f(P[0], P[1], P[2]), fx), h);
+                P[a] = c;
+                const V backward = hn::Div(hn::Sub(fx, f(P[0], P[1], P[2])), hn::Sub(X[a], c));
+                g[a] = hn::IfThenElse(hn::Le(xh, hi), forward, backward);
+            }
+        }
+    }
+};
+
+template <class V>
+HWY_INLINE V dot3(const V a[3], const V b[3]) {
+    return hn::Add(hn::Add(hn::Mul(a[0], b[0]), hn::Mul(a[1], b[1])), hn::Mul(a[2], b[2]));
+}
+
+// Shader::shade for a packet: m = the material colour, g = grad f, view = -direction, depth = t.
+template <typename T>
+HWY_INLINE void shade(const PacketCompositeInputs& in, VT<T> m[3], const VT<T> g[3], const VT<T> view[3], VT<T> depth) {
+    using D = DT<T>;
+    using V = VT<T>;
+    using M = MT<T>;
+    const D d;
+    const V zero = hn::Zero(d), one = hn::Set(d, T(1));
+    const V glen = hn::Sqrt(dot3(g, g));
+    const M lit = hn::Gt(glen, hn::Set(d, T(in.zero_gradient_tolerance)));
+    if (hn::AllFalse(d, lit)) return;
+    const V N[3] = {hn::Div(hn::Neg(g[0]), glen), hn::Div(hn::Neg(g[1]), glen), hn::Div(hn::Neg(g[2]), glen)};
+    auto clamp_dot = [&](V x) { return in.two_sided ? hn::Abs(x) : hn::Max(x, zero); };
+    const V cue = hn::Div(one, hn::Add(hn::Set(d, T(in.kc)), hn::Mul(hn::Set(d, T(in.kl)), depth)));
+    V out[3] = {zero, zero, zero};
+    for (int li = 0; li < in.light_count; ++li) {
+        const PacketCompositeInputs::Light& light = in.lights[li];
+        V L[3];
+        for (int c = 0; c < 3; ++c) L[c] = light.headlight ? view[c] : hn::Set(d, T(light.direction[c]));
+        const V n_dot_l_raw = dot3(N, L);
+        const V n_dot_l = clamp_dot(n_dot_l_raw);
+        V spec_dot;
+        if (in.phong) {
+            const V s2 = hn::Mul(hn::Set(d, T(2)), n_dot_l_raw);
+            const V R[3] = {hn::Sub(hn::Mul(s2, N[0]), L[0]), hn::Sub(hn::Mul(s2, N[1]), L[1]),
+                            hn::Sub(hn::Mul(s2, N[2]), L[2])};
+            spec_dot = hn::Max(dot3(R, view), zero);
+        } else {
+            V H[3] = {hn::Add(L[0], view[0]), hn::Add(L[1], view[1]), hn::Add(L[2], view[2])};
+            const V inv = hn::Div(one, hn::Sqrt(dot3(H, H)));
+            for (int c = 0; c < 3; ++c) H[c] = hn::Mul(H[c], inv);
+            spec_dot = clamp_dot(dot3(N, H));
+        }
+        V specular = zero;
+        if (in.ks != 0.0) {
+            // s^n = exp(n log s) for s > 0; 0^n = 0 (n > 0), s^0 = 1.
+            const V power = in.n == 0.0 ? one
+                                        : hn::IfThenElseZero(hn::Gt(spec_dot, zero),
+                                                             hn::Exp(d, hn::Mul(hn::Set(d, T(in.n)), hn::Log(d, spec_dot))));
+            specular = hn::Mul(hn::Mul(hn::Set(d, T(in.ks)), power), cue);
+        }
+        for (int c = 0; c < 3; ++c) {
+            const V I = hn::Set(d, T(light.color[c]));
+            const V ambient = hn::Mul(I, hn::Mul(hn::Set(d, T(in.ka)), m[c]));
+            const V diffuse = hn::Mul(I, hn::Mul(hn::Mul(hn::Mul(hn::Set(d, T(in.kd)), m[c]), n_dot_l), cue));
+            V term = hn::Add(ambient, diffuse);
+            if (in.ks != 0.0) term = hn::Add(term, hn::Mul(I, specular));
+            out[c] = hn::Add(out[c], term);
+        }
+    }
+    for (int c = 0; c < 3; ++c) m[c] = hn::IfThenElse(lit, out[c], m[c]);
+}
+
+template <typename T>
+void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                     PixelValue* out, int count) {
+    using D = DT<T>;
+    using V = VT<T>;
+    using M = MT<T>;
+    constexpr bool kFast = std::is_same_v<T, float>;
+    const D d;
+    const PacketTables<T>& tab = in.tables<T>();
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells);
+    const std::size_t L = packet.lanes;
+    HWY_ALIGN T buf[RayPacketT<T>::kLanes];
+    const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
+    const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
+    const PacketTrilinearT<T> trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    // The cached gradient components share the volume's grid.
+    const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
+    const ScalarType cached_type = kFast ? ScalarType::F32 : ScalarType::F64;
+    const PacketTrilinearT<T> gx(cached ? tab.cached_gradient[0] : in.voxels, cached ? cached_type : in.voxel_type,
+                                 in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> gy(cached ? tab.cached_gradient[1] : in.voxels, cached ? cached_type : in.voxel_type,
+                                 in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> gz(cached ? tab.cached_gradient[2] : in.voxels, cached ? cached_type : in.voxel_type,
+                                 in.dims, in.origin, in.inv_spacing);
+    const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}};
+    const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
+
+    const V zero = hn::Zero(d), one = hn::Set(d, T(1));
+    // The reference composites with the compensated optical depth, the fast profile with a
+    // transmittance product in float (march/Accumulators.h).
+    using SL = SimdLanes<T>;
+    constexpr TransmittanceRule kRule = kFast ? TransmittanceRule::Product : TransmittanceRule::OpticalDepthSum;
+    FrontToBack<SL, kRule> acc;
+    const V l_unit = hn::Set(d, T(in.unit_distance));
+
+    while (packet.next()) {
+        const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
+        const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+        const V P[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
+        const V v = trilinear(P[0], P[1], P[2]);
+        // Transfer function.
+        const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
+        const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x);
+        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, x);
+        V g[3];
+        bool have_gradient = false;
+        if (in.gradient_opacity_rows > 0) {
+            // a = clamp(a factor(|grad f|), 0, 1)
+            gradient(P, v, g);
+            have_gradient = true;
+            const V glen = hn::Sqrt(dot3(g, g));
+            const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen);
+            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen);
+            a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
+        }
+        const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
+        if (!hn::AllFalse(d, o.visible)) {
+            const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x);
+            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, x)};
+            if (in.shaded) {
+                if (!have_gradient) gradient(P, v, g);
+                shade<T>(in, m, g, view, t);
+            }
+            acc.add(o.visible, o.solid, o.tau, o.alpha, m);
+            const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));
+            hn::Store(hn::IfThenElseZero(stop, one), d, buf);
+            for (std::size_t l = 0; l < L; ++l)
+                if (buf[l] != T(0)) packet.active[l] = false;
+        }
+    }
+    const V A = acc.alpha();
+    const V Cr = acc.color(0), Cg = acc.color(1), Cb = acc.color(2);
+    HWY_ALIGN T r_[RayPacketT<T>::kLanes], g_[RayPacketT<T>::kLanes], b_[RayPacketT<T>::kLanes], a_[RayPacketT<T>::kLanes];
+    hn::Store(Cr, d, r_);
+    hn::Store(Cg, d, g_);
+    hn::Store(Cb, d, b_);
+    hn::Store(A, d, a_);
+    for (int l = 0; l < count && l < int(L); ++l) out[l].rgba = glm::dvec4(r_[l], g_[l], b_[l], a_[l]);
+}
+
+}  // namespace
+
+template <typename T>
+void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                   PixelValue* out, int count) {
+    const int L = int(hn::Lanes(DT<T>()));
+    for (int first = 0; first < count; first += L)
+        composite_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first));
+}
+
+void CompositePacket(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                     PixelValue* out, int count) {
+    if (in.fast)
+        composite_all<float>(in, rays, intervals, out, count);
+    else
+        composite_all<double>(in, rays, intervals, out, count);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace volref
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace volref {
+HWY_EXPORT(CompositePacket);
+
+void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                      PixelValue* out, int count) {
+    HWY_DYNAMIC_DISPATCH(CompositePacket)(in, rays, intervals, out, count);
+}
+}  // namespace volref
+#endif

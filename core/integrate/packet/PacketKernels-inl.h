@@ -1,0 +1,354 @@
+// Pieces shared by the SIMD packet kernels (PacketComposite.cpp, PacketExtremum.cpp), compiled once
+// per Highway target: the lane walk over intervals and segments (Segments.h placement) and the
+// trilinear reconstruction of a packet of points, term by term as VolumeSampler::trilinear.
+// Each is a template over the lane type T: double for the reference profile (the scalar path's
+// arithmetic), float for the fast profile (FastProfile.h: twice the lanes, float rounding).
+// Per-target include guard (Highway's pattern for -inl headers).
+#if defined(VOLREF_PACKET_KERNELS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef VOLREF_PACKET_KERNELS_INL_H_
+#undef VOLREF_PACKET_KERNELS_INL_H_
+#else
+#define VOLREF_PACKET_KERNELS_INL_H_
+#endif
+
+#include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
+
+#include <bit>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include "core/camera/Ray.h"
+#include "core/grid/VoxelArray.h"
+#include "core/integrate/march/SegmentWalk.h"
+#include "core/integrate/march/Accumulators.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace volref {
+namespace HWY_NAMESPACE {
+namespace packet {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// The double lanes of the reference profile.
+using D = hn::ScalableTag<double>;
+using DI = hn::RebindToSigned<D>;
+using V = hn::Vec<D>;
+using M = hn::Mask<D>;
+
+// A vector of 32-bit values (float or int32, as many lanes as D) as D's lane type: exact for double
+// and for float from float; int32 -> float rounds above 2^24 (the fast profile only).
+template <class DT, class V32>
+HWY_INLINE hn::Vec<DT> to_lanes(DT d, V32 v) {
+    if constexpr (std::is_same_v<hn::TFromD<DT>, double>) return hn::PromoteTo(d, v);
+    else if constexpr (std::is_same_v<hn::TFromV<V32>, float>) return v;
+    else return hn::ConvertTo(d, v);
+}
+
+// The lane operations of core/Lanes.h on Highway vectors of T (double: the reference; float: the
+// fast profile), so that the accumulators of march/Accumulators.h run on packets unchanged.
+template <typename T>
+struct SimdLanes {
+    using D = hn::ScalableTag<T>;
+    using V = hn::Vec<D>;
+    using M = hn::Mask<D>;
+    static HWY_INLINE V splat(double x) { return hn::Set(D(), T(x)); }
+    static HWY_INLINE M all_lanes() { return hn::Eq(hn::Zero(D()), hn::Zero(D())); }
+    static HWY_INLINE M no_lanes() { return hn::Lt(hn::Zero(D()), hn::Zero(D())); }
+    static HWY_INLINE V select(M m, V a, V b) { return hn::IfThenElse(m, a, b); }
+    static HWY_INLINE V select_zero(M m, V a) { return hn::IfThenElseZero(m, a); }
+    static HWY_INLINE M and_(M a, M b) { return hn::And(a, b); }
+    static HWY_INLINE M or_(M a, M b) { return hn::Or(a, b); }
+    static HWY_INLINE M and_not(M a, M b) { return hn::AndNot(a, b); }
+    static HWY_INLINE bool none(M m) { return hn::AllFalse(D(), m); }
+    static HWY_INLINE M gt(V a, V b) { return hn::Gt(a, b); }
+    static HWY_INLINE M ge(V a, V b) { return hn::Ge(a, b); }
+    static HWY_INLINE M lt(V a, V b) { return hn::Lt(a, b); }
+    static HWY_INLINE M le(V a, V b) { return hn::Le(a, b); }
+    static HWY_INLINE M eq(V a, V b) { return hn::Eq(a, b); }
+    static HWY_INLINE M is_finite(V a) { return hn::IsFinite(a); }
+    static HWY_INLINE V neg(V a) { return hn::Neg(a); }
+    static HWY_INLINE V abs(V a) { return hn::Abs(a); }
+    static HWY_INLINE V exp(V a) { return hn::Exp(D(), a); }
+    static HWY_INLINE V expm1(V a) { return hn::Expm1(D(), a); }
+    static HWY_INLINE V log1p(V a) { return hn::Log1p(D(), a); }
+};
+
+// The optical model and the accumulators, compiled for this target.
+#include "transfer/OpacityCorrection-inl.h"
+#include "core/integrate/march/Accumulators-inl.h"
+
+// The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
+// segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
+// never become active. The walk is in double; the lanes hold its values rounded to T.
+template <typename T>
+struct RayPacketT {
+    static constexpr std::size_t kLanes = HWY_LANES(T);
+    HWY_ALIGN T ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
+    HWY_ALIGN T tm[kLanes], len[kLanes], live[kLanes];
+    ForwardSegmentWalk walk[kLanes];
+    bool active[kLanes];
+    std::size_t lanes = 0;
+
+    // `extremum` (mip / minip skipping, SegmentWalk.h's extremum mode): each lane's running extremum,
+    // kLanes values the caller keeps up to date (NaN before a lane's first sample).
+    RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
+               const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true) {
+        lanes = hn::Lanes(hn::ScalableTag<T>());
+        for (std::size_t l = 0; l < lanes; ++l) {
+            const bool real = int(l) < count;
+            const Ray& r = rays[real ? l : 0];
+            ox[l] = T(r.origin.x);
+            oy[l] = T(r.origin.y);
+            oz[l] = T(r.origin.z);
+            dx[l] = T(r.direction.x);
+            dy[l] = T(r.direction.y);
+            dz[l] = T(r.direction.z);
+            active[l] = real;
+            if (real)
+                walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum)
+                                   : ForwardSegmentWalk(grid, rays[l], intervals[l], step);
+        }
+    }
+    // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live
+    // (1/0); false when no lane is active any more.
+    bool next() {
+        bool any = false;
+        for (std::size_t l = 0; l < lanes; ++l) {
+            Segment s;
+            if (active[l] && !walk[l].next(s)) active[l] = false;
+            if (active[l]) {
+                tm[l] = T(s.midpoint());
+                len[l] = T(s.length());
+                live[l] = T(1);
+                any = true;
+            } else {
+                tm[l] = T(0);
+                len[l] = T(0);
+                live[l] = T(0);
+            }
+        }
+        return any;
+    }
+};
+using RayPacket = RayPacketT<double>;
+
+// Trilinear reconstruction of a regular grid for packets of world points (VolumeSampler::trilinear:
+// u = clamp((x - origin) inv_spacing, 0, n - 1), cell min(floor(u), n - 2), Levoy's sum in order).
+// The voxels are read in their storage type (VoxelArray) and converted to double exactly, so the sum
+// is the same whatever the type. One switch on the type per packet sample, then per type:
+//   f64: 64-bit index gathers (as before);
+//   f32, i32, u32: 32-bit gathers with int32 indices, promoted to double (u32: read as i32, plus 2^32
+//     where negative, exact);
+//   u16, i16, u8, i8: a 32-bit gather of the word that ends with the sample (VoxelArray pads the
+//     buffer, so the bytes before the first sample are inside the allocation; little-endian hosts),
+//     shifted right by 16 or 24 bits (logical for unsigned, arithmetic for signed types);
+//   anything else (a volume of 2^31 samples or bytes or more, or a big-endian host): lane by lane.
+// With float lanes (the fast profile) the position, weights and sum are float, the corner index is
+// computed in int32, and the storage must be one of the 32-bit-gathered kinds (f32, i32, u32, u16,
+// i16, u8, i8: FastProfile.h converts anything else to f32 first).
+template <typename T>
+struct PacketTrilinearT {
+    using D = hn::ScalableTag<T>;
+    using DI = hn::RebindToSigned<D>;
+    using V = hn::Vec<D>;
+    using DI32 = hn::Rebind<std::int32_t, D>;
+    using DU32 = hn::Rebind<std::uint32_t, D>;
+    using DF32 = hn::Rebind<float, D>;
+    static constexpr bool kFloat = std::is_same_v<T, float>;
+    enum class Kind { F64, F32, I32, U32, U16, I16, U8, I8, Lanes };
+
+    const void* voxels;
+    ScalarType type;
+    Kind kind;
+    V org[3], inv[3], maxi[3], top[3];
+    bool flat[3];
+    V nx, nxy;
+    hn::Vec<DI> offx, offy, offz;
+    hn::Vec<DI32> offx32, offy32, offz32, nx32, nxy32;
+
+    PacketTrilinearT(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
+                     const double inv_spacing[3]) {
+        const D d;
+        const DI di;
+        const DI32 di32;
+        voxels = data;
+        type = data_type;
+        for (int a = 0; a < 3; ++a) {
+            org[a] = hn::Set(d, T(origin[a]));
+            inv[a] = hn::Set(d, T(inv_spacing[a]));
+            maxi[a] = hn::Set(d, T(dims[a] - 1));
+            top[a] = hn::Set(d, T(dims[a] - 2));
+            flat[a] = dims[a] == 1;
+        }
+        nx = hn::Set(d, T(dims[0]));
+        nxy = hn::Set(d, T(dims[0] * dims[1]));
+        offx = hn::Set(di, flat[0] ? 0 : 1);
+        offy = hn::Set(di, flat[1] ? 0 : hn::TFromD<DI>(dims[0]));
+        offz = hn::Set(di, flat[2] ? 0 : hn::TFromD<DI>(dims[0] * dims[1]));
+        const std::uint64_t count = std::uint64_t(dims[0]) * std::uint64_t(dims[1]) * std::uint64_t(dims[2]);
+        const bool fits32 = count * scalar_type_size(type) < (std::uint64_t(1) << 31) - 64;
+        const std::int64_t unit = std::int64_t(scalar_type_size(type) < 4 ? scalar_type_size(type) : 1);
+        // 32-bit offsets: in elements for the 4-byte types, in bytes for the 1- and 2-byte ones.
+        offx32 = hn::Set(di32, std::int32_t(fits32 ? (flat[0] ? 0 : 1) * unit : 0));
+        offy32 = hn::Set(di32, std::int32_t(fits32 ? (flat[1] ? 0 : dims[0]) * unit : 0));
+        offz32 = hn::Set(di32, std::int32_t(fits32 ? (flat[2] ? 0 : dims[0] * dims[1]) * unit : 0));
+        nx32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] : 0));
+        nxy32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] * dims[1] : 0));
+        constexpr bool little = std::endian::native == std::endian::little;
+        switch (type) {
+            case ScalarType::F64: kind = Kind::F64; break;
+            case ScalarType::F32: kind = fits32 ? Kind::F32 : Kind::Lanes; break;
+            case ScalarType::I32: kind = fits32 ? Kind::I32 : Kind::Lanes; break;
+            case ScalarType::U32: kind = fits32 ? Kind::U32 : Kind::Lanes; break;
+            case ScalarType::U16: kind = fits32 && little ? Kind::U16 : Kind::Lanes; break;
+            case ScalarType::I16: kind = fits32 && little ? Kind::I16 : Kind::Lanes; break;
+            case ScalarType::U8: kind = fits32 && little ? Kind::U8 : Kind::Lanes; break;
+            case ScalarType::I8: kind = fits32 && little ? Kind::I8 : Kind::Lanes; break;
+            default: kind = Kind::Lanes; break;
+        }
+    }
+
+    // The eight corners f1..f8 (Levoy's order) of the cells at `idx` (i + nx j + nx ny k, any index
+    // vector type), each fetched by g.
+    template <class IV, class G>
+    static HWY_INLINE void eight(IV idx, IV ox, IV oy, IV oz, const G& g, V f[8]) {
+        f[0] = g(idx);
+        f[1] = g(hn::Add(idx, ox));
+        f[2] = g(hn::Add(hn::Add(idx, ox), oy));
+        f[3] = g(hn::Add(idx, oy));
+        const IV idz = hn::Add(idx, oz);
+        f[4] = g(idz);
+        f[5] = g(hn::Add(idz, ox));
+        f[6] = g(hn::Add(hn::Add(idz, ox), oy));
+        f[7] = g(hn::Add(idz, oy));
+    }
+
+    // A 32-bit word ending with each 1- or 2-byte sample, shifted down to the sample.
+    template <int kShift, bool kSigned>
+    HWY_INLINE V narrow(hn::Vec<DI32> byte_offset) const {
+        const D d;
+        const DI32 di32;
+        const DU32 du32;
+        const auto* base = reinterpret_cast<const std::int32_t*>(static_cast<const char*>(voxels) - (4 - (32 - kShift) / 8));
+        const auto word = hn::GatherOffset(di32, base, byte_offset);
+        if constexpr (kSigned) return to_lanes(d, hn::ShiftRight<kShift>(word));
+        else return to_lanes(d, hn::BitCast(di32, hn::ShiftRight<kShift>(hn::BitCast(du32, word))));
+    }
+
+    HWY_INLINE void corners(V cell0, V cell1, V cell2, V f[8]) const {
+        const D d;
+        const DI di;
+        const DI32 di32;
+        const DF32 df32;
+        if constexpr (kFloat) {
+            if (kind == Kind::F64 || kind == Kind::Lanes) {  // excluded by FastProfile.h
+                for (int c = 0; c < 8; ++c) f[c] = hn::Zero(d);
+                return;
+            }
+        } else if (kind == Kind::F64 || kind == Kind::Lanes) {
+            // i + nx j + nx ny k, exact in double.
+            const auto idx = hn::Add(hn::ConvertTo(di, hn::Add(cell0, hn::Mul(nx, cell1))), hn::ConvertTo(di, hn::Mul(nxy, cell2)));
+            if (kind == Kind::F64) {
+                const auto* p = static_cast<const double*>(voxels);
+                eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return hn::GatherIndex(d, p, i); }, f);
+            } else {
+                eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return lanes(i); }, f);
+            }
+            return;
+        }
+        // The same index, exact in double and < 2^31, as int32 (in bytes for the 1- and 2-byte types);
+        // float lanes compute it in int32 (a float holds integers exactly only up to 2^24).
+        hn::Vec<DI32> idx;
+        if constexpr (kFloat) {
+            idx = hn::Add(hn::Add(hn::ConvertTo(di32, cell0), hn::Mul(nx32, hn::ConvertTo(di32, cell1))),
+                          hn::Mul(nxy32, hn::ConvertTo(di32, cell2)));
+            if (kind == Kind::U16 || kind == Kind::I16) idx = hn::Add(idx, idx);
+        } else {
+            V index = hn::Add(hn::Add(cell0, hn::Mul(nx, cell1)), hn::Mul(nxy, cell2));
+            if (kind == Kind::U16 || kind == Kind::I16) index = hn::Add(index, index);
+            idx = hn::DemoteTo(di32, index);
+        }
+        switch (kind) {
+            case Kind::F32: {
+                const auto* p = static_cast<const float*>(voxels);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(df32, p, i)); }, f);
+                break;
+            }
+            case Kind::I32: {
+                const auto* p = static_cast<const std::int32_t*>(voxels);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(di32, p, i)); }, f);
+                break;
+            }
+            case Kind::U32: {
+                const auto* p = static_cast<const std::int32_t*>(voxels);
+                const V two32 = hn::Set(d, T(4294967296.0)), zero = hn::Zero(d);
+                eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR {
+                    const V s = to_lanes(d, hn::GatherIndex(di32, p, i));
+                    return hn::IfThenElse(hn::Lt(s, zero), hn::Add(s, two32), s);
+                }, f);
+                break;
+            }
+            case Kind::U16: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<16, false>(i); }, f); break;
+            case Kind::I16: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<16, true>(i); }, f); break;
+            case Kind::U8: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<24, false>(i); }, f); break;
+            case Kind::I8: eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return narrow<24, true>(i); }, f); break;
+            default: break;
+        }
+    }
+
+    // Lane by lane (64-bit indices), any storage type (double lanes).
+    HWY_INLINE V lanes(hn::Vec<DI> idx) const {
+        const D d;
+        const DI di;
+        HWY_ALIGN hn::TFromD<DI> ix[RayPacketT<T>::kLanes];
+        HWY_ALIGN T out[RayPacketT<T>::kLanes];
+        hn::Store(idx, di, ix);
+        const std::size_t n = hn::Lanes(d);
+        dispatch_scalar_type(type, [&](auto tag) {
+            using S = decltype(tag);
+            const S* p = static_cast<const S*>(voxels);
+            for (std::size_t l = 0; l < n; ++l) out[l] = T(p[ix[l]]);
+        });
+        return hn::Load(d, out);
+    }
+
+    HWY_INLINE V operator()(V x, V y, V z) const {
+        const D d;
+        const V zero = hn::Zero(d), one = hn::Set(d, T(1));
+        const V X[3] = {x, y, z};
+        V cell[3], frac[3];
+        for (int a = 0; a < 3; ++a) {
+            const V u = hn::Min(hn::Max(hn::Mul(hn::Sub(X[a], org[a]), inv[a]), zero), maxi[a]);
+            if (flat[a]) {
+                cell[a] = zero;
+                frac[a] = zero;
+            } else {
+                cell[a] = hn::Min(hn::Floor(u), top[a]);
+                frac[a] = hn::Sub(u, cell[a]);
+            }
+        }
+        V f[8];
+        corners(cell[0], cell[1], cell[2], f);
+        const V p = frac[0], q = frac[1], r = frac[2];
+        const V P = hn::Sub(one, p), Q = hn::Sub(one, q), R = hn::Sub(one, r);
+        V v = zero;
+        v = hn::Add(v, hn::Mul(f[0], hn::Mul(hn::Mul(P, Q), R)));
+        v = hn::Add(v, hn::Mul(f[1], hn::Mul(hn::Mul(p, Q), R)));
+        v = hn::Add(v, hn::Mul(f[2], hn::Mul(hn::Mul(p, q), R)));
+        v = hn::Add(v, hn::Mul(f[3], hn::Mul(hn::Mul(P, q), R)));
+        v = hn::Add(v, hn::Mul(f[4], hn::Mul(hn::Mul(P, Q), r)));
+        v = hn::Add(v, hn::Mul(f[5], hn::Mul(hn::Mul(p, Q), r)));
+        v = hn::Add(v, hn::Mul(f[6], hn::Mul(hn::Mul(p, q), r)));
+        v = hn::Add(v, hn::Mul(f[7], hn::Mul(hn::Mul(P, q), r)));
+        return v;
+    }
+};
+using PacketTrilinear = PacketTrilinearT<double>;
+
+}  // namespace packet
+}  // namespace HWY_NAMESPACE
+}  // namespace volref
+HWY_AFTER_NAMESPACE();
+
+#endif  // per-target include guard

@@ -1,0 +1,119 @@
+#include "core/integrate/profiles/Profile.h"
+
+#include "core/Error.h"
+
+namespace volref {
+
+namespace {
+
+Profile make_reference() { return Profile{}; }
+
+// vtkGPUVolumeRayCastMapper of VTK 9.1 (its GLSL, vtkVolumeShaderComposer.h, and the opacity and
+// colour tables vtkOpenGLVolumeOpacityTable / vtkOpenGLVolumeRGBTable), as the shared spec's section 9
+// describes it and as measured against python3-vtk9 under Mesa llvmpipe (scripts/vtk-parity.sh).
+Profile make_vtk_gpu() {
+    Profile p;
+    p.id = ProfileId::VtkGpu;
+    p.name = "vtk-gpu";
+    p.placement = Profile::Placement::FromEntry;
+    p.first = 1.0;  // no jittering: the first sample one step inside
+    p.correction = Profile::Correction::Power;
+    p.correction_floor = 1e-4;
+    p.table_entries = 1024;
+    p.termination.test_alpha_above = true;
+    p.termination.alpha_above = 1.0 - 1.0 / 255.0;
+    p.gradient_offset = 1.0;
+    p.normal_along_gradient = true;
+    p.clamp_shaded = true;
+    p.average = Profile::Average::MeanOpacityTimesNormalised;
+    return p;
+}
+
+// vtkFixedPointVolumeRayCastMapper of VTK 9.1, its CPU mapper: 15-bit fixed point throughout, on an
+// internal image drawn as a stretched texture: its own renderer (VtkCpuProfile.h has it;
+// (conventions section 9 states each formula).
+Profile make_vtk_cpu() {
+    Profile p;
+    p.id = ProfileId::VtkCpu;
+    p.name = "vtk-cpu";
+    p.renderer = Profile::Renderer::VtkFixedPoint;
+    return p;
+}
+
+// A textbook GLSL ray caster (issue 7): samples from the entry point on, acc += (1 - acc.a) col.a col
+// with the transfer function's opacity used as the sample's alpha (no correction), stop at alpha >= 1,
+// central differences at +-0.1 in texture coordinates ([0, 1] over the volume's domain).
+Profile make_glsl_basic() {
+    Profile p;
+    p.id = ProfileId::GlslBasic;
+    p.name = "glsl-basic";
+    p.placement = Profile::Placement::FromEntry;
+    p.first = 0.0;
+    p.correction = Profile::Correction::None;
+    p.termination.test_alpha_at_least = true;
+    p.termination.alpha_at_least = 1.0;
+    p.gradient_offset = 0.0;
+    p.gradient_offset_texture = 0.1;
+    return p;
+}
+
+// OSPRay SciVis / Open VKL (issue 7, spec section 9): alpha = 1 - exp(-a dt densityScale) with
+// densityScale 1 (the transfer-function opacity taken as an extinction coefficient per world unit),
+// forward-difference gradients (one voxel), termination at T <= 0.001. Placement: the reference's
+// segment midpoints (OSPRay jitters its samples inside each step; without jitter the midpoint is the
+// expected position).
+Profile make_ospray() {
+    Profile p;
+    p.id = ProfileId::Ospray;
+    p.name = "ospray";
+    p.placement = Profile::Placement::Midpoints;
+    p.correction = Profile::Correction::Extinction;
+    p.density_scale = 1.0;
+    p.termination.test_alpha_at_least = true;
+    p.termination.alpha_at_least = 1.0 - 0.001;
+    p.gradient_offset = 1.0;
+    p.forward_gradient = true;
+    return p;
+}
+
+// A CUDA ray caster for cylindrical and spherical data (issue 7, shared spec section 9): samples from
+// the entry point on at a step of size / n voxels, composited back to front by
+// sum = lerp(sum, col, col.a * density) over the samples with s >= the iso threshold, the transfer
+// function read from a 9-entry linearly filtered table over [0, 1] at s * transfer scale (texel position
+// 9 u - 0.5, as CUDA's normalised linear texture fetch), x-ray = max s times brightness; unshaded.
+Profile make_cuda_curvilinear() {
+    Profile p;
+    p.id = ProfileId::CudaCurvilinear;
+    p.name = "cuda-curvilinear";
+    p.placement = Profile::Placement::FromEntry;
+    p.first = 0.0;
+    p.correction = Profile::Correction::None;
+    p.table_entries = 9;
+    p.compositing = Profile::Compositing::BackToFrontLerp;
+    p.table_coordinate = Profile::TableCoordinate::DataRangeTimesTransferScale;
+    p.sample_filter = Profile::SampleFilter::AtOrAboveIsoThreshold;
+    p.xray = Profile::Xray::BrightnessTimesMaximum;
+    p.voxel_length = Profile::VoxelLength::ExtentOverSamples;
+    p.grids = Profile::Grids::CartesianAndShells;
+    return p;
+}
+
+}  // namespace
+
+const Profile& profile(ProfileId id) {
+    static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), vtk_cpu = make_vtk_cpu(),
+                         glsl_basic = make_glsl_basic(),
+                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear();
+    switch (id) {
+        case ProfileId::Reference: return reference;
+        case ProfileId::VtkGpu: return vtk_gpu;
+        case ProfileId::VtkCpu: return vtk_cpu;
+        case ProfileId::GlslBasic: return glsl_basic;
+        case ProfileId::Ospray: return ospray;
+        case ProfileId::CudaCurvilinear: return cuda_curvilinear;
+        case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
+    }
+    throw Error("render.profile: unknown profile");
+}
+
+}  // namespace volref

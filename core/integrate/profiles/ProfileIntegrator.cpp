@@ -1,0 +1,358 @@
+#include "core/integrate/profiles/ProfileIntegrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/Accumulators.h"
+#include "transfer/OpacityCorrection.h"
+
+namespace volref {
+
+ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                                     const Scene* scene)
+    : Integrator(ctx), p_(profile) {
+    const std::string where = std::string("render.profile: \"") + p_.name + "\" ";
+    const RenderSpec& r = ctx.render;
+    if (r.projection == Projection::FirstHit) throw Error(where + "does not render the first-hit projection");
+    if (r.integrator != IntegrationMethod::Fixed) throw Error(where + "needs render.integrator \"fixed\"");
+    if (r.order != CompositeOrder::FrontToBack)
+        throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
+    if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
+    const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
+    if (!cartesian && p_.grids == Profile::Grids::Cartesian) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
+    if (p_.grids == Profile::Grids::CartesianAndShells && ctx.pipeline.shaded() && r.projection == Projection::Composite)
+        throw Error(where + "does not shade (remove volume.shading)");
+    if (ctx.pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
+    if (ctx.pipeline.classifier().needs_gradient())
+        throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
+    if (p_.renderer == Profile::Renderer::VtkFixedPoint) {
+        if (!scene) throw Error(where + "needs the scene's camera and image (construct ProfileIntegrator with the scene)");
+        if (scene->volumes.size() != 1) throw Error(where + "renders one volume: volumes");
+        const BoundsSpec& b = scene->volume().bounds;
+        if (b.type != BoundsSpec::Type::Box || b.min || b.max)
+            throw Error(where + "casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
+        vtk_cpu_ = std::make_unique<vtkcpu::Caster>(volume, ctx.pipeline.classifier(), ctx.pipeline.shader(), r.projection,
+                                                    ctx.step, scene->camera, scene->image, scene->volume().interpolation);
+        return;
+    }
+    const double inf = std::numeric_limits<double>::infinity();
+    domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
+    domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
+    step_ = ctx.step;
+    if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && r.step_units == StepUnits::Voxel) {
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (cartesian ? volume.spacing[a] < volume.spacing[axis] : volume.dims[a] > volume.dims[axis]) axis = a;
+        const double n = double(volume.dims[std::size_t(axis)]);
+        if (n > 1.0) step_ = ctx.step * (n - 1.0) / n;
+    }
+    offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
+                                               : p_.gradient_offset * volume.spacing;
+    const auto [vmin, vmax] = volume.value_range();
+    lo_ = vmin;
+    width_ = vmax - vmin;
+    if (p_.table_entries > 1) {
+        const int n = p_.table_entries;
+        const Classifier& c = ctx.pipeline.classifier();
+        table_.resize(std::size_t(n));
+        table_alpha_.resize(std::size_t(n));
+        for (int j = 0; j < n; ++j) {
+            const double x = vmin + double(j) * (vmax - vmin) / double(n - 1);
+            const Classified k = c.classify(x, 0.0);
+            table_[std::size_t(j)] = glm::dvec4(k.color, k.opacity);
+            // VTK corrects the table entries (not the interpolated opacity) for the sample distance.
+            table_alpha_[std::size_t(j)] = alpha(k.opacity, step_);
+        }
+    }
+}
+
+ProfileIntegrator::~ProfileIntegrator() = default;
+
+double ProfileIntegrator::alpha(double a, double d) const {
+    const double l = ctx_.pipeline.classifier().unit_distance();
+    a = std::clamp(a, 0.0, 1.0);
+    switch (p_.correction) {
+        case Profile::Correction::Power: return a > p_.correction_floor ? opacity_for_length(a, d, l) : a;
+        case Profile::Correction::None: return a;
+        case Profile::Correction::Extinction: return -std::expm1(-a * d * p_.density_scale);
+    }
+    return a;
+}
+
+// A texture read clamps to the edge: positions past the domain read its boundary.
+double ProfileIntegrator::value(const glm::dvec3& x) const {
+    return ctx_.pipeline.sampler().value(glm::clamp(x, domain_lo_, domain_hi_));
+}
+
+ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
+    Lookup out;
+    if (table_.empty()) {
+        const Classified k = ctx_.pipeline.classifier().classify(v, 0.0);
+        out.color = k.color;
+        out.opacity = k.opacity;
+        out.alpha = alpha(k.opacity, d);
+        return out;
+    }
+    // GL_LINEAR over N texels with CLAMP_TO_EDGE: texel position s N - 0.5.
+    const int n = p_.table_entries;
+    const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
+                                     : normalised(v);
+    const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
+    const int i = std::min(int(pos), n - 2);
+    const double w = pos - double(i);
+    const glm::dvec4 e = table_[std::size_t(i)] + w * (table_[std::size_t(i) + 1] - table_[std::size_t(i)]);
+    out.color = glm::dvec3(e);
+    out.opacity = e.a;
+    out.alpha = table_alpha_[std::size_t(i)] + w * (table_alpha_[std::size_t(i) + 1] - table_alpha_[std::size_t(i)]);
+    return out;
+}
+
+glm::dvec3 ProfileIntegrator::gradient(const glm::dvec3& x) const {
+    glm::dvec3 g(0.0);
+    for (int a = 0; a < 3; ++a) {
+        glm::dvec3 e(0.0);
+        e[a] = offset_[a];
+        g[a] = p_.forward_gradient ? (value(x + e) - value(x)) / offset_[a]
+                                   : (value(x + e) - value(x - e)) / (2.0 * offset_[a]);
+    }
+    return g;
+}
+
+template <class Fn>
+void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const {
+    const double h = step_;
+    if (p_.placement == Profile::Placement::Midpoints) {
+        for_each_segment(intervals, h, [&](const Segment& s) { return fn(s.midpoint(), s.length()); });
+        return;
+    }
+    for (const Interval& iv : intervals) {
+        const double n = std::max(1.0, std::floor(iv.length() / h + 1.0 - p_.first));
+        for (double k = 0.0; k < n; k += 1.0)
+            if (!fn(iv.t0 + (p_.first + k) * h, h)) return;
+    }
+}
+
+PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    if (vtk_cpu_) {  // the pixel this ray belongs to, as VTK draws it (its own clipping: intervals unused)
+        const auto [x, y] = vtk_cpu_->pixel_of(ray);
+        PixelValue out;
+        out.rgba = vtk_cpu_->display(x, y, nullptr);
+        return out;
+    }
+    NoRecording rec;
+    return integrate_impl(ray, intervals, rec);
+}
+
+PixelValue ProfileIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                               SampleRecorder& recorder) const {
+    Recording rec{recorder};
+    if (vtk_cpu_) {
+        const auto [x, y] = vtk_cpu_->pixel_of(ray);
+        PixelValue out;
+        out.rgba = vtk_cpu_->display(x, y, &rec);
+        return out;
+    }
+    return integrate_impl(ray, intervals, rec);
+}
+
+namespace {
+
+// Starts a record for a sample at t standing for length d.
+template <class Rec>
+void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, double d, double v) {
+    rec.begin(r, t - 0.5 * d, t + 0.5 * d);
+    r.t = t;
+    r.length = d;
+    r.sample.position = x;
+    r.sample.value = v;
+}
+
+}  // namespace
+
+template <class Rec>
+PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    switch (ctx_.render.projection) {
+        case Projection::Composite: return composite(ray, intervals, rec);
+        case Projection::Mip: return extremum(ray, intervals, true, rec);
+        case Projection::Minip: return extremum(ray, intervals, false, rec);
+        case Projection::Average: return line_integral(ray, intervals, true, rec);
+        case Projection::Xray: return line_integral(ray, intervals, false, rec);
+        case Projection::FirstHit: break;
+    }
+    return {};
+}
+
+template <class Rec>
+PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    if (p_.compositing == Profile::Compositing::BackToFrontLerp) return composite_lerp(ray, intervals, rec);
+    // A GPU shader's compositing: A += (1 - A) alpha, C += (1 - A) alpha c (march/Accumulators.h),
+    // stopping as the profile says after every sample.
+    FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
+    const Shader* shader = ctx_.pipeline.shader();
+    for_each_sample(intervals, [&](double t, double d) {
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
+        if constexpr (Rec::kOn) begin_record(rec, r, x, t, d, v);
+        const Lookup k = std::isfinite(v) ? lookup(v, d) : Lookup{};
+        [[maybe_unused]] const double T_before = acc.transmittance();
+        if (k.alpha > 0.0) {
+            glm::dvec3 c = k.color;
+            if (shader) {
+                const glm::dvec3 g = gradient(x);
+                const glm::dvec3 n = p_.normal_along_gradient ? -g : g;
+                if constexpr (Rec::kOn) {
+                    c = shader->shade(c, n, -ray.direction, t, r.sample.shading);
+                    r.sample.has_gradient = true;
+                    r.sample.gradient = g;
+                    r.sample.shaded = true;
+                } else {
+                    c = shader->shade(c, n, -ray.direction, t);
+                }
+                if (p_.clamp_shaded) c = glm::clamp(c, 0.0, 1.0);
+            }
+            const double cc[3] = {c.r, c.g, c.b};
+            acc.add(true, false, 0.0, k.alpha, cc);
+            if constexpr (Rec::kOn) r.sample.color = c;
+        } else if constexpr (Rec::kOn) {
+            r.sample.color = k.color;
+        }
+        if constexpr (Rec::kOn) {
+            r.sample.classified = std::isfinite(v);
+            r.sample.classified_color = k.color;
+            r.sample.opacity = k.opacity;
+            r.composited = true;
+            r.alpha = k.alpha;
+            r.tau = k.alpha < 1.0 ? -std::log1p(-k.alpha) : std::numeric_limits<double>::infinity();
+            r.transmittance_before = T_before;
+            r.transmittance_after = acc.transmittance();
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+            rec.recorder.record(r);
+        }
+        return !acc.stops(true, p_.termination);
+    });
+    PixelValue out;
+    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    return out;
+}
+
+// sum = lerp(sum, col, col.a density) from the far end; samples with s < the iso threshold skipped.
+template <class Rec>
+PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    std::vector<std::pair<double, double>> samples;
+    for_each_sample(intervals, [&](double t, double d) {
+        samples.emplace_back(t, d);
+        return true;
+    });
+    const ProfileOptions& o = ctx_.render.profile_options;
+    BackToFront<Scalar, BackToFrontRule::Lerp> acc;
+    for (auto it = samples.rbegin(); it != samples.rend(); ++it) {
+        const auto [t, d] = *it;
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        const bool used = std::isfinite(v) && !(p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold && normalised(v) < o.iso_threshold);
+        const Lookup k = used ? lookup(v, d) : Lookup{};
+        const double w = k.opacity * o.density;
+        const double c[3] = {k.color.r, k.color.g, k.color.b};
+        acc.lerp(used, w, c, k.opacity);
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            r.sample.classified = used;
+            r.sample.classified_color = k.color;
+            r.sample.opacity = k.opacity;
+            r.sample.color = k.color;
+            r.composited = true;
+            r.alpha = used ? w : 0.0;
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+            rec.recorder.record(r);
+        }
+    }
+    PixelValue out;
+    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    return out;
+}
+
+template <class Rec>
+PixelValue ProfileIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum,
+                                       Rec& rec) const {
+    Extremum<Scalar> acc(maximum);
+    auto pixel = [&](double v) {
+        const Lookup k = lookup(v, step_);
+        return glm::dvec4(k.opacity * k.color, k.opacity);
+    };
+    for_each_sample(intervals, [&](double t, double d) {
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        acc.add(true, v, t);
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            if (std::isfinite(v)) {
+                const Lookup k = lookup(v, d);
+                r.sample.classified = true;
+                r.sample.classified_color = k.color;
+                r.sample.opacity = k.opacity;
+                r.sample.color = k.color;
+            }
+            r.running = acc.value();
+            r.accumulated = acc.any() ? pixel(acc.value()) : glm::dvec4(0.0);
+            rec.recorder.record(r);
+        }
+        (void)d;
+        return true;
+    });
+    PixelValue out;
+    if (acc.any()) out.rgba = pixel(acc.value());
+    return out;
+}
+
+template <class Rec>
+PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean,
+                                            Rec& rec) const {
+    // A shader's plain sums (march/Accumulators.h); x-ray maximum: the largest normalised value.
+    LineIntegral<PlainSum> acc;
+    Extremum<Scalar> largest(true);
+    const Classifier& c = ctx_.pipeline.classifier();
+    const bool weighted = mean && p_.average == Profile::Average::MeanOpacityTimesNormalised;
+    auto result = [&]() {
+        if (!mean && p_.xray == Profile::Xray::BrightnessTimesMaximum)
+            return ctx_.render.profile_options.brightness * (acc.length() > 0.0 ? largest.value() : 0.0);
+        return mean ? (acc.length() > 0.0 ? acc.mean() : 0.0) : ctx_.render.gain * acc.integral();
+    };
+    for_each_sample(intervals, [&](double t, double d) {
+        const glm::dvec3 x = ray.at(t);
+        const double v = value(x);
+        [[maybe_unused]] double s = 0.0;
+        if (std::isfinite(v)) {
+            s = weighted ? lookup(v, d).opacity * normalised(v) : c.coordinate(v);
+            acc.add(weighted ? s : s * d, weighted ? 1.0 : d);
+            largest.add(true, normalised(v), t);
+        }
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            begin_record(rec, r, x, t, d, v);
+            r.coordinate = s;
+            r.running = result();
+            r.accumulated = glm::dvec4(r.running, r.running, r.running, 1.0);
+            rec.recorder.record(r);
+        }
+        return true;
+    });
+    PixelValue out;
+    if (intervals.empty()) return out;
+    const double g = result();
+    out.rgba = glm::dvec4(g, g, g, 1.0);
+    return out;
+}
+
+}  // namespace volref

@@ -1,0 +1,83 @@
+// ProfileIntegrator: renders a scene with another renderer's discretisation, read from a Profile
+// (Profile.h; conventions section 9): sample placement, table lookup, opacity correction, gradient
+// scheme, compositing and termination. Scalar path only; the reference profile never comes here
+// (make_integrator's integrators and their SIMD paths render it).
+//
+// Per projection (v_k the samples' values, (c, a) = transfer function or table at v, alpha_k the
+// profile's per-sample alpha, s = (v - min) / (max - min) over the volume's data range):
+//   composite: C += (1 - A) alpha_k c_k, A += (1 - A) alpha_k, front to back, stopping as the profile
+//              says; c_k shaded (and clamped when the profile clamps) when the scene is shaded;
+//   mip/minip: v* = max/min v_k, pixel (a(v*) c(v*), a(v*)) with the uncorrected opacity;
+//   average:   Average::MeanOpacityTimesNormalised: g = mean_k a(v_k) s_k; MeanCoordinate: g = the
+//              weighted mean of the transfer function's coordinate; pixel (g, g, g, 1);
+//   xray:      g = gain * sum_k coordinate(v_k) d_k (BrightnessTimesMaximum: brightness * max_k s_k);
+//              pixel (g, g, g, 1).
+//   composite with Compositing::BackToFrontLerp: sum = lerp(sum, (c, a), a density) from the far end.
+// Every formula is an accumulator's (march/Accumulators.h).
+//   vtk-cpu (Renderer::VtkFixedPoint): VtkCpuProfile.h's caster renders the pixel the ray belongs to
+//              (its internal rays, then the texture display); needs the scene's camera and image.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "core/grid/Volume.h"
+#include "core/integrate/Integrator.h"
+#include "core/integrate/profiles/Profile.h"
+#include "core/integrate/march/SampleRecorder.h"
+#include "core/integrate/profiles/VtkCpuProfile.h"
+
+namespace volref {
+
+class ProfileIntegrator final : public Integrator {
+public:
+    // Throws volref::Error naming render.profile for what the profile cannot render. `scene`: the
+    // scene being rendered (its camera and image size), required by vtk-cpu.
+    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                      const Scene* scene = nullptr);
+    ~ProfileIntegrator() override;
+    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
+    // The same loops, recording every sample (SampleRecorder.h): the record's segment is the length
+    // the sample stands for centred on it, `t` the sample's own position, `alpha` its alpha,
+    // `opacity` the (table's) uncorrected opacity, transmittance 1 - A before and after it.
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override;
+
+private:
+    struct Lookup {
+        glm::dvec3 color{0.0};
+        double opacity = 0.0;    // the transfer function's (uncorrected)
+        double alpha = 0.0;      // the sample's alpha (composite)
+    };
+    // fn(t, d): a sample at ray parameter t standing for length d; returns false to stop.
+    template <class Fn>
+    void for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const;
+    double value(const glm::dvec3& x) const;
+    Lookup lookup(double v, double d) const;
+    double alpha(double a, double d) const;
+    glm::dvec3 gradient(const glm::dvec3& x) const;
+    double normalised(double v) const { return width_ > 0.0 ? (v - lo_) / width_ : 0.0; }
+
+    template <class Rec>
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue composite_lerp(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals, bool maximum, Rec& rec) const;
+    template <class Rec>
+    PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean, Rec& rec) const;
+
+    const Profile& p_;
+    glm::dvec3 domain_lo_, domain_hi_;
+    glm::dvec3 offset_;  // per-axis gradient offset, world units
+    double step_ = 0.0;  // the profile's step, world units
+    double lo_ = 0.0, width_ = 0.0;  // the data range [lo, lo + width]
+    std::vector<glm::dvec4> table_;  // rgb + uncorrected opacity
+    std::vector<double> table_alpha_;  // corrected for the step (composite)
+    std::unique_ptr<vtkcpu::Caster> vtk_cpu_;  // vtk-cpu only
+};
+
+}  // namespace volref

@@ -113,7 +113,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.lights = t.shaded ? v.shader->lights().size() : 0;
     t.skipping = v.macrocells != nullptr && t.projection == Projection::Composite;  // the traced mip / minip loop does not skip
     Collector collector(scene, t.samples);
-    t.pixel = v.integrator->integrate_traced(v.volume_ray(t.ray), t.intervals, collector);
+    t.pixel = scene.trace_pixel(x, y, collector);
     return t;
 }
 

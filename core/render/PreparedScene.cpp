@@ -1,5 +1,7 @@
 #include "core/render/PreparedScene.h"
 
+#include "core/integrate/profiles/VtkFixedPointRenderer.h"
+
 #include <algorithm>
 #include <limits>
 
@@ -38,7 +40,24 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
 
 PreparedScene::~PreparedScene() = default;
 
+void PreparedScene::pixels(int x0, int y, int count, PixelValue* out, bool simd, Scratch& scratch) const {
+    if (const vtkcpu::VtkFixedPointRenderer* r = image_space()) {
+        for (int i = 0; i < count; ++i) out[i] = PixelValue{r->display(x0 + i, y, nullptr)};
+        return;
+    }
+    Ray rays[kMaxPacketRays];
+    for (int i = 0; i < count; ++i) rays[i] = camera->pixel_ray(x0 + i, y);
+    integrate(rays, count, out, simd, scratch);
+}
+
 void PreparedScene::integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const {
+    if (const vtkcpu::VtkFixedPointRenderer* r = image_space()) {  // the window pixel each ray passes through
+        for (int i = 0; i < count; ++i) {
+            const auto [x, y] = r->pixel_of(rays[i]);
+            out[i] = PixelValue{r->display(x, y, nullptr)};
+        }
+        return;
+    }
     const std::size_t n = volumes.size();
     scratch.rays.resize(n);
     scratch.intervals.resize(n);
@@ -80,10 +99,9 @@ std::vector<Interval> PreparedScene::intervals(const Ray& ray) const {
 }
 
 PixelValue PreparedScene::render_pixel(int x, int y) const {
-    const Ray ray = pixel_ray(x, y);
     Scratch scratch;
     PixelValue out;
-    integrate(&ray, 1, &out, false, scratch);
+    pixels(x, y, 1, &out, false, scratch);
     return out;
 }
 
@@ -94,6 +112,10 @@ const PreparedVolume& PreparedScene::traced_volume() const {
 
 PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) const {
     const PreparedVolume& v = traced_volume();
+    if (v.image_space) {
+        Recording rec{recorder};
+        return PixelValue{v.image_space->display(x, y, &rec)};
+    }
     const Ray ray = pixel_ray(x, y);
     return v.integrator->integrate_traced(v.volume_ray(ray), intervals(ray), recorder);
 }

@@ -37,8 +37,10 @@ struct PreparedScene {
     // The first (for most scenes the only) volume.
     const PreparedVolume& volume() const { return *volumes.front(); }
     const Integrator& integrator() const { return *volumes.front()->integrator; }
-    bool writes_depth() const { return integrator().writes_depth(); }
-    bool writes_error() const { return integrator().writes_error(); }
+    // The image-space renderer that draws the image instead of the integrators (vtk-cpu), or null.
+    const vtkcpu::VtkFixedPointRenderer* image_space() const { return volumes.front()->image_space.get(); }
+    bool writes_depth() const { return !image_space() && integrator().writes_depth(); }
+    bool writes_error() const { return !image_space() && integrator().writes_error(); }
 
     // Scratch space of one thread for integrate(): each volume's local rays and intervals.
     struct Scratch {
@@ -54,6 +56,10 @@ struct PreparedScene {
     // integrator (the SIMD packet path when `simd` and the volume allows it), then for several volumes
     // the mix. The result does not depend on `simd` beyond the packet path's documented rounding.
     void integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const;
+
+    // Pixels (x0 .. x0 + count - 1, y) of the image (count <= kMaxPacketRays): the camera's rays
+    // integrated (integrate), or the image-space renderer's pixels. The render step's one call.
+    void pixels(int x0, int y, int count, PixelValue* out, bool simd, Scratch& scratch) const;
 
     // The one volume `volref trace` and `volref explain ray` follow; an Error for several volumes.
     const PreparedVolume& traced_volume() const;

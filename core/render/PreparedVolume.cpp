@@ -15,6 +15,7 @@
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/packet/FastProfile.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
+#include "core/integrate/profiles/VtkFixedPointRenderer.h"
 #include "core/io/VolumeReader.h"
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
@@ -269,9 +270,18 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
-    integrator = scene.render.profile == ProfileId::Reference || scene.render.profile == ProfileId::Fast
-                     ? make_integrator(*context)
-                     : std::make_unique<ProfileIntegrator>(*context, profile(scene.render.profile), volume, &scene);
+    if (scene.render.profile == ProfileId::Reference || scene.render.profile == ProfileId::Fast) {
+        integrator = make_integrator(*context);
+    } else if (const Profile& p = profile(scene.render.profile); p.renderer == Profile::Renderer::VtkFixedPoint) {
+        check_profile_applies(p, *pipeline, scene.render);
+        if (vs.bounds.type != BoundsSpec::Type::Box || vs.bounds.min || vs.bounds.max)
+            throw Error(std::string("render.profile: \"") + p.name +
+                        "\" casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
+        image_space = std::make_unique<vtkcpu::VtkFixedPointRenderer>(volume, *classifier, shader.get(), scene.render.projection,
+                                                                      step, scene.camera, scene.image, vs.interpolation);
+    } else {
+        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume);
+    }
     // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed
     // volume whose gradient is used.
     packets = !(transform && (shader || classifier->needs_gradient()));

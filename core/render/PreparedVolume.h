@@ -35,6 +35,10 @@
 
 namespace volref {
 
+namespace vtkcpu {
+class VtkFixedPointRenderer;
+}
+
 // A ShellSampler as the pipeline's FieldSampler and GradientSource (world-space differences).
 class ShellField final : public FieldSampler, public GradientSource {
 public:
@@ -90,7 +94,10 @@ struct PreparedVolume {
     int geometry_id = 0;
     glm::dvec3 view_lo{0.0}, view_hi{0.0};          // the world box this volume adds to the default camera's view
     std::unique_ptr<IntegrationContext> context;
-    std::unique_ptr<Integrator> integrator;
+    std::unique_ptr<Integrator> integrator;  // null when an image-space renderer draws the image instead
+    // render.profile "vtk-cpu": VTK's fixed-point mapper, an image-space renderer (its own internal
+    // image and display; VtkFixedPointRenderer.h), called from the render step instead of `integrator`.
+    std::unique_ptr<vtkcpu::VtkFixedPointRenderer> image_space;
     bool packets = true;  // false: the integrator's SIMD packet path does not apply (shading a transformed volume)
 
     // The ray this volume's geometry, pipeline and integrator take: the world ray, or its local ray.

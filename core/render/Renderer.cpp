@@ -131,7 +131,6 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
             for (double x : v->model.volume.values)
                 if (!std::isfinite(x)) ++stats->non_finite_voxels;
     }
-    const Camera& camera = *prepared.camera;
     const int W = scene.image.width, H = scene.image.height;
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
@@ -148,7 +147,6 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
             // Each tile row is integrated in packets of up to kMaxPacketRays pixels.
             PreparedScene::Scratch scratch;
-            Ray rays[kMaxPacketRays];
             PixelValue values[kMaxPacketRays];
             for (int tile = r.begin(); tile != r.end(); ++tile) {
                 if (cancel_requested()) return;  // SIGINT/SIGTERM: stop at the next tile (Cancellation.h)
@@ -157,8 +155,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
                 for (int y = y0; y < std::min(y0 + T, H); ++y)
                     for (int xs = x0; xs < x_end; xs += kMaxPacketRays) {
                         const int count = std::min(kMaxPacketRays, x_end - xs);
-                        for (int i = 0; i < count; ++i) rays[i] = camera.pixel_ray(xs + i, y);
-                        prepared.integrate(rays, count, values, options.simd, scratch);  // Embree packets per volume
+                        prepared.pixels(xs, y, count, values, options.simd, scratch);  // Embree packets per volume
                         for (int i = 0; i < count; ++i) {
                             for (int c = 0; c < 4; ++c) image.at(xs + i, y, std::size_t(c)) = values[i].rgba[c];
                             if (prepared.writes_depth()) image.at(xs + i, y, 4) = values[i].depth;

@@ -1,4 +1,4 @@
-// The vtk-cpu profile (core/integrate/profiles/VtkCpuProfile.h): vtkFixedPointVolumeRayCastMapper's 15-bit
+// The vtk-cpu profile (core/integrate/profiles/VtkFixedPointRenderer.h): vtkFixedPointVolumeRayCastMapper's 15-bit
 // arithmetic checked against numbers worked out by hand in the comments (integer arithmetic, one
 // unit = 1/32768), VTK's own clipping range (printed by python3-vtk9), and `volref trace` for every
 // mirror profile (the last row is the rendered pixel, bit for bit). The images themselves are
@@ -11,7 +11,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/explain/PixelTrace.h"
-#include "core/integrate/profiles/VtkCpuProfile.h"
+#include "core/integrate/profiles/VtkFixedPointRenderer.h"
 #include "core/render/PreparedScene.h"
 #include "core/render/Renderer.h"
 #include "transfer/Classifier.h"
@@ -189,12 +189,12 @@ TEST(VtkCpuProfile, OpacityTableCorrectedForTheStepByHand) {
     s.volume().transfer.color = {{0.0, 0.5, 0.5, 0.5}, {1.0, 0.5, 0.5, 0.5}};
     const Volume v = load_volume(s.volume());
     const std::unique_ptr<Classifier> k = make_classifier(s.volume(), v);
-    const vtkcpu::Caster c(v, *k, nullptr, Projection::Composite, 0.5, s.camera, s.image, Interpolation::Trilinear);
+    const vtkcpu::VtkFixedPointRenderer c(v, *k, nullptr, Projection::Composite, 0.5, s.camera, s.image, Interpolation::Trilinear);
     EXPECT_EQ(c.opacity_table().size(), 32768u);
     EXPECT_EQ(c.opacity_table().front(), 9597);
     EXPECT_EQ(c.opacity_table().back(), 9597);
     EXPECT_EQ(c.color_table()[0], 16384);
-    const vtkcpu::Caster m(v, *k, nullptr, Projection::Mip, 0.5, s.camera, s.image,
+    const vtkcpu::VtkFixedPointRenderer m(v, *k, nullptr, Projection::Mip, 0.5, s.camera, s.image,
                            Interpolation::Trilinear);
     EXPECT_EQ(m.opacity_table()[100], 16384);
 }

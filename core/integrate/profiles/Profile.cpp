@@ -30,7 +30,7 @@ Profile make_vtk_gpu() {
 }
 
 // vtkFixedPointVolumeRayCastMapper of VTK 9.1, its CPU mapper: 15-bit fixed point throughout, on an
-// internal image drawn as a stretched texture: its own renderer (VtkCpuProfile.h has it;
+// internal image drawn as a stretched texture: its own renderer (VtkFixedPointRenderer.h has it;
 // (conventions section 9 states each formula).
 Profile make_vtk_cpu() {
     Profile p;

@@ -17,38 +17,33 @@
 
 namespace volref {
 
-ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
-                                     const Scene* scene)
-    : Integrator(ctx), p_(profile) {
-    const std::string where = std::string("render.profile: \"") + p_.name + "\" ";
-    const RenderSpec& r = ctx.render;
+void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, const RenderSpec& r) {
+    const std::string where = std::string("render.profile: \"") + p.name + "\" ";
     if (r.projection == Projection::FirstHit) throw Error(where + "does not render the first-hit projection");
     if (r.integrator != IntegrationMethod::Fixed) throw Error(where + "needs render.integrator \"fixed\"");
     if (r.order != CompositeOrder::FrontToBack)
         throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
-    const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
-    if (!cartesian && p_.grids == Profile::Grids::Cartesian) throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
-    if (p_.grids == Profile::Grids::CartesianAndShells && ctx.pipeline.shaded() && r.projection == Projection::Composite)
+    if (!pipeline.cartesian_sampler() && p.grids == Profile::Grids::Cartesian)
+        throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
+    if (p.grids == Profile::Grids::CartesianAndShells && pipeline.shaded() && r.projection == Projection::Composite)
         throw Error(where + "does not shade (remove volume.shading)");
-    if (ctx.pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
-    if (ctx.pipeline.classifier().needs_gradient())
+    if (pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
+    if (pipeline.classifier().needs_gradient())
         throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
-    if (p_.renderer == Profile::Renderer::VtkFixedPoint) {
-        if (!scene) throw Error(where + "needs the scene's camera and image (construct ProfileIntegrator with the scene)");
-        if (scene->volumes.size() != 1) throw Error(where + "renders one volume: volumes");
-        const BoundsSpec& b = scene->volume().bounds;
-        if (b.type != BoundsSpec::Type::Box || b.min || b.max)
-            throw Error(where + "casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
-        vtk_cpu_ = std::make_unique<vtkcpu::Caster>(volume, ctx.pipeline.classifier(), ctx.pipeline.shader(), r.projection,
-                                                    ctx.step, scene->camera, scene->image, scene->volume().interpolation);
-        return;
-    }
+}
+
+ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume)
+    : Integrator(ctx), p_(profile) {
+    check_profile_applies(p_, ctx.pipeline, ctx.render);
+    if (p_.renderer != Profile::Renderer::RayCaster)
+        throw Error(std::string("render.profile: \"") + p_.name + "\" is an image-space renderer, not a ray integrator");
+    const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
     const double inf = std::numeric_limits<double>::infinity();
     domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
     domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
     step_ = ctx.step;
-    if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && r.step_units == StepUnits::Voxel) {
+    if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && ctx.render.step_units == StepUnits::Voxel) {
         int axis = 0;
         for (int a = 1; a < 3; ++a)
             if (cartesian ? volume.spacing[a] < volume.spacing[axis] : volume.dims[a] > volume.dims[axis]) axis = a;
@@ -142,12 +137,6 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
 }
 
 PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    if (vtk_cpu_) {  // the pixel this ray belongs to, as VTK draws it (its own clipping: intervals unused)
-        const auto [x, y] = vtk_cpu_->pixel_of(ray);
-        PixelValue out;
-        out.rgba = vtk_cpu_->display(x, y, nullptr);
-        return out;
-    }
     NoRecording rec;
     return integrate_impl(ray, intervals, rec);
 }
@@ -155,12 +144,6 @@ PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interv
 PixelValue ProfileIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                SampleRecorder& recorder) const {
     Recording rec{recorder};
-    if (vtk_cpu_) {
-        const auto [x, y] = vtk_cpu_->pixel_of(ray);
-        PixelValue out;
-        out.rgba = vtk_cpu_->display(x, y, &rec);
-        return out;
-    }
     return integrate_impl(ray, intervals, rec);
 }
 

@@ -14,8 +14,8 @@
 //              pixel (g, g, g, 1).
 //   composite with Compositing::BackToFrontLerp: sum = lerp(sum, (c, a), a density) from the far end.
 // Every formula is an accumulator's (march/Accumulators.h).
-//   vtk-cpu (Renderer::VtkFixedPoint): VtkCpuProfile.h's caster renders the pixel the ray belongs to
-//              (its internal rays, then the texture display); needs the scene's camera and image.
+// vtk-cpu (Renderer::VtkFixedPoint) is not a ray integrator: VtkFixedPointRenderer.h renders its image
+// in image space, called from the render step (PreparedScene::pixels).
 #pragma once
 #include <memory>
 #include <vector>
@@ -26,16 +26,17 @@
 #include "core/integrate/Integrator.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/integrate/march/SampleRecorder.h"
-#include "core/integrate/profiles/VtkCpuProfile.h"
 
 namespace volref {
 
+// What every mirror profile needs of the scene (fixed step, front-to-back order, its own termination,
+// a grid it reads, post-classification by value alone); throws volref::Error naming render.profile.
+void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, const RenderSpec& render);
+
 class ProfileIntegrator final : public Integrator {
 public:
-    // Throws volref::Error naming render.profile for what the profile cannot render. `scene`: the
-    // scene being rendered (its camera and image size), required by vtk-cpu.
-    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
-                      const Scene* scene = nullptr);
+    // Throws volref::Error naming render.profile for what the profile cannot render.
+    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
     ~ProfileIntegrator() override;
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     // The same loops, recording every sample (SampleRecorder.h): the record's segment is the length
@@ -77,7 +78,6 @@ private:
     double lo_ = 0.0, width_ = 0.0;  // the data range [lo, lo + width]
     std::vector<glm::dvec4> table_;  // rgb + uncorrected opacity
     std::vector<double> table_alpha_;  // corrected for the step (composite)
-    std::unique_ptr<vtkcpu::Caster> vtk_cpu_;  // vtk-cpu only
 };
 
 }  // namespace volref

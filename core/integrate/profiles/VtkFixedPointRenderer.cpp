@@ -1,4 +1,4 @@
-#include "core/integrate/profiles/VtkCpuProfile.h"
+#include "core/integrate/profiles/VtkFixedPointRenderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -133,7 +133,7 @@ std::array<double, 2> clipping_range(const glm::dvec3& eye, const glm::dvec3& fo
 
 // ---------------------------------------------------------------------------------------------
 
-Caster::Caster(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
+VtkFixedPointRenderer::VtkFixedPointRenderer(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
                double step, const CameraSpec& camera, const ImageSpec& image, Interpolation interpolation)
     : dims_(volume.dims), origin_(volume.origin), spacing_(volume.spacing), projection_(projection),
       shaded_(shader != nullptr && projection == Projection::Composite), step_(step), width_(image.width),
@@ -321,7 +321,7 @@ Caster::Caster(const Volume& volume, const Classifier& classifier, const Shader*
 // n = (f(x - d) - f(x + d)) / (d aspect) per axis (one-sided 2 (f(x) - f(x + d)) or
 // 2 (f(x - d) - f(x)) within d of a face), aspect = 2 spacing / mean spacing, for d = 1, 2, 3 until
 // |n| > 1e-5 (max - min); normalised and encoded (zero when no d gives one). Arithmetic in float.
-void Caster::build_gradients() {
+void VtkFixedPointRenderer::build_gradients() {
     const std::int64_t nx = dims_[0], ny = dims_[1], nz = dims_[2];
     const double avg = (spacing_.x + spacing_.y + spacing_.z) / 3.0;
     const double aspect[3] = {spacing_.x * 2.0 / avg, spacing_.y * 2.0 / avg, spacing_.z * 2.0 / avg};
@@ -373,7 +373,7 @@ void Caster::build_gradients() {
 // diffuse D += ka I + (n.L > 0 ? kd (n.L) I : 0), specular S += (n.L > 0 and n.H > 0.001 ? ks (n.H)^p I : 0),
 // with n.L and n.H negated when two-sided lighting is on and n.V > 0; a zero normal gets D = ka I,
 // S = 0. Accumulated in float, then unsigned(x 32767 + 0.5).
-void Caster::build_shading(const Shader& shader) {
+void VtkFixedPointRenderer::build_shading(const Shader& shader) {
     const ShadingSpec& s = shader.spec();
     const glm::dvec3 view = forward_;
     std::vector<float> D(3 * std::size_t(kDirections), 0.0f), S(3 * std::size_t(kDirections), 0.0f);
@@ -424,7 +424,7 @@ void Caster::build_shading(const Shader& shader) {
 // view transform (rows r, u, (eye - target) / |eye - target|, translation -R eye); P:
 // Perspective(fov_y, aspect, n, F) (Frustum with x_max = tan(fov_y / 2) n aspect, y_max =
 // tan(fov_y / 2) n) after AdjustZBuffer(-1, 1, 0, 1) (view depth 0 at the near plane, 1 at the far).
-void Caster::build_view_to_voxels() {
+void VtkFixedPointRenderer::build_view_to_voxels() {
     using M4 = std::array<double, 16>;  // row-major
     auto mul = [](const M4& a, const M4& b) {
         M4 c{};
@@ -450,7 +450,7 @@ void Caster::build_view_to_voxels() {
         for (int j = 0; j < 4; ++j) view_to_voxels_[4 * i + j] = float(inv[j][i]);
 }
 
-std::array<int, 2> Caster::pixel_of(const Ray& ray) const {
+std::array<int, 2> VtkFixedPointRenderer::pixel_of(const Ray& ray) const {
     const double a = glm::dot(ray.direction, forward_);
     const double nx = glm::dot(ray.direction, right_) / a / (tan_half_ * aspect_);
     const double ny = glm::dot(ray.direction, up_) / a / tan_half_;
@@ -515,7 +515,7 @@ bool clip_ray(float s[3], float e[3], const float dir[3], const double b[6]) {
 // of the lattice near + k step (k = 1 + int(distance to the clipped start / step), counted along
 // the axis the start moved most) and positions in fixed point; the sample count the smallest over
 // the axes of 1 + (end - start) / step in fixed point.
-Caster::RayInfo Caster::ray_info(int i, int j) const {
+VtkFixedPointRenderer::RayInfo VtkFixedPointRenderer::ray_info(int i, int j) const {
     RayInfo info;
     // viewRay in float as the mapper computes it; start at view depth 0, end at depth 1 (no z-buffer).
     const float offset_x = float(1.0 / double(float(width_))), offset_y = float(1.0 / double(float(height_)));
@@ -576,7 +576,7 @@ constexpr double kDisplay = 2.0 / 65535.0;
 
 }  // namespace
 
-Pixel15 Caster::cast(int i, int j, Recording* rec) const {
+Pixel15 VtkFixedPointRenderer::cast(int i, int j, Recording* rec) const {
     Pixel15 out;
     if (!layout_.any || j < 0 || j >= layout_.in_use[1] || i < layout_.row_lo[std::size_t(j)] ||
         i > layout_.row_hi[std::size_t(j)])
@@ -685,7 +685,7 @@ Pixel15 Caster::cast(int i, int j, Recording* rec) const {
 // edges, GL_LINEAR: window pixel p reads the texture at s = (p + 0.5 - origin) (M - 1) / M texels
 // from texel 0's centre, i.e. texels floor(s) and floor(s) + 1 with weights 1 - frac(s), frac(s);
 // the texel value v / 65535 times the shader's scale 2. Pixels outside the quad are background.
-glm::dvec4 Caster::display(int x, int y, Recording* rec) const {
+glm::dvec4 VtkFixedPointRenderer::display(int x, int y, Recording* rec) const {
     glm::dvec4 out(0.0);
     if (!layout_.any) return out;
     const int px = x, py = height_ - 1 - y;  // VTK's window rows count from the bottom

@@ -1,8 +1,10 @@
-// VtkCpuProfile: the `vtk-cpu` profile, VTK 9.1's vtkFixedPointVolumeRayCastMapper (its CPU mapper)
+// VtkFixedPointRenderer: the `vtk-cpu` profile, VTK 9.1's vtkFixedPointVolumeRayCastMapper (its CPU mapper)
 // reproduced step by step in its own fixed-point arithmetic (conventions section 9, docs/gpu-checking.md).
 //
-// The mapper does three things a per-ray integrator does not, so this file is more than a Profile
-// struct (Profile.h describes the other profiles as data):
+// It is an image-space renderer, not a ray integrator: PreparedVolume builds it instead of an
+// Integrator for render.profile "vtk-cpu" (Profile::Renderer::VtkFixedPoint), and the render step
+// (PreparedScene::pixels) asks it for window pixels by their coordinates. The mapper does three
+// things a per-ray integrator does not:
 //  1. It casts rays on an internal image: one ray per window pixel centre inside the volume's
 //     projected bounding box widened by 2 pixels (ImageOrigin, ImageInUseSize), and inside each
 //     row only between the box's edges pulled in by about a pixel (RowBounds); elsewhere 0.
@@ -16,7 +18,9 @@
 //     on the quad's corners (the image is stretched by M / (M - 1)), scaled by 2 (0x7fff is 1/2 of
 //     a 16-bit texel).
 // The pixel volref writes for window pixel (x, y) is step 3 applied to the up to four internal
-// pixels it blends (each a ray of steps 1-2), so every output pixel still depends on rays alone.
+// pixels it blends (each a ray of steps 1-2), so every output pixel is computed on its own (any
+// thread count, any tile order). Its compositing is VTK's 15-bit integer arithmetic (composite()
+// below), the one compositing formula outside march/Accumulators.h: it is that mapper's, not volref's.
 //
 // Sources (Kitware/VTK, 9.1): vtkFixedPointVolumeRayCastMapper.{h,cxx} (ComputeRayInfo,
 // ClipRayAgainstVolume, ComputeRowBounds, UpdateColorTable, ComputeGradients, UpdateShadingTable),
@@ -91,10 +95,10 @@ struct Pixel15 {
     std::array<unsigned short, 4> rgba{0, 0, 0, 0};
 };
 
-class Caster {
+class VtkFixedPointRenderer {
 public:
     // Throws volref::Error naming the scene key vtk-cpu cannot mirror.
-    Caster(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
+    VtkFixedPointRenderer(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
            double step, const CameraSpec& camera, const ImageSpec& image, const Interpolation interpolation);
 
     // The displayed value of window pixel (x, y) (volref's film coordinates, row 0 at the top),

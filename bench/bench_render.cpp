@@ -55,7 +55,7 @@
 #include "core/camera/Camera.h"
 #include "core/film/Image.h"
 #include "core/grid/Volume.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/render/Renderer.h"
 #include "core/scene/Scene.h"
 #include "core/scene/SceneLoader.h"

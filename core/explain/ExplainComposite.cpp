@@ -1,6 +1,6 @@
 // explain composite: a list of samples composited by CompositeIntegrator itself. The samples become a
 // ray along +x from the origin through one interval [0, n d] cut into n segments of length d
-// (Segments.h); a field whose value at x is x / d and a classifier that returns sample floor(value)
+// (SamplePlacement.h); a field whose value at x is x / d and a classifier that returns sample floor(value)
 // hand segment k's midpoint ((k + 1/2) d) sample k. Integrator::integrate_traced records every step
 // (SampleRecorder.h), in the chosen order, and both orders are run to show that they agree.
 #include <algorithm>

@@ -8,7 +8,7 @@
 
 #include "core/explain/Explain.h"
 #include "core/explain/PixelTrace.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/render/PreparedScene.h"
 
 namespace volref::explain {
@@ -45,7 +45,7 @@ Explanation ray(const PreparedScene& scene, int x, int y) {
     for (const Interval& i : t.intervals)
         iv.rows.push_back({i.t0, i.t1, i.length(), double(segment_count(i, t.step))});
     if (t.intervals.empty()) iv.notes.push_back("none: the ray misses the volume; the pixel is (0, 0, 0, 0)");
-    Section& pl = e.section("sample placement (core/integrate/march/Segments.h)");
+    Section& pl = e.section("sample placement (core/integrate/march/SamplePlacement.h)");
     add(pl, "h", t.step, "step in world units");
     add(pl, "l", t.unit_distance, "opacity unit distance");
     pl.notes.push_back("n = max(1, ceil(L / h - 1e-9)) segments per interval, sampled at their midpoints,");

@@ -1,5 +1,5 @@
 // Integrator: turns one ray's intervals into one pixel. One implementation per projection
-// (conventions section 6); they share the sample placement of Segments.h and the optical model of
+// (conventions section 6); they share the sample placement of SamplePlacement.h and the optical model of
 // transfer/OpacityCorrection.h.
 #pragma once
 #include <limits>
@@ -67,6 +67,24 @@ public:
 
 protected:
     const IntegrationContext& ctx_;
+};
+
+// An integrator whose one loop, Derived::integrate_impl<Rec>(ray, intervals, rec), serves both the
+// render (NoRecording) and `volref trace` (Recording, SampleRecorder.h): the same statements, so the
+// traced pixel is the rendered one bit for bit. Derived befriends this class.
+template <class Derived>
+class OneLoopIntegrator : public Integrator {
+public:
+    using Integrator::Integrator;
+    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override {
+        NoRecording rec;
+        return static_cast<const Derived&>(*this).integrate_impl(ray, intervals, rec);
+    }
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
+                                SampleRecorder& recorder) const override {
+        Recording rec{recorder};
+        return static_cast<const Derived&>(*this).integrate_impl(ray, intervals, rec);
+    }
 };
 
 std::unique_ptr<Integrator> make_integrator(const IntegrationContext& ctx);

@@ -11,7 +11,7 @@
 #include "geometry/ShellCoordinates.h"
 #include "core/integrate/march/Accumulators.h"
 #include "transfer/OpacityCorrection.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/TransferFunction.h"

@@ -16,6 +16,27 @@ namespace {
 
 using namespace segment_walk;
 
+// The composite sample at segment s's midpoint. With Rec::kOn the same computation also fills the
+// stages of record r and starts it (the transmittance in front of the sample: the accumulator's).
+template <class Rec, class Record, class Acc>
+PipelineSample composite_sample(const SamplePipeline& pipeline, const Ray& ray, const Segment& s, Rec& rec, Record& r,
+                                const Acc& acc) {
+    if constexpr (Rec::kOn) {
+        rec.begin(r, s.t0, s.t1);
+        r.composited = true;
+        r.transmittance_before = acc.transmittance();
+        return pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
+    } else {
+        return pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+    }
+}
+
+// A composited sample's optical depth (infinite when opaque) and alpha, for its record.
+void record_opacity(SampleRecord& r, const SampleOpacity<Scalar>& o) {
+    r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
+    r.alpha = o.alpha;
+}
+
 // for_each_segment_reversed without the segments in empty macrocells.
 template <typename Fn>
 void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ray,
@@ -96,15 +117,7 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
     Segment s;
     while (walk.next(s)) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
-        PipelineSample p;
-        if constexpr (Rec::kOn) {
-            rec.begin(r, s.t0, s.t1);
-            p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
-            r.composited = true;
-            r.transmittance_before = acc.transmittance();
-        } else {
-            p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
-        }
+        const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
         if (!(p.opacity > 0.0)) {
             if constexpr (Rec::kOn) {  // nothing changes
                 r.transmittance_after = acc.transmittance();
@@ -117,8 +130,7 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
         const double c[3] = {p.color.r, p.color.g, p.color.b};
         acc.add(true, o.solid, o.tau, o.alpha, c);
         if constexpr (Rec::kOn) {
-            r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
-            r.alpha = o.alpha;
+            record_opacity(r, o);
             r.transmittance_after = o.solid ? 0.0 : acc.transmittance();
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
@@ -137,23 +149,12 @@ PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<
     [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
     for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, [&](const Segment& s) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
-        PipelineSample p;
-        if constexpr (Rec::kOn) {
-            rec.begin(r, s.t0, s.t1);
-            p = ctx_.pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
-            r.composited = true;
-            r.transmittance_before = acc.transmittance();
-        } else {
-            p = ctx_.pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
-        }
+        const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
         if (p.opacity > 0.0) {
             const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
             const double c[3] = {p.color.r, p.color.g, p.color.b};
             acc.add(true, o.solid, o.tau, o.alpha, c);
-            if constexpr (Rec::kOn) {
-                r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
-                r.alpha = o.alpha;
-            }
+            if constexpr (Rec::kOn) record_opacity(r, o);
         }
         if constexpr (Rec::kOn) {
             r.transmittance_after = acc.transmittance();

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/integrate/packet/FastProfile.h"
+#include "core/integrate/packet/PacketGrid.h"
 #include "core/sample/GradientField.h"
 #include "transfer/Shader.h"
 #include "transfer/TransferFunction.h"
@@ -20,34 +21,12 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     auto unavailable = [&](const char* reason) {
         if (fast) fast_profile_unavailable(reason);
     };
+    if (const char* reason = packet_path_unavailable(p, true, ctx.render.order)) {
+        unavailable(reason);
+        return;
+    }
     const TransferFunction* tf = p.stages().transfer_function;
-    const VolumeSampler* sampler = p.cartesian_sampler();
-    if (!tf) {
-        unavailable("this volume is classified otherwise");
-        return;
-    }
-    if (!sampler) {
-        unavailable("this volume is not on a Cartesian grid");
-        return;
-    }
-    if (p.preclassified()) {
-        unavailable("this volume is pre-classified");
-        return;
-    }
-    if (sampler->interpolation() != Interpolation::Trilinear) {
-        unavailable("this volume is not trilinear");
-        return;
-    }
-    if (ctx.render.order != CompositeOrder::FrontToBack) {
-        unavailable("this scene composites back to front");
-        return;
-    }
-    const Volume& v = sampler->volume();
-    // Non-finite voxels: the scalar path, whose pipeline makes them transparent (docs/accuracy.md).
-    if (!all_finite(v.values)) {
-        unavailable("this volume has non-finite voxels");
-        return;
-    }
+    const Volume& v = p.cartesian_sampler()->volume();
     PacketCompositeInputs in;
     const Volume* cached[3] = {nullptr, nullptr, nullptr};
     if (tf->needs_gradient() || p.shaded()) {
@@ -106,13 +85,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
             }
         }
     }
-    in.voxels = v.values.raw();
-    in.voxel_type = v.values.type();
-    for (int a = 0; a < 3; ++a) {
-        in.dims[a] = v.dims[a];
-        in.origin[a] = v.origin[a];
-        in.inv_spacing[a] = 1.0 / v.spacing[a];
-    }
+    in.grid = PacketGrid::of(v);
     in.normalized = tf->normalized();
     in.lo = tf->window()[0];
     in.inv_width = tf->inverse_window_width();

@@ -1,7 +1,8 @@
 #include "core/integrate/fixed/ExtremumIntegrator.h"
 
 #include "core/integrate/packet/FastProfile.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/packet/PacketGrid.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
 
 #include <algorithm>
@@ -12,38 +13,22 @@ namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
     const bool fast = ctx.render.profile == ProfileId::Fast;
-    const VolumeSampler* sampler = ctx.pipeline.cartesian_sampler();
     auto unavailable = [&](const char* reason) {
         if (fast) fast_profile_unavailable(reason);
     };
-    if (!sampler) {
-        unavailable("this volume is not on a Cartesian grid");
+    if (const char* reason = packet_path_unavailable(ctx.pipeline, false, ctx.render.order)) {
+        unavailable(reason);
         return;
     }
-    if (sampler->interpolation() != Interpolation::Trilinear) {
-        unavailable("this volume is not trilinear");
-        return;
-    }
-    const Volume& v = sampler->volume();
-    // Non-finite voxels: the scalar path, which ignores them (docs/accuracy.md).
-    if (!all_finite(v.values)) {
-        unavailable("this volume has non-finite voxels");
-        return;
-    }
+    const Volume& v = ctx.pipeline.cartesian_sampler()->volume();
     PacketExtremumInputs in;
-    in.voxels = v.values.raw();
-    in.voxel_type = v.values.type();
-    for (int a = 0; a < 3; ++a) {
-        in.dims[a] = v.dims[a];
-        in.origin[a] = v.origin[a];
-        in.inv_spacing[a] = 1.0 / v.spacing[a];
-    }
+    in.grid = PacketGrid::of(v);
     in.step = ctx.step;
     in.maximum = maximum;
     in.macrocells = ctx.macrocells;  // skipping (PreparedVolume builds the grid for mip / minip)
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();
-        fast_voxels(v, *fast_copies_, &in.voxels, &in.voxel_type);
+        fast_voxels(v, *fast_copies_, &in.grid.voxels, &in.grid.voxel_type);
         in.fast = true;
     }
     packet_ = in;

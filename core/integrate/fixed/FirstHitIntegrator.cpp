@@ -8,7 +8,7 @@
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/CellCubic.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/sample/VolumeSampler.h"
 
 namespace volref {

@@ -1,7 +1,7 @@
 // FirstHitIntegrator: the first crossing of the isovalue (conventions section 6).
 //
 // On each interval [t0, t1] (front to back) the field g(t) = f(t) - iso is evaluated at the segment
-// endpoints of Segments.h (t0, t0 + h, ..., t1). The first endpoint where g is 0, or where the sign
+// endpoints of SamplePlacement.h (t0, t0 + h, ..., t1). The first endpoint where g is 0, or where the sign
 // of g differs from the previous endpoint's, brackets the crossing; bisection halves the bracket
 // (keeping the sign change) until it is at most kFirstHitRelativeTolerance * (t1 - t0) wide and the
 // hit is its midpoint. The pixel is the classification's colour there, shaded when the scene is,

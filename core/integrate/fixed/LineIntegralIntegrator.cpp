@@ -3,21 +3,10 @@
 #include <cmath>
 
 #include "core/integrate/march/CompensatedSum.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
 
 namespace volref {
-
-PixelValue LineIntegralIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    NoRecording rec;
-    return integrate_impl(ray, intervals, rec);
-}
-
-PixelValue LineIntegralIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                                    SampleRecorder& recorder) const {
-    Recording rec{recorder};
-    return integrate_impl(ray, intervals, rec);
-}
 
 // With Rec::kOn each record carries the sample's value and coordinate s(v) and the projection of the
 // ray so far (g of the segments up to this one); no classification is involved.
@@ -47,5 +36,10 @@ PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vec
     out.rgba = glm::dvec4(g, g, g, 1.0);
     return out;
 }
+
+// The two loops OneLoopIntegrator calls (its virtual functions are instantiated where the class is
+// constructed, which does not see this definition).
+template PixelValue LineIntegralIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, NoRecording&) const;
+template PixelValue LineIntegralIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, Recording&) const;
 
 }  // namespace volref

@@ -1,5 +1,5 @@
 // LineIntegralIntegrator: the average and x-ray projections (conventions section 6).
-// With the midpoint samples of Segments.h, I = sum_k s(v_k) d_k (a compensated sum) and L = sum_k d_k,
+// With the midpoint samples of SamplePlacement.h, I = sum_k s(v_k) d_k (a compensated sum) and L = sum_k d_k,
 // where s is the transfer function's coordinate (the data value, or the normalised value for the
 // normalised domain):
 //   average: g = I / L,          pixel (g, g, g, 1);
@@ -11,14 +11,12 @@
 
 namespace volref {
 
-class LineIntegralIntegrator final : public Integrator {
+class LineIntegralIntegrator final : public OneLoopIntegrator<LineIntegralIntegrator> {
 public:
-    LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : Integrator(ctx), mean_(mean) {}
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                SampleRecorder& recorder) const override;
+    LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : OneLoopIntegrator(ctx), mean_(mean) {}
 
 private:
+    friend class OneLoopIntegrator<LineIntegralIntegrator>;
     template <class Rec>
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     bool mean_;

@@ -78,6 +78,13 @@ public:
         else s_ = L::select(visible, s_ + w, s_);
         opaque_ = L::or_(opaque_, L::and_(visible, solid));
     }
+    // Continues behind an already composited pixel (C, A) (opacity-sum rule): the film puts the
+    // background behind a rendered pixel this way.
+    void resume(const V C[3], V A) {
+        static_assert(R == ::volref::TransmittanceRule::OpacitySum);
+        for (int i = 0; i < 3; ++i) color_[i] = C[i];
+        s_ = A;
+    }
     // A piece integrated by quadrature (the adaptive integrator): its emission E relative to the
     // transmittance at its front, C += T E, and its optical depth in two halves (optical-depth rule).
     void add_emission(const V E[3], V tau0, V tau1) {

@@ -1,4 +1,4 @@
-// Walking a ray's segments (Segments.h) with empty-space skipping (conventions section 4): the
+// Walking a ray's segments (SamplePlacement.h) with empty-space skipping (conventions section 4): the
 // segments whose midpoints lie in an empty macrocell (MacrocellGrid.h) are passed over, every other
 // segment is visited exactly as without skipping, in the same order. Shared by the scalar
 // CompositeIntegrator and the SIMD packet path, so both visit the same segments.
@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "core/camera/Ray.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/sample/MacrocellGrid.h"
 
 namespace volref {

@@ -6,7 +6,7 @@
 
 #include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SamplePipeline.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
 
 namespace volref {

@@ -5,7 +5,7 @@
 //
 // composite (the media mix): the union of every I_k's end points cuts the ray into pieces on which
 // the set of volumes present is constant; each piece is cut into segments of the scene's step h (the
-// smallest of the volumes' steps) exactly as Segments.h cuts an interval, and sampled at the
+// smallest of the volumes' steps) exactly as SamplePlacement.h cuts an interval, and sampled at the
 // midpoints. At a midpoint every present volume k gives (a_k, c_k) through its own pipeline; its
 // optical depth over the segment is tau_k = -(d / l_k) log1p(-a_k) (transfer/OpacityCorrection.h), the
 // extinctions add, tau = sum tau_k, and the emitted colour is the extinction-weighted mix

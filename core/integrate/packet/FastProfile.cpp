@@ -73,7 +73,7 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
         tf.gradient_opacity_x = copies.gradient_opacity_x.data();
         tf.gradient_opacity_y = copies.gradient_opacity_y.data();
     }
-    fast_voxels(volume, copies, &in.voxels, &in.voxel_type);
+    fast_voxels(volume, copies, &in.grid.voxels, &in.grid.voxel_type);
     if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
         // Held: the volume, its f64 gradient cache and any float voxels; allocated: the float cache.
         check_memory(volume.values.bytes() + 3 * volume.values.size() * (sizeof(double) + sizeof(float)) +

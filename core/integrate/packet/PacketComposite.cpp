@@ -177,16 +177,16 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     HWY_ALIGN T buf[RayPacketT<T>::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinearT<T> trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, in.grid.origin, in.grid.inv_spacing);
     // The cached gradient components share the volume's grid.
     const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
     const ScalarType cached_type = kFast ? ScalarType::F32 : ScalarType::F64;
-    const PacketTrilinearT<T> gx(cached ? tab.cached_gradient[0] : in.voxels, cached ? cached_type : in.voxel_type,
-                                 in.dims, in.origin, in.inv_spacing);
-    const PacketTrilinearT<T> gy(cached ? tab.cached_gradient[1] : in.voxels, cached ? cached_type : in.voxel_type,
-                                 in.dims, in.origin, in.inv_spacing);
-    const PacketTrilinearT<T> gz(cached ? tab.cached_gradient[2] : in.voxels, cached ? cached_type : in.voxel_type,
-                                 in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> gx(cached ? tab.cached_gradient[0] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
+                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+    const PacketTrilinearT<T> gy(cached ? tab.cached_gradient[1] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
+                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+    const PacketTrilinearT<T> gz(cached ? tab.cached_gradient[2] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
+                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
     const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}};
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
 

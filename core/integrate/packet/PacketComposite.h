@@ -2,7 +2,7 @@
 // instruction set: AVX-512 = 8 rays per vector, AVX2 = 4, SSE4 = 2).
 //
 // Rays travel in structure-of-arrays packets; each lane walks its own intervals and segments (the
-// placement of Segments.h), and a mask retires lanes whose ray has ended, become opaque or reached
+// placement of SamplePlacement.h), and a mask retires lanes whose ray has ended, become opaque or reached
 // early termination. Every step is the scalar CompositeIntegrator's arithmetic in the same order:
 // the position origin + t direction, the continuous index, Levoy's trilinear sum term by term, the
 // piecewise-linear transfer function (first row with x > v), the optical depth
@@ -40,6 +40,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/grid/VoxelArray.h"
+#include "core/integrate/packet/PacketGrid.h"
 #include "core/integrate/Integrator.h"
 #include "core/integrate/march/Accumulators.h"
 #include "geometry/RayIntervals.h"
@@ -62,10 +63,7 @@ struct PacketTables {
 
 // Everything the kernel reads, as plain arrays.
 struct PacketCompositeInputs {
-    const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
-    ScalarType voxel_type = ScalarType::F64;
-    std::int64_t dims[3] = {1, 1, 1};
-    double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
+    PacketGrid grid;  // the volume's values, dims, origin and 1 / spacing (PacketGrid.h)
     bool normalized = false;  // transfer coordinate (v - lo) * inv_width, else v
     double lo = 0.0, inv_width = 1.0;
     PacketTables<double> tables_double;  // the reference profile's

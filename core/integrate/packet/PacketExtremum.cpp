@@ -31,7 +31,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinearT<T> trilinear(in.voxels, in.voxel_type, in.dims, in.origin, in.inv_spacing);
+    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, in.grid.origin, in.grid.inv_spacing);
     const V nan = hn::Set(d, std::numeric_limits<T>::quiet_NaN());
     Extremum<SimdLanes<T>> acc(in.maximum);
     while (packet.next()) {

@@ -9,6 +9,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/grid/VoxelArray.h"
+#include "core/integrate/packet/PacketGrid.h"
 #include "geometry/RayIntervals.h"
 
 namespace volref {
@@ -16,10 +17,7 @@ namespace volref {
 class MacrocellGrid;
 
 struct PacketExtremumInputs {
-    const void* voxels = nullptr;  // the volume's values, i fastest, in their storage type
-    ScalarType voxel_type = ScalarType::F64;
-    std::int64_t dims[3] = {1, 1, 1};
-    double origin[3] = {0, 0, 0}, inv_spacing[3] = {1, 1, 1};
+    PacketGrid grid;  // the volume's values, dims, origin and 1 / spacing (PacketGrid.h)
     double step = 1.0;
     bool maximum = true;
     // Skipping (null: none): macrocells whose values cannot beat a ray's extremum so far are passed

@@ -1,5 +1,5 @@
 // Pieces shared by the SIMD packet kernels (PacketComposite.cpp, PacketExtremum.cpp), compiled once
-// per Highway target: the lane walk over intervals and segments (Segments.h placement) and the
+// per Highway target: the lane walk over intervals and segments (SamplePlacement.h placement) and the
 // trilinear reconstruction of a packet of points, term by term as VolumeSampler::trilinear.
 // Each is a template over the lane type T: double for the reference profile (the scalar path's
 // arithmetic), float for the fast profile (FastProfile.h: twice the lanes, float rounding).

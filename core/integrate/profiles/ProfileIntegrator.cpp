@@ -11,7 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
-#include "core/integrate/march/Segments.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
 #include "transfer/OpacityCorrection.h"
 
@@ -34,7 +34,7 @@ void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, con
 }
 
 ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume)
-    : Integrator(ctx), p_(profile) {
+    : OneLoopIntegrator(ctx), p_(profile) {
     check_profile_applies(p_, ctx.pipeline, ctx.render);
     if (p_.renderer != Profile::Renderer::RayCaster)
         throw Error(std::string("render.profile: \"") + p_.name + "\" is an image-space renderer, not a ray integrator");
@@ -130,21 +130,10 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
         return;
     }
     for (const Interval& iv : intervals) {
-        const double n = std::max(1.0, std::floor(iv.length() / h + 1.0 - p_.first));
+        const double n = from_entry_count(iv, h, p_.first);
         for (double k = 0.0; k < n; k += 1.0)
-            if (!fn(iv.t0 + (p_.first + k) * h, h)) return;
+            if (!fn(from_entry_sample(iv, h, p_.first, k), h)) return;
     }
-}
-
-PixelValue ProfileIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    NoRecording rec;
-    return integrate_impl(ray, intervals, rec);
-}
-
-PixelValue ProfileIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                               SampleRecorder& recorder) const {
-    Recording rec{recorder};
-    return integrate_impl(ray, intervals, rec);
 }
 
 namespace {

@@ -33,19 +33,17 @@ namespace volref {
 // a grid it reads, post-classification by value alone); throws volref::Error naming render.profile.
 void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, const RenderSpec& render);
 
-class ProfileIntegrator final : public Integrator {
+// integrate_traced records every sample (SampleRecorder.h): the record's segment is the length the
+// sample stands for centred on it, `t` the sample's own position, `alpha` its alpha, `opacity` the
+// (table's) uncorrected opacity, transmittance 1 - A before and after it.
+class ProfileIntegrator final : public OneLoopIntegrator<ProfileIntegrator> {
 public:
     // Throws volref::Error naming render.profile for what the profile cannot render.
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
     ~ProfileIntegrator() override;
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    // The same loops, recording every sample (SampleRecorder.h): the record's segment is the length
-    // the sample stands for centred on it, `t` the sample's own position, `alpha` its alpha,
-    // `opacity` the (table's) uncorrected opacity, transmittance 1 - A before and after it.
-    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                SampleRecorder& recorder) const override;
 
 private:
+    friend class OneLoopIntegrator<ProfileIntegrator>;
     struct Lookup {
         glm::dvec3 color{0.0};
         double opacity = 0.0;    // the transfer function's (uncorrected)

@@ -1,6 +1,9 @@
-// Reference sample placement (conventions section 4): an interval [t0, t1] of length L is cut into
-// n = max(1, ceil(L / h - kSegmentSlack)) segments of length h, the last one shorter
-// (L - (n - 1) h); each segment is sampled at its midpoint and weighted by its own length.
+// Sample placement on a ray's interval list, every rule in one place (conventions sections 4 and 9).
+// The reference: an interval [t0, t1] of length L is cut into n = max(1, ceil(L / h - kSegmentSlack))
+// segments of length h, the last one shorter (L - (n - 1) h); each segment is sampled at its midpoint
+// and weighted by its own length (segment_count, segment; SegmentWalk.h walks them with skipping).
+// From the entry (GPU shaders, Profile::Placement::FromEntry): t0 + (first + k) h for k = 0 .. n - 1,
+// n = max(1, floor(L / h + 1 - first)), each standing for h (from_entry_count, from_entry_sample).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -27,6 +30,15 @@ inline Segment segment(const Interval& iv, double step, std::int64_t k, std::int
     const double a = iv.t0 + double(k) * step;
     const double b = k + 1 == n ? iv.t1 : iv.t0 + double(k + 1) * step;
     return {a, b};
+}
+
+// From the entry: the number of samples of `iv` and sample k's position (k and n are doubles, as a
+// shader's float loop counts them).
+inline double from_entry_count(const Interval& iv, double step, double first) {
+    return std::max(1.0, std::floor(iv.length() / step + 1.0 - first));
+}
+inline double from_entry_sample(const Interval& iv, double step, double first, double k) {
+    return iv.t0 + (first + k) * step;
 }
 
 // Calls fn(segment) front to back over every interval; fn returns false to stop early.

@@ -1,5 +1,7 @@
 #include "core/film/ImageWriter.h"
 
+#include "core/integrate/march/Accumulators.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,13 +39,16 @@ std::vector<T> quantised_over_background(const Image& image, const glm::dvec4& b
     std::vector<T> out(std::size_t(image.width) * std::size_t(image.height) * 4);
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) {
-            const double A = image.at(x, y, 3);
-            const double a = A + (1.0 - A) * bg.a;
+            // The background behind the pixel: C += (1 - A) a_bg c_bg, A += (1 - A) a_bg (the
+            // opacity-sum rule of core/integrate/march/Accumulators.h).
+            FrontToBack<Scalar, TransmittanceRule::OpacitySum> over;
+            const double C[3] = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
+            const double background[3] = {bg.r, bg.g, bg.b};
+            over.resume(C, image.at(x, y, 3));
+            over.add(true, false, 0.0, bg.a, background);
+            const double a = over.alpha();
             T* p = &out[(std::size_t(y) * std::size_t(image.width) + std::size_t(x)) * 4];
-            for (int c = 0; c < 3; ++c) {
-                const double premultiplied = image.at(x, y, std::size_t(c)) + (1.0 - A) * bg.a * bg[c];
-                p[c] = q(a > 0.0 ? premultiplied / a : 0.0);
-            }
+            for (int c = 0; c < 3; ++c) p[c] = q(a > 0.0 ? over.color(c) / a : 0.0);
             p[3] = q(a);
         }
     return out;

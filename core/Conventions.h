@@ -113,4 +113,9 @@ inline constexpr double kStepDoublingSafety = 5.0;
 // the neighbours' rays cross the same cells and are not all in that accident.
 inline constexpr int kStepDoublingNeighbourhood = 1;
 
+// JSON documents (scene files, sidecars, --set values, --shell) nest at most this many arrays and
+// objects; deeper input is an error naming the outermost path (its nesting would otherwise exhaust the
+// stack of the code that walks the document).
+inline constexpr int kMaxJsonDepth = 256;
+
 }  // namespace volref::conventions

@@ -1,5 +1,7 @@
 #include "core/scene/JsonReader.h"
 
+#include "core/Conventions.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -75,6 +77,7 @@ public:
     bool binary(binary_t& v) override { return add(Json::binary(std::move(v))) != nullptr; }
 
     bool start_object(std::size_t) override {
+        check_depth();
         frames_.push_back({add(Json::object()), {}});
         return true;
     }
@@ -89,6 +92,7 @@ public:
         return true;
     }
     bool start_array(std::size_t) override {
+        check_depth();
         frames_.push_back({add(Json::array()), {}});
         return true;
     }
@@ -130,10 +134,19 @@ private:
         return &slot;
     }
 
-    // The path of the value being read (the next element of the innermost array, or the current key).
-    std::string pending_path() const {
+    // conventions::kMaxJsonDepth: the error names the path of the outermost two levels.
+    void check_depth() const {
+        if (frames_.size() >= std::size_t(conventions::kMaxJsonDepth))
+            ctx_.fail(pending_path(2), "nested deeper than " + std::to_string(conventions::kMaxJsonDepth) +
+                                           " arrays and objects");
+    }
+
+    // The path of the value being read (the next element of the innermost array, or the current key);
+    // with `levels`, only the outermost `levels` containers.
+    std::string pending_path(std::size_t levels = std::size_t(-1)) const {
         std::string path = base_path_;
-        for (std::size_t i = 0; i < frames_.size(); ++i) {
+        const std::size_t n = std::min(levels, frames_.size());
+        for (std::size_t i = 0; i < n; ++i) {
             const Frame& f = frames_[i];
             const bool innermost = i + 1 == frames_.size();
             if (f.container->is_object())

@@ -1257,3 +1257,27 @@ TEST(SceneLoaderBounds, ShellAloneReadsAsInAScene) {
 }
 }  // namespace
 }  // namespace volref
+
+namespace volref {
+namespace {
+
+// {"volume": {"source": "v.nrrd", "x": [[...]]}} with `depth` containers in all (the two objects
+// included).
+std::string nested_scene(std::size_t depth) {
+    return R"({"volume": {"source": "v.nrrd", "x": )" + std::string(depth - 2, '[') + std::string(depth - 2, ']') +
+           "}}";
+}
+
+
+// conventions::kMaxJsonDepth: 256 levels of arrays and objects are read (the deepest level's own
+// problem is reported: an unknown key), 257 and 100,000 are refused in one line naming the outer path,
+// without walking (or crashing on) the nesting.
+TEST(SceneLoaderErrors, NestingDeeperThanTheLimitIsOneLineNotACrash) {
+    EXPECT_NE(error_of([&] { parse(nested_scene(256)); }).find("volume.x: unknown key"), std::string::npos);
+    const std::string expected = "scene.json: volume.x: nested deeper than 256 arrays and objects";
+    EXPECT_EQ(error_of([&] { parse(nested_scene(257)); }), expected);
+    EXPECT_EQ(error_of([&] { parse(nested_scene(100000)); }), expected);
+}
+
+}  // namespace
+}  // namespace volref

@@ -113,7 +113,8 @@ for case in sorted(set(fb) | set(fa)):
         continue
     worst = max((abs(x - y) if x == x and y == y else (0.0 if x != x and y != y else float("inf")))
                 for x, y in zip(va, vb))
-    print(f"DIFFERENT {case}: max |difference| {worst:.3e}")
+    signs = sum(1 for x, y in zip(va, vb) if x == 0 and y == 0 and str(x) != str(y))
+    print(f"DIFFERENT {case}: max |difference| {worst:.3e}" + (f" ({signs} zeros changed sign)" if signs else ""))
 print(f"image-identity: {same} identical, {differ} different, {slow} too slow in both (not compared)")
 sys.exit(1 if differ else 0)
 PY

@@ -96,6 +96,10 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
             data = words.data();
         }
     }
+    // No clock in the file: OpenImageIO writes the current time (EXR capDate, TIFF DateTime) unless
+    // DateTime is set, so two renders of one scene would differ in their bytes (issue 18). The same
+    // render gives the same file on every run and at any thread count.
+    spec.attribute("DateTime", "");
     std::error_code ec;
     if (!out->open(tmp.string(), spec) || !out->write_image(spec.format, data) || !out->close()) {
         const std::string why = out->geterror();

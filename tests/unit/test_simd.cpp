@@ -43,6 +43,25 @@ double max_difference(const Scene& s) {
 
 }  // namespace
 
+// Issue 18: a ray that meets nothing (a miss, or only transparent samples) has alpha +0, not -0, on
+// every path (the SIMD path once gave -0: Highway's expm1(-0) is +0 and the alpha is its negation).
+TEST(Simd, EmptyPixelsHavePositiveZeroAlpha) {
+    Scene s = ml_scene(37, 23);
+    s.camera.type = CameraSpec::Type::Perspective;
+    for (bool simd : {true, false})
+        for (ProfileId p : {ProfileId::Reference, ProfileId::Fast}) {
+            s.render.profile = p;
+            const Image im = render_scene(s, {.threads = 1, .simd = simd});
+            int zeros = 0;
+            for (std::size_t i = 3; i < im.pixels.size(); i += 4)
+                if (im.pixels[i] == 0.0) {
+                    ++zeros;
+                    EXPECT_FALSE(std::signbit(im.pixels[i])) << "pixel " << i / 4 << " simd " << simd;
+                }
+            EXPECT_GT(zeros, 0);  // the scene has empty pixels
+        }
+}
+
 // The packet path differs from the scalar one only in the last bits of exp, expm1 and log1p.
 TEST(Simd, CompositeMatchesTheScalarPath) {
     Scene s = ml_scene(37, 23);  // packets of 16 with a ragged tail

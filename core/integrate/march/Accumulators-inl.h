@@ -51,7 +51,10 @@ public:
     }
     // The accumulated opacity, not counting an opaque sample.
     V partial_alpha() const {
-        if constexpr (R == ::volref::TransmittanceRule::OpticalDepthSum) return L::neg(L::expm1(L::neg(s_ + c_)));
+        // + 0: a ray that met nothing has A = +0, never -0 (Highway's expm1(-0) is +0, so its negation
+        // was -0 on the SIMD path); x + 0 = x for every other x.
+        if constexpr (R == ::volref::TransmittanceRule::OpticalDepthSum)
+            return L::neg(L::expm1(L::neg(s_ + c_))) + L::splat(0.0);
         else if constexpr (R == ::volref::TransmittanceRule::Product) return L::splat(1.0) - s_;
         else return s_;
     }
@@ -138,7 +141,7 @@ public:
     V color(int channel) const { return color_[channel]; }
     V alpha() const {
         if constexpr (R == ::volref::BackToFrontRule::Lerp) return color_[3];
-        else return L::select(opaque_, L::splat(1.0), L::neg(L::expm1(L::neg(s_ + c_))));
+        else return L::select(opaque_, L::splat(1.0), L::neg(L::expm1(L::neg(s_ + c_))) + L::splat(0.0));
     }
     // The transmittance of what is composited so far (0 once a sample was opaque).
     V transmittance() const { return L::select(opaque_, L::splat(0.0), L::exp(L::neg(s_ + c_))); }

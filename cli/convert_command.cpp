@@ -1,6 +1,6 @@
 // volref convert IN OUT [--format F] [--type T] [--encoding raw|gzip]: reads any volume format and
-// writes NRRD (.nrrd: f64 by default, or f32) or raw + JSON sidecar (.raw: the input's type by default,
-// or any of the 8 types). Every argument is checked before the input is read; the output goes to a
+// writes NRRD (.nrrd) or raw + JSON sidecar (.raw), in the input's type by default or any of the 8
+// types (--type). Every argument is checked before the input is read; the output goes to a
 // temporary name renamed into place, so a failure leaves no file.
 #include <cstdio>
 #include <optional>
@@ -42,8 +42,6 @@ int run_convert(const ConvertArgs& args) {
     std::optional<ScalarType> type;
     if (!args.type.empty()) {
         type = parse_type(args.type);
-        if (nrrd && *type != ScalarType::F32 && *type != ScalarType::F64)
-            throw Error("--type: NRRD output is f32 or f64, got '" + args.type + "' (write .raw for integer types)");
     }
     if (nrrd) check_nrrd_output_path(args.output);
     volume_format(args.input, args.format);  // a bad format fails before any reading
@@ -51,7 +49,7 @@ int run_convert(const ConvertArgs& args) {
     const Volume volume = read_volume(args.input, args.format);
     if (nrrd) {
         NrrdWriteOptions o;
-        o.type = type.value_or(ScalarType::F64);
+        o.type = type.value_or(volume.type);  // the input's type unless --type says otherwise
         o.encoding = args.encoding == "gzip" ? NrrdWriteOptions::Encoding::Gzip : NrrdWriteOptions::Encoding::Raw;
         o.comments.push_back("volref convert from " + args.input.filename().string() + " (" +
                              scalar_type_name(volume.type) + ")");

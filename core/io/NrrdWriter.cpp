@@ -18,6 +18,7 @@
 
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
+#include "core/io/VoxelEncoding.h"
 
 namespace fs = std::filesystem;
 
@@ -139,6 +140,21 @@ void check_volume(const Volume& v, const fs::path& path) {
     }
 }
 
+// NRRD's name of each storage type (the names NrrdReader reads).
+const char* nrrd_type_name(ScalarType t) {
+    switch (t) {
+        case ScalarType::U8: return "uchar";
+        case ScalarType::I8: return "signed char";
+        case ScalarType::U16: return "ushort";
+        case ScalarType::I16: return "short";
+        case ScalarType::U32: return "uint";
+        case ScalarType::I32: return "int";
+        case ScalarType::F32: return "float";
+        case ScalarType::F64: return "double";
+    }
+    return "double";
+}
+
 std::string header(const Volume& v, const NrrdWriteOptions& o) {
     std::string h = "NRRD0004\n";
     for (const std::string& c : o.comments) {
@@ -147,14 +163,14 @@ std::string header(const Volume& v, const NrrdWriteOptions& o) {
         std::replace(line.begin(), line.end(), '\r', ' ');
         h += "# " + line + "\n";
     }
-    h += std::string("type: ") + (o.type == ScalarType::F32 ? "float" : "double") + "\n";
+    h += std::string("type: ") + nrrd_type_name(o.type) + "\n";
     h += "dimension: 3\n";
     h += "space dimension: 3\n";
     h += "sizes: " + std::to_string(v.dims[0]) + " " + std::to_string(v.dims[1]) + " " + std::to_string(v.dims[2]) + "\n";
     h += "space directions: (" + num(v.spacing.x) + ",0,0) (0," + num(v.spacing.y) + ",0) (0,0," + num(v.spacing.z) +
          ")\n";
     h += "kinds: domain domain domain\n";
-    h += "endian: little\n";
+    if (scalar_type_size(o.type) > 1) h += "endian: little\n";  // one-byte types have no byte order
     h += std::string("encoding: ") + (o.encoding == NrrdWriteOptions::Encoding::Gzip ? "gzip" : "raw") + "\n";
     h += "space origin: (" + num(v.origin.x) + "," + num(v.origin.y) + "," + num(v.origin.z) + ")\n";
     for (const auto& [key, value] : o.key_values) h += key + ":=" + escape_value(value) + "\n";
@@ -176,24 +192,20 @@ void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptio
     check_nrrd_output_path(path);
     check_volume(volume, path);
     const std::string at = path.string() + ": ";
-    if (options.type != ScalarType::F32 && options.type != ScalarType::F64)
-        throw Error(at + "the NRRD writer writes f32 or f64, not " + scalar_type_name(options.type));
     for (const auto& [key, value] : options.key_values) {
         if (key.empty() || key.find(":=") != std::string::npos || key.find('\n') != std::string::npos ||
             key.find('\r') != std::string::npos || key.front() == '#')
             throw Error(at + "invalid NRRD key '" + key + "'");
     }
-    const bool f32 = options.type == ScalarType::F32;
-    if (f32) {
-        constexpr double kFloatMax = double(std::numeric_limits<float>::max());
-        for (std::size_t n = 0; n < volume.values.size(); ++n) {
-            const double x = volume.values[n];
-            if (std::isfinite(x) && std::abs(x) > kFloatMax) {
-                const auto nx = std::size_t(volume.dims[0]), ny = std::size_t(volume.dims[1]);
-                throw Error(at + "value " + num(x) + " at voxel (" + std::to_string(n % nx) + ", " +
-                            std::to_string((n / nx) % ny) + ", " + std::to_string(n / (nx * ny)) +
-                            ") does not fit in f32 (write f64)");
-            }
+    // Every value must be representable in the type (checked before anything is written).
+    for (std::size_t n = 0; n < volume.values.size(); ++n) {
+        unsigned char scratch[8];
+        const double x = volume.values[n];
+        if (!encode_voxel(x, options.type, scratch)) {
+            const auto nx = std::size_t(volume.dims[0]), ny = std::size_t(volume.dims[1]);
+            throw Error(at + "value " + num(x) + " at voxel (" + std::to_string(n % nx) + ", " +
+                        std::to_string((n / nx) % ny) + ", " + std::to_string(n / (nx * ny)) + ") is not " +
+                        encodable_range(options.type) + (options.type == ScalarType::F32 ? " (write f64)" : ""));
         }
     }
 
@@ -208,15 +220,12 @@ void write_nrrd(const Volume& volume, const fs::path& path, const NrrdWriteOptio
         {
             Sink sink(file.get(), options.encoding == NrrdWriteOptions::Encoding::Gzip, path);
             constexpr std::size_t kChunk = 1 << 16;  // values per chunk
-            const std::size_t size = f32 ? 4 : 8;
+            const std::size_t size = scalar_type_size(options.type);
             std::vector<unsigned char> bytes(kChunk * size);
             for (std::size_t start = 0; start < volume.values.size(); start += kChunk) {
                 const std::size_t count = std::min(kChunk, volume.values.size() - start);
-                for (std::size_t n = 0; n < count; ++n) {
-                    const double x = volume.values[start + n];
-                    if (f32) store_little_endian(static_cast<float>(x), &bytes[n * 4]);
-                    else store_little_endian(x, &bytes[n * 8]);
-                }
+                for (std::size_t n = 0; n < count; ++n)
+                    encode_voxel(volume.values[start + n], options.type, &bytes[n * size]);  // checked above
                 sink.write(bytes.data(), count * size);
             }
             sink.finish();

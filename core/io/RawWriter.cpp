@@ -15,6 +15,7 @@
 
 #include "core/Error.h"
 #include "core/io/OutputFile.h"
+#include "core/io/VoxelEncoding.h"
 
 namespace fs = std::filesystem;
 
@@ -28,10 +29,6 @@ std::string num(double x) {
     return std::string(buf, r.ptr);
 }
 
-// The little-endian bytes of the integer `bits`, `size` of them.
-void put_le(std::string& out, std::uint64_t bits, std::size_t size) {
-    for (std::size_t b = 0; b < size; ++b) out += char((bits >> (8 * b)) & 0xff);
-}
 
 std::string voxel_name(const Volume& v, std::size_t n) {
     const auto nx = std::size_t(v.dims[0]), ny = std::size_t(v.dims[1]);
@@ -40,26 +37,12 @@ std::string voxel_name(const Volume& v, std::size_t n) {
 }
 
 std::string encode(const Volume& v, ScalarType type, const std::string& at) {
-    std::string out;
     const std::size_t size = scalar_type_size(type);
-    out.reserve(v.values.size() * size);
-    const bool integer = scalar_type_is_integer(type);
-    const auto [lo, hi] = scalar_type_range(type);
-    for (std::size_t n = 0; n < v.values.size(); ++n) {
-        const double x = v.values[n];
-        if (integer) {
-            if (!(x >= lo && x <= hi && std::floor(x) == x))
-                throw Error(at + "value " + num(x) + " at voxel " + voxel_name(v, n) + " is not an integer in the range of " +
-                            scalar_type_name(type));
-            put_le(out, static_cast<std::uint64_t>(static_cast<std::int64_t>(x)), size);
-        } else if (type == ScalarType::F32) {
-            if (std::isfinite(x) && std::fabs(x) > double(std::numeric_limits<float>::max()))
-                throw Error(at + "value " + num(x) + " at voxel " + voxel_name(v, n) + " does not fit in f32");
-            put_le(out, std::bit_cast<std::uint32_t>(static_cast<float>(x)), 4);
-        } else {
-            put_le(out, std::bit_cast<std::uint64_t>(x), 8);
-        }
-    }
+    std::string out(v.values.size() * size, '\0');
+    for (std::size_t n = 0; n < v.values.size(); ++n)
+        if (!encode_voxel(v.values[n], type, reinterpret_cast<unsigned char*>(&out[n * size])))
+            throw Error(at + "value " + num(v.values[n]) + " at voxel " + voxel_name(v, n) + " is not " +
+                        encodable_range(type));
     return out;
 }
 

@@ -150,7 +150,7 @@ TEST_F(FormatsCli, ConvertRoundTripsExactly) {
         EXPECT_EQ(a.origin, original.origin);
         EXPECT_EQ(a.spacing, original.spacing);
         EXPECT_EQ(a.values, original.values);
-        EXPECT_EQ(a.type, volref::ScalarType::F64);
+        EXPECT_EQ(a.type, volref::ScalarType::I16);  // NRRD keeps the input's type too (issue 18)
 
         const fs::path raw = dir_ / "out.raw";
         r = run("convert " + in.string() + " " + raw.string() + extra);
@@ -162,6 +162,16 @@ TEST_F(FormatsCli, ConvertRoundTripsExactly) {
         EXPECT_EQ(b.values, original.values);
         EXPECT_EQ(b.type, volref::ScalarType::I16);  // raw keeps the input's type by default
     }
+    // Every type NRRD and raw can hold, through NRRD: the values read back exactly, in that type, and
+    // the data takes its size per voxel (2 bytes for u16, where it used to be written as 8-byte doubles).
+    for (const std::string t : {"i16", "i32", "f32", "f64"}) {
+        const fs::path nrrd = dir_ / ("typed-" + t + ".nrrd");
+        const CliRun r = run("convert " + in.string() + " " + nrrd.string() + " --type " + t);
+        ASSERT_EQ(r.status, 0) << r.err;
+        const volref::Volume v = volref::read_volume(nrrd);
+        EXPECT_EQ(v.values, original.values) << t;
+        EXPECT_EQ(volref::scalar_type_name(v.type), t);
+    }
     // An explicit wider type holds the values exactly too.
     const fs::path wide = dir_ / "wide.raw";
     ASSERT_EQ(run("convert " + in.string() + " " + wide.string() + " --type i32").status, 0);
@@ -172,8 +182,8 @@ TEST_F(FormatsCli, ConvertRoundTripsExactly) {
 TEST_F(FormatsCli, BadInputOneLineNoOutput) {
     const fs::path in = write("head.nii", nifti_file());
     expect_error("convert " + in.string() + " " + (dir_ / "out.png").string(), "the output must be .nrrd", {dir_ / "out.png"});
-    expect_error("convert " + in.string() + " " + (dir_ / "out.nrrd").string() + " --type u8", "NRRD output is f32 or f64",
-                 {dir_ / "out.nrrd"});
+    expect_error("convert " + in.string() + " " + (dir_ / "out.nrrd").string() + " --type u8",
+                 "value -7 at voxel (1, 0, 0) is not an integer in the range of u8", {dir_ / "out.nrrd"});
     // -7 does not fit in u8: neither the data nor the sidecar appear.
     expect_error("convert " + in.string() + " " + (dir_ / "out.raw").string() + " --type u8",
                  "value -7 at voxel (1, 0, 0) is not an integer in the range of u8", {dir_ / "out.raw", dir_ / "out.raw.json"});

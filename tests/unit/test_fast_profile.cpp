@@ -260,3 +260,25 @@ TEST(FastProfile, FloatCopyRespectsTheMemoryLimit) {
     set_memory_limit(saved);
     EXPECT_EQ(message.rfind("render.profile: the fast profile's float copy of the voxels: needs 384 KiB", 0), 0u) << message;
 }
+
+// Issue 18, case 4: a volume far from the world origin (5e5, and 1e6 with spacing 1e-3) keeps the
+// fast profile within its bound: the float lanes work relative to the volume's origin and to each
+// ray's entry (the default camera follows the volume). World float positions were 0.235 and 0.57 off.
+TEST(FastProfile, FarFromTheOriginKeepsItsBound) {
+    for (const auto& [offset, spacing] : {std::pair{glm::dvec3(5e5, -3e5, 4e5), 1.0}, std::pair{glm::dvec3(1e6), 1e-3}}) {
+        Scene s = ml_scene();
+        s.volume().origin = *s.volume().origin + offset;
+        s.volume().spacing = *s.volume().spacing * spacing;
+        s.volume().transfer.opacity_unit_distance *= spacing;
+        EXPECT_LT(max_difference(s), kCutoff + 2e-5) << "composite at " << offset.x;
+        s.volume().shading = ShadingSpec{};
+        s.volume().shading->kl = 0.01 / spacing;  // depth cueing reads the world t
+        EXPECT_LT(max_difference(s), 2.0 * kCutoff + 1e-4) << "shaded at " << offset.x;
+        s.volume().shading.reset();
+        s.volume().transfer.opacity = {{0.0, 0.3}, {1.0, 1.0}};
+        for (Projection p : {Projection::Mip, Projection::Minip}) {
+            s.render.projection = p;
+            EXPECT_LT(max_difference(s), 2e-5) << "extremum at " << offset.x;
+        }
+    }
+}

@@ -73,6 +73,7 @@ struct PacketGradient {
     const PacketCompositeInputs& in;
     const PacketTrilinearT<T>& f;
     const PacketTrilinearT<T>* cached[3];
+    const double* shift;  // the fast profile's local coordinates: the domain relative to this; else null
 
     HWY_INLINE void operator()(const V X[3], V fx, V g[3]) const {
         const D d;
@@ -83,7 +84,9 @@ struct PacketGradient {
         for (int a = 0; a < 3; ++a) {
             g[a] = hn::Zero(d);
             if (f.flat[a]) continue;
-            const V h = hn::Set(d, T(in.spacing[a])), lo = hn::Set(d, T(in.domain_lo[a])), hi = hn::Set(d, T(in.domain_hi[a]));
+            const V h = hn::Set(d, T(in.spacing[a]));
+            const V lo = hn::Set(d, T(shift ? in.domain_lo[a] - shift[a] : in.domain_lo[a]));
+            const V hi = hn::Set(d, T(shift ? in.domain_hi[a] - shift[a] : in.domain_hi[a]));
             const V c = hn::Max(hn::Sub(X[a], h), lo);
             V P[3] = {X[0], X[1], X[2]};
             if (in.gradient == PacketCompositeInputs::Gradient::Central) {
@@ -172,22 +175,27 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     constexpr bool kFast = std::is_same_v<T, float>;
     const D d;
     const PacketTables<T>& tab = in.tables<T>();
-    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells);
+    // Float lanes work in coordinates local to the volume (RayPacketT): positions relative to its origin.
+    const double* local = kFast ? in.grid.origin : nullptr;
+    const double zero_origin[3] = {0.0, 0.0, 0.0};
+    const double* origin = kFast ? zero_origin : in.grid.origin;
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local);
     const std::size_t L = packet.lanes;
     HWY_ALIGN T buf[RayPacketT<T>::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+    const V t_ref = hn::Load(d, packet.t_ref_lane);  // 0 on double lanes
+    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, origin, in.grid.inv_spacing);
     // The cached gradient components share the volume's grid.
     const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
     const ScalarType cached_type = kFast ? ScalarType::F32 : ScalarType::F64;
     const PacketTrilinearT<T> gx(cached ? tab.cached_gradient[0] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+                                 in.grid.dims, origin, in.grid.inv_spacing);
     const PacketTrilinearT<T> gy(cached ? tab.cached_gradient[1] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+                                 in.grid.dims, origin, in.grid.inv_spacing);
     const PacketTrilinearT<T> gz(cached ? tab.cached_gradient[2] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, in.grid.origin, in.grid.inv_spacing);
-    const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}};
+                                 in.grid.dims, origin, in.grid.inv_spacing);
+    const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}, local};
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
 
     const V zero = hn::Zero(d), one = hn::Set(d, T(1));
@@ -226,7 +234,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                       table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, x)};
             if (in.shaded) {
                 if (!have_gradient) gradient(P, v, g);
-                shade<T>(in, m, g, view, t);
+                shade<T>(in, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
             }
             acc.add(o.visible, o.solid, o.tau, o.alpha, m);
             const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));

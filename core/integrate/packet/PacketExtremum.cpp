@@ -28,10 +28,16 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     HWY_ALIGN double extremum[kLanes];
     HWY_ALIGN T lane_best[kLanes];
     for (double& e : extremum) e = std::numeric_limits<double>::quiet_NaN();
-    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum);
+    // Float lanes work in coordinates local to the volume (RayPacketT): positions relative to its
+    // origin, t relative to each lane's first entry (added back to the extremum's t below).
+    constexpr bool kFast = std::is_same_v<T, float>;
+    const double zero_origin[3] = {0.0, 0.0, 0.0};
+    const double* origin = kFast ? zero_origin : in.grid.origin;
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum,
+                         kFast ? in.grid.origin : nullptr);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, in.grid.origin, in.grid.inv_spacing);
+    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, origin, in.grid.inv_spacing);
     const V nan = hn::Set(d, std::numeric_limits<T>::quiet_NaN());
     Extremum<SimdLanes<T>> acc(in.maximum);
     while (packet.next()) {
@@ -48,7 +54,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     hn::Store(acc.value(), d, b);
     hn::Store(acc.where(), d, tb);
     hn::Store(hn::IfThenElseZero(acc.any(), hn::Set(d, T(1))), d, s);
-    for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != T(0), double(b[l]), double(tb[l])};
+    for (int l = 0; l < count && l < int(packet.lanes); ++l) out[l] = RayExtremum{s[l] != T(0), double(b[l]), double(tb[l]) + packet.t_ref[l]};
 }
 
 template <typename T>

@@ -86,6 +86,12 @@ struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
     HWY_ALIGN T ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
     HWY_ALIGN T tm[kLanes], len[kLanes], live[kLanes];
+    // Local coordinates (float lanes, the fast profile): each lane's ray starts at its first entry
+    // point t_ref, relative to `local_origin` (the volume's origin), both in double before rounding,
+    // and tm holds t - t_ref; so a volume far from the world origin loses no float precision
+    // (issue 18: 0.235 off at origin 5e5). t_ref = 0 and world coordinates otherwise.
+    double t_ref[kLanes] = {};
+    HWY_ALIGN T t_ref_lane[kLanes] = {};
     ForwardSegmentWalk walk[kLanes];
     bool active[kLanes];
     std::size_t lanes = 0;
@@ -93,14 +99,24 @@ struct RayPacketT {
     // `extremum` (mip / minip skipping, SegmentWalk.h's extremum mode): each lane's running extremum,
     // kLanes values the caller keeps up to date (NaN before a lane's first sample).
     RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
-               const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true) {
+               const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true,
+               const double* local_origin = nullptr) {
         lanes = hn::Lanes(hn::ScalableTag<T>());
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
             const Ray& r = rays[real ? l : 0];
-            ox[l] = T(r.origin.x);
-            oy[l] = T(r.origin.y);
-            oz[l] = T(r.origin.z);
+            if (local_origin) {
+                const double t0 = real && !intervals[l].empty() ? intervals[l].front().t0 : 0.0;
+                t_ref[l] = t0;
+                t_ref_lane[l] = T(t0);
+                ox[l] = T(r.origin.x + t0 * r.direction.x - local_origin[0]);
+                oy[l] = T(r.origin.y + t0 * r.direction.y - local_origin[1]);
+                oz[l] = T(r.origin.z + t0 * r.direction.z - local_origin[2]);
+            } else {
+                ox[l] = T(r.origin.x);
+                oy[l] = T(r.origin.y);
+                oz[l] = T(r.origin.z);
+            }
             dx[l] = T(r.direction.x);
             dy[l] = T(r.direction.y);
             dz[l] = T(r.direction.z);
@@ -118,7 +134,7 @@ struct RayPacketT {
             Segment s;
             if (active[l] && !walk[l].next(s)) active[l] = false;
             if (active[l]) {
-                tm[l] = T(s.midpoint());
+                tm[l] = T(s.midpoint() - t_ref[l]);
                 len[l] = T(s.length());
                 live[l] = T(1);
                 any = true;

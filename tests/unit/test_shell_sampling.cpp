@@ -859,7 +859,9 @@ TEST_F(ResampleCommand, ShellErrorsAreTheScenesErrors) {
         {"spherical", R"({"type": "spherical", "radius": [0, 1], "latitude": [-100, 0]})"},
         {"spherical", R"({"type": "spherical", "radius": [0, 1], "axes": ["radius", "longitude", "up"]})"},
     };
-    for (const auto& [to, shell] : cases) {
+    for (const auto& c : cases) {
+        const std::string& to = c.first;
+        const std::string& shell = c.second;  // (clang 14 cannot capture a structured binding)
         const std::string alone = error_of([&] { parse_shell(shell, "--shell"); });
         const std::string in_scene = error_of([&] {
             parse_scene(R"({"volume": {"source": "v.nrrd", "bounds": )" + shell + "}}", dir_, "scene.json");

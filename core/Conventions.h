@@ -73,6 +73,15 @@ inline constexpr double kAdaptiveDefaultTolerance = 1e-6;
 // when they are kAdaptiveMaxDepth bisections deep (the estimate is still reported: 2^-48 of a
 // piece is below any length the double t of a ray resolves for pieces up to 2^48 ulps long).
 inline constexpr int kAdaptiveMaxDepth = 48;
+// Work per ray is bounded (issue 18: an opacity reaching 1 on a cell face made the bisection run for
+// minutes and grow without bound): a ray evaluates at most kAdaptiveMaxRulesPerRay G7/K15 rules (15
+// samples each). Once they are spent, every piece still open is accepted with the estimate it has
+// (the halves against their rule), so the pixel's error channel reports what was not resolved instead
+// of claiming the tolerance; the ray also stops refining once a cancel is requested (SIGINT/SIGTERM),
+// so a render answers it within one tile. 2^14 rules are about 250,000 samples, far more than a smooth
+// ray needs at the default tolerance; rays that spend them report error >= T K (T in front of the first
+// piece left unresolved, K >= 1 the largest colour), a bound on what the rest of the ray may change.
+inline constexpr long kAdaptiveMaxRulesPerRay = 1L << 14;
 inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16;  // 50 eps
 // Opacities are clamped to 1 - 2^-53 inside a piece so that sigma = -log1p(-a) / l stays finite at an
 // isolated point where a reaches 1 (a ramp ending at 1, a value touching a row with a = 1): the

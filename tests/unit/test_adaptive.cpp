@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <vector>
 
 #include "TestScenes.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "core/integrate/adaptive/CellCubic.h"
@@ -534,4 +538,78 @@ TEST(Adaptive, StepDoublingEstimateByHand) {
             EXPECT_NEAR(out.at(x, y, 5), x <= 2 ? 0.02 : 0.0, 1e-15) << x << "," << y;
             EXPECT_EQ(out.at(x, y, 4), 0.25);
         }
+}
+
+namespace {
+
+// A tent of opacity reaching 1 exactly on the grid plane x = 4 of a linear field f = x: near the
+// plane sigma = -log1p(-a) grows like -log|x - 4| (integrable), and the bisection used to run for
+// minutes on the rays that cross it (issue 18, case 3).
+Scene opacity_one_on_a_face(int size) {
+    Scene s = field_scene(linear_field({1, 0, 0, 0}, {9, 9, 9}));
+    s.volume().transfer.color = {{0.0, 1.0, 1.0, 1.0}, {8.0, 1.0, 1.0, 1.0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {4.0, 1.0}, {8.0, 0.0}};
+    s.camera.type = CameraSpec::Type::Perspective;
+    s.camera.eye = glm::dvec3(-10.0, 3.3, 4.1);
+    s.camera.target = glm::dvec3(4.0, 4.0, 4.0);
+    s.camera.up = glm::dvec3(0.0, 0.0, 1.0);
+    s.camera.fov_y = 40.0;
+    s.image.width = s.image.height = size;
+    s.render.integrator = IntegrationMethod::Adaptive;
+    return s;
+}
+
+}  // namespace
+
+// The work per ray is bounded (kAdaptiveMaxRulesPerRay) and the error channel stays honest where the
+// bound stops the refinement: every such pixel is within its error of a converged fine fixed step
+// (steps 1e-3 and 5e-4 agree to the stated fine_error on every pixel). Issue 18's case 1 (a kink of the
+// classification on a grid plane is not a cut) still leaves a few resolved pixels off by more than
+// their estimate here; they are counted and printed, not asserted, until that case is fixed.
+TEST(Adaptive, BoundedWorkWithHonestErrorWhereTheOpacityReachesOneOnAFace) {
+    const Scene s = opacity_one_on_a_face(10);
+    const Image a = render_scene(s, {.threads = 2});
+    Scene fine = s;
+    fine.render.integrator = IntegrationMethod::Fixed;
+    fine.render.step = 5e-4;
+    const Image f = render_scene(fine, {.threads = 2});
+    fine.render.step = 1e-3;
+    const Image f2 = render_scene(fine, {.threads = 2});
+    const std::size_t err = a.channel_count() - 1;
+    ASSERT_EQ(a.channels[err], "error");
+    int unresolved = 0, case1 = 0;
+    for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 10; ++x) {
+            double diff = 0.0, fine_error = 0.0;
+            for (std::size_t c = 0; c < 4; ++c) {
+                diff = std::max(diff, std::fabs(a.at(x, y, c) - f.at(x, y, c)));
+                fine_error = std::max(fine_error, std::fabs(f.at(x, y, c) - f2.at(x, y, c)));
+            }
+            EXPECT_LT(fine_error, 1e-4) << x << ", " << y;
+            if (a.at(x, y, err) > 1e-3) {  // a ray that spent its rules
+                ++unresolved;
+                EXPECT_LE(diff, a.at(x, y, err) + 2.0 * fine_error) << x << ", " << y;
+            } else if (diff > a.at(x, y, err) + 2.0 * fine_error) {
+                ++case1;
+            }
+        }
+    EXPECT_GT(unresolved, 0);  // the bound was reached on some rays, and they say so
+    std::printf("rays that spent their rules: %d; resolved pixels off by more than their estimate (case 1): %d\n",
+                unresolved, case1);
+}
+
+// A cancel (SIGINT/SIGTERM) stops the refinement inside long rays: the render gives up within a second.
+TEST(Adaptive, CancelIsAnsweredInsideLongRays) {
+    const Scene s = opacity_one_on_a_face(48);
+    reset_cancel();
+    std::thread canceller([] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        request_cancel(SIGINT);
+    });
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_THROW(render_scene(s, {.threads = 1}), Cancelled);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    canceller.join();
+    reset_cancel();
+    EXPECT_LT(seconds, 1.3);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
@@ -240,6 +241,11 @@ struct CompositeState {
     FrontToBack<Scalar, TransmittanceRule::OpticalDepthSum, true> acc;
     double colour_bound = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
     std::vector<LeafRecord> leaves;
+    long rules_left = conventions::kAdaptiveMaxRulesPerRay;  // work bound of the ray
+    double unresolved_T = 0.0;  // the transmittance in front of the first piece accepted unresolved
+    // False once the ray has spent its rules or a cancel was requested: open pieces are then accepted
+    // with their estimates (conventions.h, kAdaptiveMaxRulesPerRay).
+    bool may_refine() const { return rules_left > 0 && !cancel_requested(); }
 
     // sigma and colour at t; transparent where the value (or the shaded colour) is not finite.
     void sample(double t, double& sigma, glm::dvec3& c) const {
@@ -262,6 +268,7 @@ struct CompositeState {
         double tau_error() const { return std::fabs(tk - tg); }
     };
     Rule evaluate(double a, double b) {
+        --rules_left;
         const gk::Tables& g = gk::tables();
         const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
         double sigma[gk::kNodes];
@@ -313,6 +320,11 @@ struct CompositeState {
         const double budget = tolerance * (b - a) / total;
         const double roundoff = conventions::kAdaptiveRoundoffRelative * T * (max_abs(E) + colour_bound * (L.tk + R.tk));
         if (estimate <= budget || estimate <= roundoff) {
+            commit(T, E, L.tk, R.tk, e_e, e_t);
+            return;
+        }
+        if (!may_refine()) {  // unresolved: everything from here on is uncertain (see composite())
+            unresolved_T = std::max(unresolved_T, T);
             commit(T, E, L.tk, R.tk, e_e, e_t);
             return;
         }
@@ -372,7 +384,9 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
         tau_err += it->e_tau;
         behind += it->contribution;
     }
-    out.error = std::max(colour_err, T_end * tau_err) + rounding_bound(out.rgba);
+    // A piece accepted unresolved (the ray's rules spent) may be wrong by anything it and the pieces
+    // behind it contribute: at most T K in each channel (T in front of it, K >= 1 the largest colour).
+    out.error = std::max(colour_err, T_end * tau_err) + rounding_bound(out.rgba) + st.unresolved_T * st.colour_bound;
     return out;
 }
 
@@ -389,6 +403,8 @@ struct LineState {
     double safety;             // as CompositeState::safety
     CompensatedSum integral;
     double error = 0.0;
+    long rules_left = conventions::kAdaptiveMaxRulesPerRay;  // as CompositeState's
+    bool may_refine() const { return rules_left > 0 && !cancel_requested(); }
 
     double s(double t) const {
         const double v = pipeline->value(*ray, t);
@@ -399,7 +415,8 @@ struct LineState {
     struct Rule {
         double k = 0.0, g = 0.0;
     };
-    Rule evaluate(double a, double b) const {
+    Rule evaluate(double a, double b) {
+        --rules_left;
         const gk::Tables& t = gk::tables();
         const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
         Rule r;
@@ -423,7 +440,8 @@ struct LineState {
         const Rule L = evaluate(a, m), R = evaluate(m, b);
         const double sum = L.k + R.k;
         const double e = safety * (std::fabs(P.k - sum) + std::fabs(L.k - L.g) + std::fabs(R.k - R.g));
-        if (e <= budget_per_length * (b - a) || e <= conventions::kAdaptiveRoundoffRelative * std::fabs(sum)) {
+        if (e <= budget_per_length * (b - a) || e <= conventions::kAdaptiveRoundoffRelative * std::fabs(sum) ||
+            !may_refine()) {
             integral.add(L.k);
             integral.add(R.k);
             error += e;

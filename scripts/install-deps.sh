@@ -17,6 +17,9 @@ packages=(
   # the VTK parity test (scripts/vtk-parity.sh): VTK 9.1's mappers under Debian's /usr/bin/python3 on Mesa
   # llvmpipe (libgl1-mesa-dri comes as a dependency) in Xvfb; xauth is only a recommendation of xvfb
   python3-vtk9 python3-numpy xvfb xauth
+  # the Python module (python/, docs/python.md): pybind11 and Python's headers to build it; pytest and
+  # OpenImageIO's Python binding (reads the CLI's EXR) for its tests (numpy is listed above)
+  pybind11-dev python3-dev python3-pytest python3-openimageio
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -13,6 +13,7 @@
 #include "core/compare/Fits.h"
 #include "core/compare/HeatMap.h"
 #include "core/compare/ImageMetrics.h"
+#include "core/compare/MetricsJson.h"
 #include "core/compare/Tolerance.h"
 
 namespace volref::cli {
@@ -50,17 +51,6 @@ std::string number(double v, const char* fmt = "%.6g") {
     return buf;
 }
 
-nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json channel_json(const ChannelMetrics& c, long pixels) {
-    return {{"max_abs", json_number(c.max_abs)},
-            {"mean_abs", json_number(c.mean_abs)},
-            {"rmse", json_number(c.rmse)},
-            {"psnr_db", json_number(c.psnr)},
-            {"ssim", c.ssim ? json_number(*c.ssim) : nlohmann::json(nullptr)},
-            {"pixels_over", c.over},
-            {"fraction_over", pixels > 0 ? double(c.over) / double(pixels) : 0.0}};
-}
 
 void print_row(const ChannelMetrics& c) {
     std::printf("%-7s %12s %12s %12s %9s %9s %10ld\n", c.name.c_str(), number(c.max_abs, "%.4e").c_str(),

@@ -1,5 +1,7 @@
 #include "python/SceneDict.h"
 
+#include "core/explain/PixelTrace.h"
+
 #include <glm/mat4x4.hpp>
 
 namespace volref::python {
@@ -209,17 +211,6 @@ json volume_json(const VolumeSpec& v) {
     return j;
 }
 
-const char* projection_name(Projection p) {
-    switch (p) {
-        case Projection::Composite: return "composite";
-        case Projection::Mip: return "mip";
-        case Projection::Minip: return "minip";
-        case Projection::Average: return "average";
-        case Projection::FirstHit: return "first-hit";
-        case Projection::Xray: return "xray";
-    }
-    return "composite";
-}
 
 const char* profile_name(ProfileId p) {
     switch (p) {
@@ -236,7 +227,7 @@ const char* profile_name(ProfileId p) {
 
 json render_json(const RenderSpec& r) {
     json j;
-    j["projection"] = projection_name(r.projection);
+    j["projection"] = explain::projection_name(r.projection);  // the name trace and explain print
     j["order"] = r.order == CompositeOrder::BackToFront ? "back-to-front" : "front-to-back";
     j["step"] = r.step;
     j["step_units"] = r.step_units == StepUnits::World ? "world" : "voxel";

@@ -27,6 +27,7 @@
 #include "core/MemoryLimit.h"
 #include "core/compare/ComparedImage.h"
 #include "core/compare/ImageMetrics.h"
+#include "core/compare/MetricsJson.h"
 #include "core/compare/Tolerance.h"
 #include "core/explain/Explain.h"
 #include "core/explain/ExplainArguments.h"
@@ -308,18 +309,6 @@ void set_error_channel(compare::ComparedImage& image, py::handle e, const char* 
             image.error[std::size_t(y) * std::size_t(image.rgba.width) + std::size_t(x)] = q(y, x);
 }
 
-// The JSON of `volref compare --json` (cli/compare_command.cpp builds the same object, with the
-// same functions; tests/python/test_volref.py checks that they agree).
-nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-nlohmann::json channel_json(const compare::ChannelMetrics& c, long pixels) {
-    return {{"max_abs", json_number(c.max_abs)},
-            {"mean_abs", json_number(c.mean_abs)},
-            {"rmse", json_number(c.rmse)},
-            {"psnr_db", json_number(c.psnr)},
-            {"ssim", c.ssim ? json_number(*c.ssim) : nlohmann::json(nullptr)},
-            {"pixels_over", c.over},
-            {"fraction_over", pixels > 0 ? double(c.over) / double(pixels) : 0.0}};
-}
 
 // A pair (for a, for b) given as a 2-tuple, or one value for both.
 std::pair<py::object, py::object> pair_of(py::handle v) {
@@ -386,8 +375,8 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     j["width"] = a.rgba.width;
     j["height"] = a.rgba.height;
     j["tolerance"] = compare::describe_tolerance(a, b, tspec);
-    for (const compare::ChannelMetrics& c : m.channels) j["channels"][c.name] = channel_json(c, m.pixels);
-    j["overall"] = channel_json(m.overall, m.pixels);
+    for (const compare::ChannelMetrics& c : m.channels) j["channels"][c.name] = compare::channel_json(c, m.pixels);
+    j["overall"] = compare::channel_json(m.overall, m.pixels);
     j["pixels"] = m.pixels;
     j["pixels_over"] = m.overall.over;
     j["fraction_over"] = m.fraction_over();

@@ -2,11 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include <glm/geometric.hpp>
 
 #include "TestScenes.h"
 #include "core/camera/Camera.h"
+#include "core/render/PreparedScene.h"
+#include "core/scene/SceneLoader.h"
 
 using namespace volref;
 using namespace volref::test;
@@ -137,5 +140,85 @@ TEST(Projections, MissesAreEmpty) {
         s.camera = ortho_down_z(50.0, 50.0, 10.0, 4.0);
         const Image im = render_scene(s, {1, false});
         for (double v : im.pixels) EXPECT_EQ(v, 0.0);
+    }
+}
+
+// Issue 18, case 5: the bound that holds on every pixel, silhouette included. Trilinear interpolation
+// moves the field by at most eps = (h^2 / 8) max(f_xx + f_yy + f_zz) = h^2 / (4 r_min) (f = |x|: the
+// Laplacian is 2 / r) over the cells the hit can lie in, r_min = R - sqrt(3) h. So the interpolated
+// iso-surface lies between the spheres of radius R - eps and R + eps, and the exact first crossing of
+// the interpolated field along a ray (first_crossing_exact) lies between where the ray enters the
+// sphere R + eps and where it enters the sphere R - eps (or leaves R + eps, if it misses R - eps). The
+// first-order h^2 / (4 R cos theta) is this interval's width for small eps; near the silhouette the
+// sphere's curvature widens it (the reference scene's silhouette exceeded the first-order form 1.26x).
+// A ray whose chord through R + eps is shorter than a step may miss (two crossings in one step).
+TEST(Projections, FirstHitLiesBetweenTheSpheresRPlusMinusEpsilon) {
+    for (const bool reference_scene : {false, true}) {
+        FieldSpec radial;
+        radial.kind = FieldSpec::Kind::Radial;
+        Scene s;
+        double h, R;
+        glm::dvec3 centre;
+        if (reference_scene) {  // reference_scenes/sphere-first-hit.json at 96 x 96
+            s = load_scene(std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/sphere-first-hit.json",
+                           {"image.width=96", "image.height=96"});
+            h = 1.0;
+            R = 20.0;
+            centre = glm::dvec3(32.0);
+        } else {
+            radial.dims = {65, 65, 65};
+            radial.center = {0.0, 0.0, 0.0};
+            h = 2.4 / 64.0;
+            R = 0.8;
+            centre = glm::dvec3(0.0);
+            s = field_scene(radial, glm::dvec3(-1.2), glm::dvec3(h));
+            s.camera.type = CameraSpec::Type::Perspective;
+            s.camera.eye = {0.3, 0.2, 4.0};
+            s.camera.target = {0.0, 0.0, 0.0};
+            s.camera.up = {0.0, 1.0, 0.0};
+            s.camera.fov_y = 30.0;
+            s.image.width = s.image.height = 64;
+            s.render.projection = Projection::FirstHit;
+            s.render.isovalue = R;
+            s.render.step = 0.25;
+        }
+        const Image im = render_scene(s, {.threads = 2});
+        const PreparedScene prepared(s, {});
+        const double eps = h * h / (4.0 * (R - std::sqrt(3.0) * h));
+        const double step = s.render.step * (s.render.step_units == StepUnits::Voxel ? h : 1.0);
+        int hits = 0, silhouette = 0;
+        for (int y = 0; y < s.image.height; ++y)
+            for (int x = 0; x < s.image.width; ++x) {
+                const Ray ray = prepared.pixel_ray(x, y);
+                const glm::dvec3 o = ray.origin - centre;
+                const double b = glm::dot(o, ray.direction), oo = glm::dot(o, o);
+                auto chord = [&](double rho, double& t0, double& t1) {  // the ray's chord through sphere rho
+                    const double disc = b * b - (oo - rho * rho);
+                    if (disc < 0.0) return false;
+                    t0 = -b - std::sqrt(disc);
+                    t1 = -b + std::sqrt(disc);
+                    return true;
+                };
+                double outer0, outer1, inner0, inner1;
+                const bool outer = chord(R + eps, outer0, outer1), inner = chord(R - eps, inner0, inner1);
+                const double z = im.at(x, y, 4);
+                if (!outer) {
+                    EXPECT_TRUE(std::isinf(z)) << x << "," << y;
+                    continue;
+                }
+                if (std::isinf(z)) {  // allowed only where the chord is shorter than a step
+                    EXPECT_LT(inner ? inner1 - inner0 : 0.0, 2.0 * step) << x << "," << y;
+                    continue;
+                }
+                const double slack = 1e-9 * (outer1 - outer0) + 1e-12 * std::fabs(z);
+                EXPECT_GE(z, outer0 - slack) << x << "," << y;
+                EXPECT_LE(z, (inner ? inner0 : outer1) + slack) << x << "," << y;
+                ++hits;
+                double t0, t1;
+                if (chord(R, t0, t1) && std::fabs(glm::dot(glm::normalize(ray.at(t0) - centre), ray.direction)) < 0.3)
+                    ++silhouette;
+            }
+        EXPECT_GT(hits, 500);
+        EXPECT_GT(silhouette, 20);  // the silhouette (cos theta < 0.3) is checked too
     }
 }

@@ -4,6 +4,8 @@
 #include <numbers>
 
 #include <glm/geometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/Error.h"
 
@@ -62,9 +64,15 @@ Volume make_procedural_volume(const FieldSpec& field,
                     std::to_string(field.values.size()));
     v.values.allocate(ScalarType::F64, count, false);  // every voxel is written below
     double* out = v.values.data<double>();
-    for (std::int64_t k = 0; k < v.dims[2]; ++k)
-        for (std::int64_t j = 0; j < v.dims[1]; ++j)
-            for (std::int64_t i = 0; i < v.dims[0]; ++i) out[v.index(i, j, k)] = field_value(field, v, position(i, j, k), i, j, k);
+    // Each voxel depends on its indices alone, so the slices are filled in parallel (TBB, in the
+    // caller's arena: render_scene's --threads) and the volume is the same bits for any thread count.
+    const Volume& grid = v;
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
+        for (std::int64_t k = r.begin(); k != r.end(); ++k)
+            for (std::int64_t j = 0; j < grid.dims[1]; ++j)
+                for (std::int64_t i = 0; i < grid.dims[0]; ++i)
+                    out[grid.index(i, j, k)] = field_value(field, grid, position(i, j, k), i, j, k);
+    });
     return v;
 }
 

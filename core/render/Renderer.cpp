@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -124,7 +125,12 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         half.render.step *= 0.5;
         return with_step_doubling_error(coarse, render_scene(half, single));
     }
-    const PreparedScene prepared(scene, options);
+    // One arena for the whole render (--threads): the set-up (procedural volumes are generated in
+    // parallel) and the tiles.
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    std::optional<PreparedScene> prepared_storage;
+    arena.execute([&] { prepared_storage.emplace(scene, options); });
+    const PreparedScene& prepared = *prepared_storage;
     if (stats) {
         stats->non_finite_voxels = 0;
         for (const auto& v : prepared.volumes)
@@ -142,7 +148,6 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
     const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
     ProgressReporter progress(options.progress, tiles_x * tiles_y);
-    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
             // Each tile row is integrated in packets of up to kMaxPacketRays pixels.

@@ -29,7 +29,7 @@
 // render: what `volref render` reports, minus writing the file.
 //
 // Samples: the number of ray samples of a render is the sum over pixels of the segment counts of the
-// pixel's intervals (Segments.h: max(1, ceil(L / h - slack)) per interval), which is what the composite
+// pixel's intervals (march/SamplePlacement.h: max(1, ceil(L / h - slack)) per interval), which is what the composite
 // integrator samples when early termination is off (it is, in these scenes) and nothing is skipped. It is
 // counted once per scene in a separate pass, outside timing, with the renderer's own pieces: the same
 // Camera, the same BoundingGeometry (box = the volume's domain) and the same world step. With empty-space

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "TestScenes.h"
 #include "core/camera/Camera.h"
@@ -155,4 +156,42 @@ TEST(FirstHitExact, RayAlongACellFace) {
     s.image.width = s.image.height = 1;
     const PixelValue v = PreparedScene(s, {1, false}).render_pixel(0, 0);
     EXPECT_NEAR(v.depth, 10.0 - 2.25, 1e-13);
+}
+
+namespace {
+
+// Issue 18, case 2: a 2 x 2 x 4 grid whose values depend on k alone: 0.2, 1.0, NaN, 0.3. The cell
+// k in [0, 1] is finite (f = 0.2 + 0.8 z); the cells above it have a NaN corner. An orthographic ray
+// down -z from z = 10 reaches the finite cell through the plane z = 1, where the sampler reads the
+// cell above (with the NaN). The finite cell must be integrated in full: its maximum 1.0 is at z = 1,
+// and f = 0.9 at z = 0.875 (t = 9.125).
+Scene nan_above_a_finite_cell(Projection projection, IntegrationMethod method) {
+    FieldSpec cells;
+    cells.kind = FieldSpec::Kind::Cells;
+    cells.dims = {2, 2, 4};
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (double v : {0.2, 1.0, nan, 0.3})
+        for (int n = 0; n < 4; ++n) cells.values.push_back(v);
+    Scene s = field_scene(cells);
+    s.volume().transfer.color = {{0.0, 1.0, 1.0, 1.0}};
+    s.volume().transfer.opacity = {{0.0, 0.0}, {1.0, 1.0}};  // a = f
+    s.camera = ortho_down_z(0.5, 0.5, 10.0, 0.5);
+    s.image.width = s.image.height = 1;
+    s.render.projection = projection;
+    s.render.integrator = method;
+    s.render.step = 0.5;
+    if (projection == Projection::FirstHit) s.render.isovalue = 0.9;
+    return s;
+}
+
+}  // namespace
+
+TEST(FirstHitExact, NanCellsDoNotHideTheFiniteCellBesideThem) {
+    for (IntegrationMethod m : {IntegrationMethod::Fixed, IntegrationMethod::Adaptive}) {
+        const Image hit = render_scene(nan_above_a_finite_cell(Projection::FirstHit, m), {.threads = 1});
+        EXPECT_NEAR(hit.at(0, 0, 4), 9.125, 1e-12) << "first hit, method " << int(m);
+    }
+    // The adaptive MIP finds the cell's maximum on its face: a = 1, the pixel (1, 1, 1, 1).
+    const Image mip = render_scene(nan_above_a_finite_cell(Projection::Mip, IntegrationMethod::Adaptive), {.threads = 1});
+    for (std::size_t c = 0; c < 4; ++c) EXPECT_NEAR(mip.at(0, 0, c), 1.0, 1e-12) << "mip channel " << c;
 }

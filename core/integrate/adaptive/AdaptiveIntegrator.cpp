@@ -487,6 +487,17 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
     // The extremum over the candidates (march/Accumulators.h; non-finite values are ignored).
     Extremum<Scalar> acc(maximum);
     auto consider = [&](double t) { acc.add(true, ctx_.field(ray, t), t); };
+    // A piece's end: read one double inside the piece where the sampler at the face reads a neighbouring
+    // cell with a non-finite corner (issue 18: a NaN layer hid the finite cell's maximum on its face).
+    auto consider_end = [&](double t, double toward) {
+        const double v = ctx_.field(ray, t);
+        if (std::isfinite(v)) {
+            acc.add(true, v, t);
+        } else {
+            const double inside = std::nextafter(t, toward);
+            acc.add(true, ctx_.field(ray, inside), inside);
+        }
+    };
     const Volume& v = cartesian_->volume();
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
@@ -497,8 +508,8 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
                 consider(0.5 * (ta + tb));
                 continue;
             }
-            consider(ta);
-            consider(tb);
+            consider_end(ta, tb);
+            consider_end(tb, ta);
             double ex[2];
             const int ne = cubic_extrema(cell_cubic(*cartesian_, ray, ta, tb), tb - ta, ex);
             for (int k = 0; k < ne; ++k) consider(ta + ex[k]);

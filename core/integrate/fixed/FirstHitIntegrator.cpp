@@ -37,9 +37,16 @@ std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const R
         for (int k = 0; k < ne; ++k)
             if (ta + ex[k] > ts[n - 1] && ta + ex[k] < tb) ts[n++] = ta + ex[k];
         ts[n++] = tb;
-        double ga = g(ta);
+        // The piece's own ends: where the sampler reads a neighbouring cell with a non-finite corner at
+        // a face (it takes the cell above an exact grid plane), the end is read one double inside the
+        // piece, in the piece's own cell (issue 18: a NaN layer hid the finite cell beside it).
+        auto g_end = [&](double t, double toward) {
+            const double v = g(t);
+            return std::isfinite(v) ? v : g(std::nextafter(t, toward));
+        };
+        double ga = g_end(ta, tb);
         for (int m = 0; m + 1 < n; ++m) {
-            const double a = ts[m], b = ts[m + 1], gb = g(b);
+            const double a = ts[m], b = ts[m + 1], gb = m + 2 == n ? g_end(b, a) : g(b);
             if (!std::isfinite(ga) || !std::isfinite(gb)) {
                 ga = gb;
                 continue;
@@ -81,6 +88,9 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
         for (std::int64_t k = 0; k < n && !hit; ++k) {
             const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
             if (!std::isfinite(ga) || !std::isfinite(gb)) {  // non-finite values never cross
+                // Trilinear: the bracket's finite cells are searched exactly (a NaN end must not hide
+                // a crossing in the finite cell beside it).
+                if (trilinear_) hit = first_crossing_exact(*trilinear_, ray, ta, tb, iso);
                 ta = tb;
                 ga = gb;
                 continue;

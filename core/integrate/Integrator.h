@@ -35,6 +35,11 @@ struct IntegrationContext {
     const RenderSpec& render;
     // Composite only: empty-space skipping (core/sample/MacrocellGrid.h); null: every segment is sampled.
     const MacrocellGrid* macrocells = nullptr;
+    // The lanes the SIMD kernels run on: double (the reference) or float (render.profile "fast",
+    // FastProfile.h: the packet path is then the only path). Decided once, where the integrator is
+    // chosen (PreparedVolume); the integrators read this, not render.profile.
+    enum class Lanes { Double, Float };
+    Lanes lanes = Lanes::Double;
     double field(const Ray& ray, double t) const { return pipeline.value(ray, t); }
 };
 

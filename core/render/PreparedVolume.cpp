@@ -269,6 +269,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
+    if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
     if (scene.render.profile == ProfileId::Reference || scene.render.profile == ProfileId::Fast) {
         integrator = make_integrator(*context);

@@ -15,7 +15,7 @@ namespace volref {
 
 CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
     const SamplePipeline& p = ctx.pipeline;
-    const bool fast = ctx.render.profile == ProfileId::Fast;
+    const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     // Where the packet path does not apply the reference takes the scalar path; the fast profile has
     // no scalar path and says why (FastProfile.h).
     auto unavailable = [&](const char* reason) {

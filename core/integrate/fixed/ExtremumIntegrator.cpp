@@ -12,7 +12,7 @@
 namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
-    const bool fast = ctx.render.profile == ProfileId::Fast;
+    const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     auto unavailable = [&](const char* reason) {
         if (fast) fast_profile_unavailable(reason);
     };

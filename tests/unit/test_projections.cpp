@@ -91,22 +91,34 @@ TEST(Projections, FirstHitOnAPlane) {
 // (Hessian of |x| is (I - n n^T) / r), and |grad f| = 1, so along a ray meeting the sphere at angle
 // theta to the normal the hit moves by at most h^2 / (4 R cos theta). Pixels with cos theta < 0.5
 // (near the silhouette) are skipped; rays that miss the sphere by a margin must miss.
-TEST(Projections, FirstHitOnARadialFieldIsTheSphere) {
+namespace {
+
+// The radial field |x| on [-1.2, 1.2]^3 (65^3 voxels, h = 2.4 / 64), first hit at iso R = 0.8, seen by a
+// size x size perspective camera.
+constexpr double kSphereH = 2.4 / 64.0, kSphereR = 0.8;
+Scene sphere_scene(int size) {
     FieldSpec radial;
     radial.kind = FieldSpec::Kind::Radial;
     radial.dims = {65, 65, 65};
     radial.center = {0.0, 0.0, 0.0};
-    const double h = 2.4 / 64.0, R = 0.8;
-    Scene s = field_scene(radial, glm::dvec3(-1.2), glm::dvec3(h));
+    Scene s = field_scene(radial, glm::dvec3(-1.2), glm::dvec3(kSphereH));
     s.camera.type = CameraSpec::Type::Perspective;
     s.camera.eye = {0.3, 0.2, 4.0};
     s.camera.target = {0.0, 0.0, 0.0};
     s.camera.up = {0.0, 1.0, 0.0};
     s.camera.fov_y = 30.0;
-    s.image.width = s.image.height = 32;
+    s.image.width = s.image.height = size;
     s.render.projection = Projection::FirstHit;
-    s.render.isovalue = R;
+    s.render.isovalue = kSphereR;
     s.render.step = 0.25;
+    return s;
+}
+
+}  // namespace
+
+TEST(Projections, FirstHitOnARadialFieldIsTheSphere) {
+    const double h = kSphereH, R = kSphereR;
+    const Scene s = sphere_scene(32);
     const Image im = render_scene(s, {0, false});
     const Camera camera(s.camera, 32, 32, glm::dvec3(-1.2), glm::dvec3(1.2));
     const double bound = h * h / (4.0 * R * 0.5);
@@ -154,8 +166,6 @@ TEST(Projections, MissesAreEmpty) {
 // A ray whose chord through R + eps is shorter than a step may miss (two crossings in one step).
 TEST(Projections, FirstHitLiesBetweenTheSpheresRPlusMinusEpsilon) {
     for (const bool reference_scene : {false, true}) {
-        FieldSpec radial;
-        radial.kind = FieldSpec::Kind::Radial;
         Scene s;
         double h, R;
         glm::dvec3 centre;
@@ -166,21 +176,10 @@ TEST(Projections, FirstHitLiesBetweenTheSpheresRPlusMinusEpsilon) {
             R = 20.0;
             centre = glm::dvec3(32.0);
         } else {
-            radial.dims = {65, 65, 65};
-            radial.center = {0.0, 0.0, 0.0};
-            h = 2.4 / 64.0;
-            R = 0.8;
+            s = sphere_scene(64);
+            h = kSphereH;
+            R = kSphereR;
             centre = glm::dvec3(0.0);
-            s = field_scene(radial, glm::dvec3(-1.2), glm::dvec3(h));
-            s.camera.type = CameraSpec::Type::Perspective;
-            s.camera.eye = {0.3, 0.2, 4.0};
-            s.camera.target = {0.0, 0.0, 0.0};
-            s.camera.up = {0.0, 1.0, 0.0};
-            s.camera.fov_y = 30.0;
-            s.image.width = s.image.height = 64;
-            s.render.projection = Projection::FirstHit;
-            s.render.isovalue = R;
-            s.render.step = 0.25;
         }
         const Image im = render_scene(s, {.threads = 2});
         const PreparedScene prepared(s, {});

@@ -7,6 +7,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
+#include "core/integrate/adaptive/CellCubic.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "core/integrate/march/CompensatedSum.h"
 #include "geometry/ShellCoordinates.h"
@@ -90,7 +91,6 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
     }
     if (!rows_ || row_values_.empty()) return;
     if (!cubic_) return sampled_row_cuts(ray, out);
-    const Volume& v = cartesian_->volume();
     // Rows: the roots of s(f(t)) = x_k inside each cell, s the transfer function's coordinate.
     std::vector<double> all;
     all.reserve(out.size() * 2);
@@ -487,16 +487,10 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
     // The extremum over the candidates (march/Accumulators.h; non-finite values are ignored).
     Extremum<Scalar> acc(maximum);
     auto consider = [&](double t) { acc.add(true, ctx_.field(ray, t), t); };
-    // A piece's end: read one double inside the piece where the sampler at the face reads a neighbouring
-    // cell with a non-finite corner (issue 18: a NaN layer hid the finite cell's maximum on its face).
+    // A piece's end, read in the piece's own cell (piece_end, CellCubic.h).
     auto consider_end = [&](double t, double toward) {
-        const double v = ctx_.field(ray, t);
-        if (std::isfinite(v)) {
-            acc.add(true, v, t);
-        } else {
-            const double inside = std::nextafter(t, toward);
-            acc.add(true, ctx_.field(ray, inside), inside);
-        }
+        const auto [at, v] = piece_end([&](double u) { return ctx_.field(ray, u); }, t, toward);
+        acc.add(true, v, at);
     };
     const Volume& v = cartesian_->volume();
     std::vector<double> cut;

@@ -27,6 +27,18 @@ struct Cubic {
     }
 };
 
+// The value of f at the end t of a piece (a part of the ray inside one cell), read in the piece's own
+// cell: f(t), or f one double inside the piece (towards `toward`) where f(t) is not finite. At a grid
+// plane the sampler reads the cell above it, which may have a non-finite corner while the piece's cell
+// is finite (issue 18: a NaN layer hid the finite cell's maximum and crossing). Returns (t used, value).
+template <class F>
+std::pair<double, double> piece_end(const F& f, double t, double toward) {
+    const double v = f(t);
+    if (std::isfinite(v)) return {t, v};
+    const double inside = std::nextafter(t, toward);
+    return {inside, f(inside)};
+}
+
 // The cubic of Levoy's trilinear sum (corner order f1..f8, Trilinear.h) along p = p0 + dp x, etc.
 inline Cubic trilinear_cubic(const std::array<double, 8>& f, const glm::dvec3& frac0, const glm::dvec3& dfrac) {
     // The affine factors (value at x = 0, slope) of p and 1 - p per axis.

@@ -97,11 +97,10 @@ PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vect
                                                             : back_to_front(ray, intervals, rec);
 }
 
-// The termination the scene asks for (render.early_termination: A > threshold).
-Termination CompositeIntegrator::termination() const {
+Termination early_termination(const RenderSpec& render) {
     Termination t;
-    t.test_alpha_above = ctx_.render.early_termination.has_value();
-    t.alpha_above = ctx_.render.early_termination.value_or(1.0);
+    t.test_alpha_above = render.early_termination.has_value();
+    t.alpha_above = render.early_termination.value_or(1.0);
     return t;
 }
 
@@ -111,7 +110,7 @@ Termination CompositeIntegrator::termination() const {
 template <class Rec>
 PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    const Termination stop = termination();
+    const Termination stop = early_termination(ctx_.render);
     FrontToBack<Scalar> acc;
     ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step);
     Segment s;

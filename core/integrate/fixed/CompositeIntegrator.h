@@ -32,6 +32,10 @@ namespace volref {
 
 struct FloatCopies;
 
+// The termination the scene asks for (render.early_termination: stop once A > threshold), as every
+// front-to-back integrator of the reference applies it (the composite and the several-volume mix).
+Termination early_termination(const RenderSpec& render);
+
 class CompositeIntegrator final : public Integrator {
 public:
     explicit CompositeIntegrator(const IntegrationContext& ctx);
@@ -47,7 +51,6 @@ public:
 
 private:
     // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h.
-    Termination termination() const;
     template <class Rec>
     PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>

@@ -98,7 +98,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integr
     in.opacity_rows = int(tf->opacity_function().xs().size());
     in.unit_distance = tf->unit_distance();
     in.step = ctx.step;
-    in.termination = termination();
+    in.termination = early_termination(ctx.render);
     in.macrocells = ctx.macrocells;
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();

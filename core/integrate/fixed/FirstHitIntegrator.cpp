@@ -37,16 +37,10 @@ std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const R
         for (int k = 0; k < ne; ++k)
             if (ta + ex[k] > ts[n - 1] && ta + ex[k] < tb) ts[n++] = ta + ex[k];
         ts[n++] = tb;
-        // The piece's own ends: where the sampler reads a neighbouring cell with a non-finite corner at
-        // a face (it takes the cell above an exact grid plane), the end is read one double inside the
-        // piece, in the piece's own cell (issue 18: a NaN layer hid the finite cell beside it).
-        auto g_end = [&](double t, double toward) {
-            const double v = g(t);
-            return std::isfinite(v) ? v : g(std::nextafter(t, toward));
-        };
-        double ga = g_end(ta, tb);
+        // The piece's own ends, read in its cell (piece_end, CellCubic.h).
+        double ga = piece_end(g, ta, tb).second;
         for (int m = 0; m + 1 < n; ++m) {
-            const double a = ts[m], b = ts[m + 1], gb = m + 2 == n ? g_end(b, a) : g(b);
+            const double a = ts[m], b = ts[m + 1], gb = m + 2 == n ? piece_end(g, b, a).second : g(b);
             if (!std::isfinite(ga) || !std::isfinite(gb)) {
                 ga = gb;
                 continue;

@@ -31,8 +31,6 @@ inline SampleOpacity<L> sample_opacity(typename L::M alive, typename L::V a, typ
     return o;
 }
 
-
-
 // Front-to-back compositing of premultiplied colour C (kCompensatedColour: each channel a
 // compensated sum, for the adaptive integrator's many small pieces).
 template <class L, ::volref::TransmittanceRule R = ::volref::TransmittanceRule::OpticalDepthSum, bool kCompensatedColour = false>
@@ -53,8 +51,7 @@ public:
     V partial_alpha() const {
         // + 0: a ray that met nothing has A = +0, never -0 (Highway's expm1(-0) is +0, so its negation
         // was -0 on the SIMD path); x + 0 = x for every other x.
-        if constexpr (R == ::volref::TransmittanceRule::OpticalDepthSum)
-            return L::neg(L::expm1(L::neg(s_ + c_))) + L::splat(0.0);
+        if constexpr (R == ::volref::TransmittanceRule::OpticalDepthSum) return segment_alpha<L>(s_ + c_) + L::splat(0.0);
         else if constexpr (R == ::volref::TransmittanceRule::Product) return L::splat(1.0) - s_;
         else return s_;
     }
@@ -67,7 +64,6 @@ public:
         if constexpr (kCompensatedColour) return color_[channel] + color_c_[channel];
         else return color_[channel];
     }
-    M opaque() const { return opaque_; }
 
     // One sample on the lanes `visible`: opacity alpha (optical depth tau, read by the optical-depth
     // rule) and colour c (not premultiplied): C += (T alpha) c. `solid` lanes (a = 1) have alpha = 1
@@ -130,7 +126,7 @@ private:
     M opaque_ = L::no_lanes();
 };
 
-
+// Back-to-front compositing (the rule: Accumulators.h).
 template <class L, ::volref::BackToFrontRule R = ::volref::BackToFrontRule::Over>
 class BackToFront {
 public:
@@ -141,7 +137,7 @@ public:
     V color(int channel) const { return color_[channel]; }
     V alpha() const {
         if constexpr (R == ::volref::BackToFrontRule::Lerp) return color_[3];
-        else return L::select(opaque_, L::splat(1.0), L::neg(L::expm1(L::neg(s_ + c_))) + L::splat(0.0));
+        else return L::select(opaque_, L::splat(1.0), segment_alpha<L>(s_ + c_) + L::splat(0.0));  // + 0: as FrontToBack
     }
     // The transmittance of what is composited so far (0 once a sample was opaque).
     V transmittance() const { return L::select(opaque_, L::splat(0.0), L::exp(L::neg(s_ + c_))); }
@@ -190,37 +186,9 @@ public:
     V value() const { return best_; }
     V where() const { return t_best_; }
     M any() const { return seen_; }
-    bool maximum() const { return maximum_; }
 
 private:
     bool maximum_;
     V best_ = L::splat(0.0), t_best_ = L::splat(0.0);
     M seen_ = L::no_lanes();
-};
-
-// Average and x-ray: sum_k x_k (x_k = s(v_k) d_k, or the profile's own weights) and sum_k d_k, each
-// in a Sum (CompensatedSum for the reference; PlainSum for a GPU shader's plain accumulator).
-template <class Sum>
-class LineIntegral {
-public:
-    void add(double x, double length) {
-        integral_.add(x);
-        length_.add(length);
-    }
-    double integral() const { return integral_.value(); }
-    double length() const { return length_.value(); }
-    double mean() const { return integral_.value() / length_.value(); }
-
-private:
-    Sum integral_, length_;
-};
-
-// A plain running sum (a shader's accumulator), beside CompensatedSum.
-class PlainSum {
-public:
-    void add(double x) { s_ += x; }
-    double value() const { return s_; }
-
-private:
-    double s_ = 0.0;
 };

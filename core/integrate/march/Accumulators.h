@@ -44,6 +44,33 @@ enum class BackToFrontRule {
     Lerp,  // seed 001 (cuda-curvilinear): sum = lerp(sum, (c, a), w) = sum + (col - sum) w on R, G, B, A
 };
 
+// Average and x-ray: sum_k x_k (x_k = s(v_k) d_k, or the profile's own weights) and sum_k d_k, each
+// in a Sum (CompensatedSum for the reference; PlainSum for a GPU shader's plain accumulator).
+template <class Sum>
+class LineIntegral {
+public:
+    void add(double x, double length) {
+        integral_.add(x);
+        length_.add(length);
+    }
+    double integral() const { return integral_.value(); }
+    double length() const { return length_.value(); }
+    double mean() const { return integral_.value() / length_.value(); }
+
+private:
+    Sum integral_, length_;
+};
+
+// A plain running sum (a shader's accumulator), beside CompensatedSum.
+class PlainSum {
+public:
+    void add(double x) { s_ += x; }
+    double value() const { return s_; }
+
+private:
+    double s_ = 0.0;
+};
+
 // The templates, in namespace volref for the scalar lanes (the SIMD kernels include the same file
 // inside each Highway target's namespace: packet/PacketKernels-inl.h).
 #include "core/integrate/march/Accumulators-inl.h"

@@ -7,6 +7,7 @@
 #include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SamplePipeline.h"
 #include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/fixed/CompositeIntegrator.h"
 #include "core/integrate/march/Accumulators.h"
 
 namespace volref {
@@ -109,9 +110,7 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
     };
     PixelValue out;
     if (render_.order == CompositeOrder::FrontToBack) {
-        Termination stop;
-        stop.test_alpha_above = render_.early_termination.has_value();
-        stop.alpha_above = render_.early_termination.value_or(1.0);
+        const Termination stop = early_termination(render_);
         FrontToBack<Scalar> acc;
         bool done = false;
         for (const Piece& p : ps) {

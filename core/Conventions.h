@@ -65,12 +65,14 @@ inline constexpr int kTileSize = 16;
 // ---- Adaptive integration (render.integrator "adaptive"; core/integrate/Adaptive*.h, docs/accuracy.md) ----
 // The default render.tolerance: absolute error per channel (R, G, B, A) of a pixel.
 inline constexpr double kAdaptiveDefaultTolerance = 1e-6;
-// Each smooth piece is integrated by Gauss-Kronrod G7/K15 with recursive bisection; the halves of
-// [a, b] are accepted when their error estimate e (below, kAdaptiveWeakSafety: emission error plus the
-// colour bound times the optical depth's error, times the transmittance in front) is at most
-//   tolerance * (b - a) / (total length of the ray's intervals)   (the budget is shared by length),
-// or at most kAdaptiveRoundoffRelative * |K15| (the estimate is then rounding, QUADPACK's test), or
-// when they are kAdaptiveMaxDepth bisections deep (the estimate is still reported: 2^-48 of a
+// Each smooth piece [a, b] (between two cuts) is integrated by Gauss-Kronrod G7/K15, globally adaptive
+// inside the piece (QUADPACK's QAG): its candidate sub-intervals, each with an error estimate e
+// (below, kAdaptiveWeakSafety: emission error plus the colour bound times the optical depth's error),
+// are split largest estimate first until T(a) sum e is at most
+//   tolerance * (b - a) / (total length of the ray's intervals)   (the budget is shared by length;
+// a test per sub-interval never holds beside an integrable singularity of sigma, issue 18),
+// a candidate whose e is at most kAdaptiveRoundoffRelative * |K15| (rounding, QUADPACK's test), or that
+// is kAdaptiveMaxDepth bisections deep, is not split again (the estimate is still reported: 2^-48 of a
 // piece is below any length the double t of a ray resolves for pieces up to 2^48 ulps long).
 inline constexpr int kAdaptiveMaxDepth = 48;
 // Work per ray is bounded (issue 18: an opacity reaching 1 on a cell face made the bisection run for
@@ -85,9 +87,15 @@ inline constexpr long kAdaptiveMaxRulesPerRay = 1L << 14;
 inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16;  // 50 eps
 // Opacities are clamped to 1 - 2^-53 inside a piece so that sigma = -log1p(-a) / l stays finite at an
 // isolated point where a reaches 1 (a ramp ending at 1, a value touching a row with a = 1): the
-// integral changes only where a > 1 - 2^-53, a set of length ~ 2^-53 of the ramp. A piece whose
-// opacity is 1 at its midpoint is opaque (the ray ends there, T = 0 behind it).
+// integral changes only where a > 1 - 2^-53, a set of length ~ 2^-53 of the ramp. A piece is opaque
+// (the ray ends there, T = 0 behind it) when its opacity is 1 at its midpoint and at
+// a + kAdaptiveOpaqueColourOffset (b - a) and b - kAdaptiveOpaqueColourOffset (b - a): between two
+// cuts the transfer function is linear in s, so that is opacity 1 on the whole piece, not at one point
+// (issue 18, case 1: a tent of opacity 1 at a value reached on a grid plane made every ray crossing
+// the plane opaque). A piece with kAdaptiveOpaqueMinDoubles or fewer doubles inside it is never opaque:
+// its ends are two cuts that coincide in exact arithmetic (a face and a row's root, found to rounding).
 inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
+inline constexpr int kAdaptiveOpaqueMinDoubles = 4;
 // The colour of an opaque piece [a, b] is c(a+), read at a + kAdaptiveOpaqueColourOffset (b - a): just
 // inside the piece, so that a jump of the transfer function at a (a root found to rounding) is on
 // the piece's side.

@@ -543,8 +543,9 @@ TEST(Adaptive, StepDoublingEstimateByHand) {
 namespace {
 
 // A tent of opacity reaching 1 exactly on the grid plane x = 4 of a linear field f = x: near the
-// plane sigma = -log1p(-a) grows like -log|x - 4| (integrable), and the bisection used to run for
-// minutes on the rays that cross it (issue 18, case 3).
+// plane sigma = -log1p(-a) grows like -log|x - 4| (integrable). The bisection used to run for
+// minutes on the rays that cross it (issue 18, case 3), and rays whose face and row cuts fell a few
+// doubles apart were taken as opaque (case 1).
 Scene opacity_one_on_a_face(int size) {
     Scene s = field_scene(linear_field({1, 0, 0, 0}, {9, 9, 9}));
     s.volume().transfer.color = {{0.0, 1.0, 1.0, 1.0}, {8.0, 1.0, 1.0, 1.0}};
@@ -559,15 +560,35 @@ Scene opacity_one_on_a_face(int size) {
     return s;
 }
 
-}  // namespace
+// Rays that lie in the grid planes x = 1, ..., 7 of f = x, where the transfer function jumps: the
+// trilinear weights sum to 1 only up to rounding, so along such a ray the value reads k or the double
+// below it, and the integrand jumps between the two sides of the row at points no cut can locate.
+// Such rays spend their rules (kAdaptiveMaxRulesPerRay).
+Scene rays_in_jump_planes(int rows) {
+    Scene s = field_scene(linear_field({1, 0, 0, 0}, {9, 9, 9}));
+    s.volume().transfer.color = {{0.0, 0.0, 0.0, 1.0}};
+    s.volume().transfer.opacity = {{0.0, 0.05}};
+    for (int k = 1; k <= 7; ++k) {
+        const double r = k % 2 ? 1.0 : 0.2;
+        s.volume().transfer.color.push_back({double(k), 0.0, 0.0, 1.0});
+        s.volume().transfer.color.push_back({double(k), r, 0.5, 0.0});
+        s.volume().transfer.opacity.push_back({double(k), 0.05});
+        s.volume().transfer.opacity.push_back({double(k), 0.9});
+    }
+    s.camera.type = CameraSpec::Type::Orthographic;
+    s.camera.eye = glm::dvec3(4.0, -6.0, 20.0);
+    s.camera.target = glm::dvec3(4.0, 4.0, 4.0);
+    s.camera.up = glm::dvec3(0.0, 0.0, 1.0);
+    s.image.width = 9;  // pixel centres at x = 0, ..., 8 (the camera's right vector is exactly +x)
+    s.image.height = rows;
+    s.camera.height = double(rows);
+    s.render.integrator = IntegrationMethod::Adaptive;
+    return s;
+}
 
-// The work per ray is bounded (kAdaptiveMaxRulesPerRay) and the error channel stays honest where the
-// bound stops the refinement: every such pixel is within its error of a converged fine fixed step
-// (steps 1e-3 and 5e-4 agree to the stated fine_error on every pixel). Issue 18's case 1 (a kink of the
-// classification on a grid plane is not a cut) still leaves a few resolved pixels off by more than
-// their estimate here; they are counted and printed, not asserted, until that case is fixed.
-TEST(Adaptive, BoundedWorkWithHonestErrorWhereTheOpacityReachesOneOnAFace) {
-    const Scene s = opacity_one_on_a_face(10);
+// Every pixel within its error of a converged fine fixed step (steps 1e-3 and 5e-4 agree to the stated
+// fine_error on every pixel); returns how many rays spent their rules (error > 1e-3).
+int check_against_fine_fixed(const Scene& s) {
     const Image a = render_scene(s, {.threads = 2});
     Scene fine = s;
     fine.render.integrator = IntegrationMethod::Fixed;
@@ -576,31 +597,105 @@ TEST(Adaptive, BoundedWorkWithHonestErrorWhereTheOpacityReachesOneOnAFace) {
     fine.render.step = 1e-3;
     const Image f2 = render_scene(fine, {.threads = 2});
     const std::size_t err = a.channel_count() - 1;
-    ASSERT_EQ(a.channels[err], "error");
-    int unresolved = 0, case1 = 0;
-    for (int y = 0; y < 10; ++y)
-        for (int x = 0; x < 10; ++x) {
+    EXPECT_EQ(a.channels[err], "error");
+    int unresolved = 0;
+    for (int y = 0; y < s.image.height; ++y)
+        for (int x = 0; x < s.image.width; ++x) {
             double diff = 0.0, fine_error = 0.0;
             for (std::size_t c = 0; c < 4; ++c) {
                 diff = std::max(diff, std::fabs(a.at(x, y, c) - f.at(x, y, c)));
                 fine_error = std::max(fine_error, std::fabs(f.at(x, y, c) - f2.at(x, y, c)));
             }
-            EXPECT_LT(fine_error, 1e-4) << x << ", " << y;
-            if (a.at(x, y, err) > 1e-3) {  // a ray that spent its rules
-                ++unresolved;
-                EXPECT_LE(diff, a.at(x, y, err) + 2.0 * fine_error) << x << ", " << y;
-            } else if (diff > a.at(x, y, err) + 2.0 * fine_error) {
-                ++case1;
-            }
+            if (a.at(x, y, err) > 1e-3) ++unresolved;
+            EXPECT_LE(diff, a.at(x, y, err) + 2.0 * fine_error + 1e-9) << x << ", " << y;
         }
-    EXPECT_GT(unresolved, 0);  // the bound was reached on some rays, and they say so
-    std::printf("rays that spent their rules: %d; resolved pixels off by more than their estimate (case 1): %d\n",
-                unresolved, case1);
+    return unresolved;
+}
+
+}  // namespace
+
+// Issue 18, cases 1 and 3: the opacity-1 tent on a face is integrated to the tolerance (the sum of a
+// piece's estimates halves with each split beside the singularity), no ray is taken as opaque, and
+// every pixel is within its error of a converged fine step.
+TEST(Adaptive, OpacityOneOnAFaceIsResolvedAndHonest) {
+    EXPECT_EQ(check_against_fine_fixed(opacity_one_on_a_face(10)), 0);
+}
+
+// The work per ray is bounded (kAdaptiveMaxRulesPerRay) and the error channel stays honest where the
+// bound stops the refinement: rays in the jump planes spend their rules and say so.
+TEST(Adaptive, BoundedWorkWithHonestErrorOnRaysInAJumpPlane) {
+    EXPECT_GT(check_against_fine_fixed(rays_in_jump_planes(3)), 0);
+}
+
+// Closed forms for rays crossing the plane x = 4 of f = x obliquely (issue 18, case 1): the ray
+// direction d (d_x = 20 / |(20, 6, 4)|) passes from the face x = 0 to the face x = 8, so
+// s = x runs from 0 to 8 with ds/dt = d_x.
+namespace {
+Scene oblique_through_x(std::vector<std::array<double, 4>> color, std::vector<std::array<double, 2>> opacity) {
+    Scene s = field_scene(linear_field({1, 0, 0, 0}, {9, 9, 9}));
+    s.volume().transfer.color = std::move(color);
+    s.volume().transfer.opacity = std::move(opacity);
+    s.camera.type = CameraSpec::Type::Orthographic;
+    s.camera.eye = glm::dvec3(-16.0, -0.8, 0.8);
+    s.camera.target = glm::dvec3(4.0, 5.2, 4.8);
+    s.camera.up = glm::dvec3(0.0, 0.0, 1.0);
+    s.camera.height = 0.5;
+    s.image.width = s.image.height = 8;
+    s.render.integrator = IntegrationMethod::Adaptive;
+    return s;
+}
+const double kDx = 20.0 / std::sqrt(20.0 * 20.0 + 6.0 * 6.0 + 4.0 * 4.0);
+}  // namespace
+
+// A tent of opacity 1 at s = 4 (a = s/4, then (8 - s)/4), white: tau = (1/d_x) 2 * 4 * integral_0^1
+// -log(1 - u) du = 8 / d_x, so every channel is 1 - exp(-8 / d_x) (no piece is opaque).
+TEST(Adaptive, OpacityOneTentOnAGridPlaneClosedForm) {
+    const Scene s = oblique_through_x({{0.0, 1.0, 1.0, 1.0}, {8.0, 1.0, 1.0, 1.0}}, {{0.0, 0.0}, {4.0, 1.0}, {8.0, 0.0}});
+    const Image im = render_scene(s, {.threads = 2});
+    const double expected = -std::expm1(-8.0 / kDx);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            EXPECT_LT(im.at(x, y, 4), 1e-6) << x << "," << y;  // resolved to the tolerance
+            for (std::size_t c = 0; c < 4; ++c)
+                EXPECT_NEAR(im.at(x, y, c), expected, im.at(x, y, 4) + 1e-12) << x << "," << y << " " << c;
+        }
+}
+
+// Colour and opacity jumping at s = 4, reached on the plane x = 4: blue with a = 0.2 below, red-orange
+// (1, 0.5, 0) with a = 0.5 above; each part is 4 / d_x long. C = blue (1 - 0.8^L) + 0.8^L (1, 0.5, 0)
+// (1 - 0.5^L), A = 1 - 0.8^L 0.5^L, L = 4 / d_x.
+TEST(Adaptive, JumpOnAGridPlaneClosedForm) {
+    const Scene s = oblique_through_x({{0.0, 0.0, 0.0, 1.0}, {4.0, 0.0, 0.0, 1.0}, {4.0, 1.0, 0.5, 0.0}, {8.0, 1.0, 0.5, 0.0}},
+                                      {{0.0, 0.2}, {4.0, 0.2}, {4.0, 0.5}, {8.0, 0.5}});
+    const Image im = render_scene(s, {.threads = 2});
+    const double L = 4.0 / kDx, T1 = std::pow(0.8, L), a2 = 1.0 - std::pow(0.5, L);
+    const double expected[4] = {T1 * a2, 0.5 * T1 * a2, 1.0 - T1, 1.0 - T1 * (1.0 - a2)};
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            for (std::size_t c = 0; c < 4; ++c)
+                EXPECT_NEAR(im.at(x, y, c), expected[c], im.at(x, y, 4) + 1e-12) << x << "," << y << " " << c;
+}
+
+// A ray inside the plane x = 4 where the field is flat at the jump's value (pixel column 4 of an
+// orthographic view along +y): the transfer function takes the row above the jump at s = 4 exactly
+// (PiecewiseLinear.h), a = 0.5 over the 8 units of the ray: A = 1 - 0.5^8, C = (1, 0.5, 0) A.
+TEST(Adaptive, FlatFieldAtTheJumpValue) {
+    Scene s = oblique_through_x({{0.0, 0.0, 0.0, 1.0}, {4.0, 0.0, 0.0, 1.0}, {4.0, 1.0, 0.5, 0.0}, {8.0, 1.0, 0.5, 0.0}},
+                                {{0.0, 0.2}, {4.0, 0.2}, {4.0, 0.5}, {8.0, 0.5}});
+    s.camera.eye = glm::dvec3(4.0, -10.0, 4.0);
+    s.camera.target = glm::dvec3(4.0, 4.0, 4.0);
+    s.camera.height = 1.0;
+    s.image.width = s.image.height = 1;
+    const Image im = render_scene(s, {.threads = 1});
+    const double A = 1.0 - std::pow(0.5, 8.0);
+    const double expected[4] = {A, 0.5 * A, 0.0, A};
+    for (std::size_t c = 0; c < 4; ++c) EXPECT_NEAR(im.at(0, 0, c), expected[c], im.at(0, 0, 4) + 1e-12) << c;
+    EXPECT_LT(im.at(0, 0, 4), 1e-6);
 }
 
 // A cancel (SIGINT/SIGTERM) stops the refinement inside long rays: the render gives up within a second.
 TEST(Adaptive, CancelIsAnsweredInsideLongRays) {
-    const Scene s = opacity_one_on_a_face(48);
+    const Scene s = rays_in_jump_planes(64);
     reset_cancel();
     std::thread canceller([] {
         std::this_thread::sleep_for(std::chrono::milliseconds(300));

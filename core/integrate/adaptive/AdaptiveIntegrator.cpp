@@ -7,6 +7,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
+#include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/CellCubic.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "core/integrate/march/CompensatedSum.h"
@@ -22,16 +23,7 @@ namespace volref {
 
 namespace gk = gauss_kronrod;
 
-namespace {
-
-double max_abs(const glm::dvec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-double max_abs(const glm::dvec4& v) { return std::max(max_abs(glm::dvec3(v)), std::fabs(v.w)); }
-
-double rounding_bound(const glm::dvec4& rgba) {
-    return conventions::kRoundingErrorRelative * (1.0 + max_abs(rgba));
-}
-
-}  // namespace
+using adaptive_detail::rounding_bound;
 
 AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
     const RenderSpec& r = ctx.render;
@@ -66,6 +58,8 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
         throw Error("render.integrator: \"adaptive\" mip/minip needs a Cartesian grid with trilinear or nearest "
                     "interpolation (the extremum is found exactly there)");
 }
+
+double AdaptiveIntegrator::safety() const { return weak_ ? conventions::kAdaptiveWeakSafety : 1.0; }
 
 PixelValue AdaptiveIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
     switch (ctx_.render.projection) {
@@ -222,172 +216,69 @@ void AdaptiveIntegrator::sampled_row_cuts(const Ray& ray, std::vector<double>& o
 // Composite
 // ---------------------------------------------------------------------------------------------
 
-namespace {
-
-struct LeafRecord {
-    glm::dvec3 contribution;  // T(a) E
-    double e_emission;        // T(a) e_E
-    double e_tau;
-};
-
-struct CompositeState {
-    const SamplePipeline* pipeline;
-    const Ray* ray;
-    double l;          // opacity_unit_distance
-    double tolerance;  // render.tolerance
-    double safety;     // 1, or kAdaptiveWeakSafety where kinks inside pieces are not located
-    double total;      // length of all intervals
-    // The pieces composite front to back with compensated colour sums (march/Accumulators.h).
-    FrontToBack<Scalar, TransmittanceRule::OpticalDepthSum, true> acc;
-    double colour_bound = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
-    std::vector<LeafRecord> leaves;
-    long rules_left = conventions::kAdaptiveMaxRulesPerRay;  // work bound of the ray
-    double unresolved_T = 0.0;  // the transmittance in front of the first piece accepted unresolved
-    // False once the ray has spent its rules or a cancel was requested: open pieces are then accepted
-    // with their estimates (conventions.h, kAdaptiveMaxRulesPerRay).
-    bool may_refine() const { return rules_left > 0 && !cancel_requested(); }
-
-    // sigma and colour at t; transparent where the value (or the shaded colour) is not finite.
-    void sample(double t, double& sigma, glm::dvec3& c) const {
-        const PipelineSample p = pipeline->sample(*ray, t, SamplePipeline::Use::Composite);
-        const double a = std::min(p.opacity, conventions::kAdaptiveMaxOpacity);
-        if (!(a > 0.0) || !std::isfinite(p.value) || !std::isfinite(p.color.x + p.color.y + p.color.z)) {
-            sigma = 0.0;
-            c = glm::dvec3(0.0);
-            return;
-        }
-        sigma = extinction(a, l);
-        c = p.color;
+bool AdaptiveIntegrator::opaque_piece(const Ray& ray, double a, double b) const {
+    // A cut found to rounding beside another (a cell face and a row's root that coincide in exact
+    // arithmetic) leaves a piece a few doubles long: it has no length, so it is never opaque.
+    double t = a;
+    for (int k = 0; k < conventions::kAdaptiveOpaqueMinDoubles; ++k)
+        if (!((t = std::nextafter(t, b)) < b)) return false;
+    // Opacity 1 at a, the midpoint and b (just inside the ends): on a piece the transfer function is
+    // linear in s between two consecutive rows, so opacity 1 at two different s of it is opacity 1 on
+    // all of it; opacity 1 at one point only (a tent's peak touched or crossed) is integrable.
+    const double d = conventions::kAdaptiveOpaqueColourOffset * (b - a);
+    for (double x : {0.5 * (a + b), a + d, b - d}) {
+        const PipelineSample p = ctx_.pipeline.sample(ray, x, SamplePipeline::Use::Composite);
+        if (!(p.opacity >= 1.0 && std::isfinite(p.value))) return false;
     }
+    return true;
+}
 
-    // One G7/K15 evaluation of [a, b]: the emission E (relative to T(a)) and Delta tau by both rules.
-    struct Rule {
-        glm::dvec3 ek{0.0}, eg{0.0};
-        double tk = 0.0, tg = 0.0;
-        double em_error() const { return max_abs(ek - eg); }
-        double tau_error() const { return std::fabs(tk - tg); }
-    };
-    Rule evaluate(double a, double b) {
-        --rules_left;
-        const gk::Tables& g = gk::tables();
-        const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
-        double sigma[gk::kNodes];
-        glm::dvec3 c[gk::kNodes];
-        for (int i = 0; i < gk::kNodes; ++i) {
-            sample(mid + half * g.x[std::size_t(i)], sigma[i], c[i]);
-            colour_bound = std::max(colour_bound, max_abs(c[i]));
-        }
-        Rule r;
-        for (int i = 0; i < gk::kNodes; ++i) {
-            r.tk += g.wk[std::size_t(i)] * sigma[i];
-            if (sigma[i] == 0.0) continue;
-            double tau_i = 0.0;
-            for (int j = 0; j < gk::kNodes; ++j) tau_i += g.sk[std::size_t(i)][std::size_t(j)] * sigma[j];
-            r.ek += (g.wk[std::size_t(i)] * sigma[i] * std::exp(-half * tau_i)) * c[i];
-        }
-        for (int q = 0; q < gk::kGaussNodes; ++q) {
-            const int i = 2 * q + 1;
-            r.tg += g.wg[std::size_t(q)] * sigma[i];
-            if (sigma[i] == 0.0) continue;
-            double tau_q = 0.0;
-            for (int j = 0; j < gk::kGaussNodes; ++j) tau_q += g.sg[std::size_t(q)][std::size_t(j)] * sigma[2 * j + 1];
-            r.eg += (g.wg[std::size_t(q)] * sigma[i] * std::exp(-half * tau_q)) * c[i];
-        }
-        r.tk *= half;
-        r.tg *= half;
-        r.ek *= half;
-        r.eg *= half;
-        return r;
-    }
+bool AdaptiveIntegrator::empty_piece(const Ray& ray, double a, double b) const {
+    // A piece lies in one cell (nearest: reads one voxel, a corner of the cell of its midpoint); in an
+    // empty macrocell every sample of it has opacity 0.
+    return ctx_.macrocells && cut_cells_ && ctx_.macrocells->empty(ctx_.macrocells->macrocell_at(ray.at(0.5 * (a + b))));
+}
 
-    // [a, b] with its rule P already evaluated: its halves L and R are evaluated; the pair is accepted
-    // when the estimate  e = |P - (L + R)| + |K15 - G7|_L + |K15 - G7|_R  (emission with R behind L:
-    // E = E_L + exp(-Delta tau_L) E_R; and optical depth) fits the budget; otherwise each half goes on.
-    // Comparing a rule with its halves catches what both rules of one evaluation miss together (a
-    // narrow feature between nodes, an unlocated kink).
-    void process(double a, double b, int depth, const Rule& P) {
-        const double m = 0.5 * (a + b);
-        const double T = acc.transmittance();
-        if (!(m > a && m < b) || depth >= conventions::kAdaptiveMaxDepth) {
-            commit(T, P.ek, P.tk, 0.0, safety * P.em_error(), safety * P.tau_error());
-            return;
-        }
-        const Rule L = evaluate(a, m), R = evaluate(m, b);
-        const glm::dvec3 E = L.ek + std::exp(-L.tk) * R.ek;
-        const double e_e = safety * (max_abs(P.ek - E) + L.em_error() + R.em_error());
-        const double e_t = safety * (std::fabs(P.tk - (L.tk + R.tk)) + L.tau_error() + R.tau_error());
-        const double estimate = T * (e_e + colour_bound * e_t);
-        const double budget = tolerance * (b - a) / total;
-        const double roundoff = conventions::kAdaptiveRoundoffRelative * T * (max_abs(E) + colour_bound * (L.tk + R.tk));
-        if (estimate <= budget || estimate <= roundoff) {
-            commit(T, E, L.tk, R.tk, e_e, e_t);
-            return;
-        }
-        if (!may_refine()) {  // unresolved: everything from here on is uncertain (see composite())
-            unresolved_T = std::max(unresolved_T, T);
-            commit(T, E, L.tk, R.tk, e_e, e_t);
-            return;
-        }
-        process(a, m, depth + 1, L);
-        process(m, b, depth + 1, R);
+void AdaptiveIntegrator::medium(const Ray& ray, double t, double& sigma, glm::dvec3& c) const {
+    const PipelineSample p = ctx_.pipeline.sample(ray, t, SamplePipeline::Use::Composite);
+    const double a = std::min(p.opacity, conventions::kAdaptiveMaxOpacity);
+    if (!(a > 0.0) || !std::isfinite(p.value) || !std::isfinite(p.color.x + p.color.y + p.color.z)) {
+        sigma = 0.0;
+        c = glm::dvec3(0.0);
+        return;
     }
-    void commit(double T, const glm::dvec3& E, double dtau0, double dtau1, double e_e, double e_t) {
-        const glm::dvec3 contribution = T * E;
-        const double e[3] = {E.r, E.g, E.b};
-        acc.add_emission(e, dtau0, dtau1);
-        leaves.push_back({contribution, T * e_e, e_t});
-    }
-    void integrate(double a, double b) { process(a, b, 0, evaluate(a, b)); }
-};
+    sigma = extinction(a, ctx_.pipeline.classifier().unit_distance());
+    c = p.color;
+}
 
-}  // namespace
+glm::dvec3 AdaptiveIntegrator::opaque_colour(const Ray& ray, double a, double b) const {
+    return ctx_.pipeline.sample(ray, a + conventions::kAdaptiveOpaqueColourOffset * (b - a), SamplePipeline::Use::Composite).color;
+}
 
 PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals) const {
-    PixelValue out;
-    CompositeState st{&ctx_.pipeline, &ray, ctx_.pipeline.classifier().unit_distance(), ctx_.render.tolerance,
-                      weak_ ? conventions::kAdaptiveWeakSafety : 1.0, 0.0, {}, 1.0, {}};
-    for (const Interval& iv : intervals) st.total += iv.length();
-    if (!(st.total > 0.0)) return out;
-    bool opaque = false;
-    glm::dvec3 opaque_colour(0.0);
+    double total = 0.0;
+    for (const Interval& iv : intervals) total += iv.length();
+    if (!(total > 0.0)) return PixelValue{};
+    struct OneVolume {
+        const AdaptiveIntegrator* self;
+        const Ray* ray;
+        void sample(double t, double& sigma, glm::dvec3& c) const { self->medium(*ray, t, sigma, c); }
+    } one{this, &ray};
+    AdaptiveComposite<OneVolume> st(one, ctx_.render.tolerance, safety(), total);
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
         cuts(ray, iv, cut);
-        for (std::size_t p = 0; p + 1 < cut.size() && !opaque; ++p) {
+        for (std::size_t p = 0; p + 1 < cut.size() && !st.is_opaque(); ++p) {
             const double a = cut[p], b = cut[p + 1];
-            if (!(b > a)) continue;
-            // Empty-space skipping: a piece lies in one cell (nearest: reads one voxel, a corner of the
-            // cell of its midpoint); in an empty macrocell every sample of it has opacity 0.
-            if (ctx_.macrocells && cut_cells_ && ctx_.macrocells->empty(ctx_.macrocells->macrocell_at(ray.at(0.5 * (a + b)))))
-                continue;
-            const PipelineSample pm = ctx_.pipeline.sample(ray, 0.5 * (a + b), SamplePipeline::Use::Composite);
-            if (pm.opacity >= 1.0 && std::isfinite(pm.value)) {  // opaque piece: the ray ends at a
-                const PipelineSample ps = ctx_.pipeline.sample(ray, a + conventions::kAdaptiveOpaqueColourOffset * (b - a),
-                                                               SamplePipeline::Use::Composite);
-                opaque_colour = st.acc.transmittance() * ps.color;
-                const double c[3] = {ps.color.r, ps.color.g, ps.color.b};
-                st.acc.add_opaque(c);
-                opaque = true;
-                break;
-            }
-            st.integrate(a, b);
+            if (!(b > a) || empty_piece(ray, a, b)) continue;
+            if (opaque_piece(ray, a, b))  // the ray ends at a
+                st.opaque(opaque_colour(ray, a, b));
+            else
+                st.integrate(a, b);
         }
-        if (opaque) break;
+        if (st.is_opaque()) break;
     }
-    const double T_end = opaque ? 0.0 : st.acc.transmittance();
-    out.rgba = glm::dvec4(st.acc.color(0), st.acc.color(1), st.acc.color(2), st.acc.alpha());
-    // Posterior error: leaf i's tau error scales everything emitted behind it.
-    glm::dvec3 behind = opaque_colour;
-    double colour_err = 0.0, tau_err = 0.0;
-    for (auto it = st.leaves.rbegin(); it != st.leaves.rend(); ++it) {
-        colour_err += it->e_emission + it->e_tau * max_abs(behind);
-        tau_err += it->e_tau;
-        behind += it->contribution;
-    }
-    // A piece accepted unresolved (the ray's rules spent) may be wrong by anything it and the pieces
-    // behind it contribute: at most T K in each channel (T in front of it, K >= 1 the largest colour).
-    out.error = std::max(colour_err, T_end * tau_err) + rounding_bound(out.rgba) + st.unresolved_T * st.colour_bound;
-    return out;
+    return st.result();
 }
 
 // ---------------------------------------------------------------------------------------------

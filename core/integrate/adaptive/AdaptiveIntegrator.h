@@ -26,13 +26,15 @@
 //   C = integral c(t) sigma(t) T(t) dt,   A = 1 - T(end) = -expm1(-tau_total).
 // A rule on [a, b] gives Delta tau = integral of sigma (K15) and E = integral c sigma exp(-(tau(t) - tau(a)))
 // (K15, with tau(t) - tau(a) at the nodes from the integration matrix, AdaptiveQuadrature.h), and the
-// same by G7. The halves L, R of [a, b] are accepted together when
+// same by G7. A candidate [a', b'] with rule P and halves L, R has the estimate
 //   e = |P - (L + R)| + |K15 - G7|_L + |K15 - G7|_R   (E of L + R = E_L + exp(-Delta tau_L) E_R),
 // for the emission (e_E, max over channels) and the optical depth (e_tau), times kAdaptiveWeakSafety
-// where kinks lie inside pieces, fits T(a) (e_E + K e_tau) <= tolerance (b - a) / (ray length); then
-// C += T(a) E and tau += Delta tau, both compensated sums (never a product of transmittances).
-// A piece whose opacity is 1 at its midpoint is opaque: C += T c(start of the piece), A = 1, and the
-// ray ends. The order (front to back, back to front) does not apply.
+// where kinks lie inside pieces. Each piece [a, b] between cuts is refined globally (AdaptiveComposite.h):
+// the candidate with the largest e_E + K e_tau is split until T(a) sum (e_E + K e_tau) <= tolerance
+// (b - a) / (ray length); then, front to back, C += T(a') E and tau += Delta tau for each candidate,
+// both compensated sums (never a product of transmittances).
+// A piece whose opacity is 1 at its midpoint and just inside both ends (and that is longer than
+// kAdaptiveOpaqueMinDoubles doubles) is opaque: C += T c(start of the piece), A = 1, and the ray ends. The order (front to back, back to front) does not apply.
 //
 // Error (PixelValue::error, the "error" channel): to first order in the leaf estimates,
 //   colour: sum_i T_i e_E,i + sum_i e_tau,i * max_ch C_after,i   (C_after,i: what is emitted behind leaf i,
@@ -69,6 +71,18 @@ public:
 
     // The cut points of one interval (t0, ..., t1), increasing: the pieces described above.
     void cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const;
+
+    // What the composite reads, also used by the several-volume mix (MultiVolumeIntegrator):
+    // sigma(t) = -log1p(-min(a, kAdaptiveMaxOpacity)) / l and c(t), 0 and 0 where not finite;
+    void medium(const Ray& ray, double t, double& sigma, glm::dvec3& c) const;
+    // is the piece [a, b] opaque (opacity 1 on all of it; conventions.h, kAdaptiveMaxOpacity)?
+    bool opaque_piece(const Ray& ray, double a, double b) const;
+    // an opaque piece's colour, c(a+) (kAdaptiveOpaqueColourOffset);
+    glm::dvec3 opaque_colour(const Ray& ray, double a, double b) const;
+    // does the piece lie in an empty macrocell (every sample of it has opacity 0)?
+    bool empty_piece(const Ray& ray, double a, double b) const;
+    // 1, or kAdaptiveWeakSafety where kinks of the integrand lie inside pieces.
+    double safety() const;
 
 private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;

@@ -14,9 +14,6 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
     const bool several = scene.volumes.size() > 1;
     if (several && scene.render.profile != ProfileId::Reference)
         throw Error("render.profile: only \"reference\" renders several volumes (the mirror profiles and \"fast\" render one)");
-    if (several && scene.render.integrator == IntegrationMethod::Adaptive && scene.render.projection == Projection::Composite)
-        throw Error("render.integrator: \"adaptive\" does not mix several volumes in the composite projection yet "
-                    "(use \"fixed\"; the other projections combine adaptive volumes)");
     std::size_t held = 0;
     view_lo = glm::dvec3(std::numeric_limits<double>::infinity());
     view_hi = -view_lo;
@@ -30,7 +27,7 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
         std::vector<MultiVolumeIntegrator::Member> members;
         double step = std::numeric_limits<double>::infinity();
         for (const auto& v : volumes) {
-            members.push_back({v->pipeline.get(), v->integrator.get()});
+            members.push_back({v->pipeline.get(), v->integrator.get(), v->context.get()});
             step = std::min(step, v->step);
         }
         multi = std::make_unique<MultiVolumeIntegrator>(std::move(members), scene.render, step);

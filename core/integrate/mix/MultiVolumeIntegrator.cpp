@@ -4,6 +4,8 @@
 #include <cmath>
 #include <tuple>
 
+#include "core/integrate/adaptive/AdaptiveComposite.h"
+#include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SamplePipeline.h"
 #include "core/integrate/march/SamplePlacement.h"
@@ -63,9 +65,87 @@ struct Term {
 }  // namespace
 
 MultiVolumeIntegrator::MultiVolumeIntegrator(std::vector<Member> volumes, const RenderSpec& render, double step)
-    : volumes_(std::move(volumes)), render_(render), step_(step) {}
+    : volumes_(std::move(volumes)), render_(render), step_(step) {
+    if (render_.integrator == IntegrationMethod::Adaptive && render_.projection == Projection::Composite)
+        for (const Member& m : volumes_) adaptive_.push_back(std::make_unique<AdaptiveIntegrator>(*m.context));
+}
+
+MultiVolumeIntegrator::~MultiVolumeIntegrator() = default;
+
+PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std::vector<Interval>* intervals) const {
+    const std::vector<Piece> ps = pieces(intervals, volumes_.size());
+    double total = 0.0;
+    for (const Piece& p : ps) total += p.span.length();
+    if (!(total > 0.0)) return PixelValue{};
+    struct Mixed {
+        const std::vector<std::unique_ptr<AdaptiveIntegrator>>* parts;
+        const Ray* rays;
+        const std::vector<int>* present = nullptr;
+        mutable std::vector<Term> terms;
+        void sample(double t, double& sigma, glm::dvec3& c) const {
+            terms.clear();
+            for (int k : *present) {
+                double s;
+                glm::dvec3 ck;
+                (*parts)[std::size_t(k)]->medium(rays[k], t, s, ck);
+                if (s > 0.0) terms.push_back({s, ck});
+            }
+            sigma = 0.0;
+            c = glm::dvec3(0.0);
+            if (terms.size() == 1) {
+                sigma = terms[0].tau;
+                c = terms[0].c;
+                return;
+            }
+            std::sort(terms.begin(), terms.end());  // canonical order: the volumes' listing changes no bit
+            glm::dvec3 weighted(0.0);
+            for (const Term& term : terms) {
+                sigma += term.tau;
+                weighted += term.tau * term.c;
+            }
+            if (sigma > 0.0) c = weighted / sigma;
+        }
+    } mixed{&adaptive_, rays};
+    double safety = 1.0;
+    for (const auto& part : adaptive_) safety = std::max(safety, part->safety());
+    AdaptiveComposite<Mixed> st(mixed, render_.tolerance, safety, total);
+    std::vector<double> cut, all;
+    std::vector<Term> opaque;
+    for (const Piece& p : ps) {
+        all.clear();
+        for (int k : p.present) {
+            adaptive_[std::size_t(k)]->cuts(rays[k], p.span, cut);
+            all.insert(all.end(), cut.begin(), cut.end());
+        }
+        std::sort(all.begin(), all.end());
+        all.erase(std::unique(all.begin(), all.end()), all.end());
+        mixed.present = &p.present;
+        for (std::size_t i = 0; i + 1 < all.size() && !st.is_opaque(); ++i) {
+            const double a = all[i], b = all[i + 1];
+            if (!(b > a)) continue;
+            bool empty = true;
+            opaque.clear();
+            for (int k : p.present) {
+                const AdaptiveIntegrator& part = *adaptive_[std::size_t(k)];
+                if (!part.empty_piece(rays[k], a, b)) empty = false;
+                if (part.opaque_piece(rays[k], a, b)) opaque.push_back({0.0, part.opaque_colour(rays[k], a, b)});
+            }
+            if (!opaque.empty()) {  // the mean of the opaque volumes' colours, in canonical order
+                std::sort(opaque.begin(), opaque.end());
+                glm::dvec3 c(0.0);
+                for (const Term& o : opaque) c += o.c;
+                st.opaque(c / double(opaque.size()));
+            } else if (!empty) {
+                st.integrate(a, b);
+            }
+        }
+        if (st.is_opaque()) break;
+    }
+    return st.result();
+}
 
 PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<Interval>* intervals) const {
+    if (!adaptive_.empty()) return adaptive_composite(rays, intervals);
     const std::vector<Piece> ps = pieces(intervals, volumes_.size());
     std::vector<Term> terms, opaque_terms;
     // The mix at segment s of the volumes `present`.

@@ -15,12 +15,21 @@
 // Compositing then is the single-volume one (front to back with T = exp(-tau) and a compensated
 // optical depth, or back to front), with early termination as render.early_termination says.
 //
+// composite with render.integrator "adaptive": the same mix in continuous form, sigma(t) = sum_k
+// sigma_k(t), emission sum_k sigma_k(t) c_k(t) (terms in the same canonical order), integrated by
+// AdaptiveComposite over the pieces cut at every present volume's cuts (AdaptiveIntegrator::cuts: its
+// cell faces and transfer-function rows; the clip planes and crop faces are already interval ends):
+// between them every term is smooth, so the sum is. A piece where some present volume is opaque
+// (AdaptiveIntegrator::opaque_piece) is opaque with the mean of those volumes' colours c_k(a+) (sorted),
+// as in the fixed mix. The estimate's safety factor is the largest of the volumes'.
+//
 // mip / minip: each volume's own projection (its transfer function at its extremum), then the
 // per-channel maximum / minimum of the premultiplied RGBA over the volumes the ray meets (OpenGL's
 // GL_MAX / GL_MIN blending of one image per volume). average: the length-weighted mean over all the
 // volumes, sum_k L_k avg_k / sum_k L_k (L_k the length of I_k). x-ray: the sum of the volumes' line
 // integrals. first-hit: the nearest hit over all volumes (ties: the smaller RGBA, lexicographically).
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "core/camera/Ray.h"
@@ -30,14 +39,19 @@
 
 namespace volref {
 
+class AdaptiveIntegrator;
+
 class MultiVolumeIntegrator {
 public:
     struct Member {
         const SamplePipeline* pipeline;
         const Integrator* integrator;  // the volume's own integrator (projections other than composite)
+        const IntegrationContext* context;  // what the adaptive mix builds its per-volume parts from
     };
     // `step`: the composite mix's step (world units).
+    // Throws volref::Error where render.integrator "adaptive" cannot integrate a volume.
     MultiVolumeIntegrator(std::vector<Member> volumes, const RenderSpec& render, double step);
+    ~MultiVolumeIntegrator();
 
     // Composite only: the mix along the ray; rays[k], intervals[k] are volume k's.
     PixelValue composite(const Ray* rays, const std::vector<Interval>* intervals) const;
@@ -49,7 +63,11 @@ public:
     double step() const { return step_; }
 
 private:
+    PixelValue adaptive_composite(const Ray* rays, const std::vector<Interval>* intervals) const;
+
     std::vector<Member> volumes_;
+    // render.integrator "adaptive", composite: each volume's cuts, medium and opaque test.
+    std::vector<std::unique_ptr<AdaptiveIntegrator>> adaptive_;
     const RenderSpec& render_;
     double step_;
 };

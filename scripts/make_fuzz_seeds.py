@@ -34,6 +34,11 @@ scene['render']['profile'] = 'fast'
 with open(os.path.join(CORPUS, 'fuzz_scene', 'two-volumes-crop-matrix.json'), 'w') as f:
     json.dump(scene, f, indent=1)
 
+# Nesting near the loader's depth limit (kMaxJsonDepth = 256; issue 18: 100,000 brackets crashed it;
+# that input is tests/fuzz/regressions/fuzz_scene/deep-nesting-100000.json, replayed by CI).
+put('fuzz_scene', 'deep-nesting-300.json',
+    '{"volume": {"transfer": {"color": ' + '[' * 150 + '{"a": ' * 150 + '0' + '}' * 150 + ']' * 150 + '}}}')
+
 # NRRD: raw little-endian float, big-endian short, ascii, gzip.
 hdr = 'NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nspacings: 1 2 3\nendian: little\nencoding: raw\n\n'
 put('fuzz_nrrd', 'float-raw.nrrd', hdr.encode() + struct.pack('<8f', *values))

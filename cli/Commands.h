@@ -13,6 +13,8 @@ struct RenderArgs {
     bool no_skipping = false;  // --no-skipping: RenderOptions::empty_space_skipping = false
     bool error = false;        // --error: RenderOptions::error_estimate (step doubling, fixed integrator)
     std::vector<std::string> overrides;  // --set PATH=VALUE
+    bool timing = false;       // --timing: print "volref: timing {...}" on stderr (docs/performance.md)
+    int repeat = 1;            // --repeat N: render the frame N times after one set-up
 };
 
 // Renders args.scene to args.output; throws volref::Error on bad input. Returns the exit status.

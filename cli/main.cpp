@@ -52,6 +52,11 @@ int main(int argc, char** argv) {
     rc->add_flag("--error", render.error,
                  "Fixed-step integrator: also render at step/2 and write the step-doubling error estimate as the "
                  "EXR `error` channel (the adaptive integrator always writes its own)");
+    rc->add_flag("--timing", render.timing,
+                 "Print one line on stderr: volref: timing {\"setup_s\", \"frames_s\", \"median_s\", \"samples\", "
+                 "\"samples_per_s\", \"threads\"} (frame time only: no reading, generation or set-up)");
+    rc->add_option("--repeat", render.repeat, "Render the frame N times after one set-up (default 1; the image is written once)")
+        ->check(CLI::Range(1, 100000));
     rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
         ->take_all();
 

@@ -1,8 +1,13 @@
-// volref render SCENE -o OUT [--threads N] [--no-skipping] [--error] [--set PATH=VALUE ...]
+// volref render SCENE -o OUT [--threads N] [--no-skipping] [--error] [--timing] [--repeat N] [--set PATH=VALUE ...]
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <tbb/info.h>
 
 #include "cli/Commands.h"
 #include "core/film/ImageWriter.h"
@@ -18,7 +23,9 @@ int run_render(const RenderArgs& args) {
     options.threads = args.threads;
     options.empty_space_skipping = !args.no_skipping;
     options.error_estimate = args.error;
-    options.progress = ::isatty(STDERR_FILENO) != 0;
+    options.progress = ::isatty(STDERR_FILENO) != 0 && !args.timing;
+    options.frames = args.repeat;
+    options.count_samples = args.timing;
     const auto start = std::chrono::steady_clock::now();
     RenderStats stats;
     const Image image = render_scene(scene, options, &stats);
@@ -28,6 +35,26 @@ int run_render(const RenderArgs& args) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_image(image, args.output, scene.image.background);
     std::fprintf(stderr, "volref: rendered %dx%d in %.3f s\n", image.width, image.height, seconds);
+    if (args.timing) {
+        // The median frame (the mean of the middle two for an even count); samples per second over it.
+        std::vector<double> sorted = stats.frames_s;
+        std::sort(sorted.begin(), sorted.end());
+        const std::size_t n = sorted.size();
+        const double median = n == 0 ? 0.0 : (n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]));
+        nlohmann::json t;
+        t["setup_s"] = stats.setup_s;
+        t["frames_s"] = stats.frames_s;
+        t["median_s"] = median;
+        t["threads"] = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
+        if (stats.sample_positions > 0) {
+            t["samples"] = stats.sample_positions;
+            t["samples_per_s"] = median > 0.0 ? double(stats.sample_positions) / median : 0.0;
+        } else {  // the adaptive integrator places no fixed samples
+            t["samples"] = nullptr;
+            t["samples_per_s"] = nullptr;
+        }
+        std::fprintf(stderr, "volref: timing %s\n", t.dump().c_str());
+    }
     std::printf("%s\n", args.output.string().c_str());
     return 0;
 }

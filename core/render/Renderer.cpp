@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <functional>
 #include <cstdio>
 #include <limits>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "core/Cancellation.h"
@@ -25,6 +27,7 @@
 #include "core/integrate/Integrator.h"
 #include "core/integrate/packet/PacketComposite.h"
 #include "core/integrate/march/SamplePipeline.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/fixed/StepDoubling.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/MacrocellGrid.h"
@@ -113,6 +116,33 @@ private:
     std::thread thread_;
 };
 
+// RenderStats::sample_positions: every pixel's ray through every volume's intervals, counted as the
+// fixed step places samples (segment_count); 0 for the adaptive integrator.
+std::uint64_t count_sample_positions(const PreparedScene& prepared, const Scene& scene, tbb::task_arena& arena) {
+    if (scene.render.integrator != IntegrationMethod::Fixed || !prepared.camera) return 0;
+    const int W = scene.image.width, H = scene.image.height;
+    return arena.execute([&] {
+        return tbb::parallel_reduce(
+            tbb::blocked_range<int>(0, H), std::uint64_t(0),
+            [&](const tbb::blocked_range<int>& rows, std::uint64_t n) {
+                Ray rays[kMaxPacketRays], local[kMaxPacketRays];
+                std::vector<Interval> intervals[kMaxPacketRays];
+                for (int y = rows.begin(); y != rows.end(); ++y)
+                    for (int x0 = 0; x0 < W; x0 += kMaxPacketRays) {
+                        const int count = std::min(kMaxPacketRays, W - x0);
+                        for (int i = 0; i < count; ++i) rays[i] = prepared.camera->pixel_ray(x0 + i, y);
+                        for (const auto& v : prepared.volumes) {
+                            v->intervals(rays, count, local, intervals);
+                            for (int i = 0; i < count; ++i)
+                                for (const Interval& iv : intervals[i]) n += std::uint64_t(segment_count(iv, v->step));
+                        }
+                    }
+                return n;
+            },
+            std::plus<>());
+    });
+}
+
 }  // namespace
 
 Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats* stats) {
@@ -128,9 +158,15 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     // One arena for the whole render (--threads): the set-up (procedural volumes are generated in
     // parallel) and the tiles.
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    using Clock = std::chrono::steady_clock;
+    const auto setup_start = Clock::now();
     std::optional<PreparedScene> prepared_storage;
     arena.execute([&] { prepared_storage.emplace(scene, options); });
     const PreparedScene& prepared = *prepared_storage;
+    if (stats) {
+        stats->setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
+        stats->frames_s.clear();
+    }
     if (stats) {
         stats->non_finite_voxels = 0;
         for (const auto& v : prepared.volumes)
@@ -147,7 +183,9 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
 
     const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
     const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
-    ProgressReporter progress(options.progress, tiles_x * tiles_y);
+    for (int frame = 0; frame < std::max(1, options.frames); ++frame) {
+    const auto frame_start = Clock::now();
+    ProgressReporter progress(options.progress && frame == 0, tiles_x * tiles_y);
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
             // Each tile row is integrated in packets of up to kMaxPacketRays pixels.
@@ -172,6 +210,9 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         });
     });
     throw_if_cancelled();
+    if (stats) stats->frames_s.push_back(std::chrono::duration<double>(Clock::now() - frame_start).count());
+    }
+    if (stats && options.count_samples) stats->sample_positions = count_sample_positions(prepared, scene, arena);
     return image;
 }
 

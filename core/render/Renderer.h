@@ -5,6 +5,8 @@
 // the same for any thread count and any tile order.
 #pragma once
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "core/film/Image.h"
 #include "core/grid/Volume.h"
@@ -24,6 +26,8 @@ struct RenderOptions {
     // "error" channel (StepDoubling.h). The adaptive integrator always writes its own estimate.
     bool error_estimate = false;
     int tile_size = 0;      // pixels per tile side; 0: conventions::kTileSize (the image does not depend on it)
+    int frames = 1;         // render the frame this many times after one set-up (volref render --repeat)
+    bool count_samples = false;  // fill RenderStats::sample_positions (one extra pass, not timed)
 };
 
 // The volume a VolumeSpec names: read from its file or made from its procedural field, with the
@@ -36,6 +40,14 @@ double world_step(const RenderSpec& render, const Volume& volume);
 // What a render noticed about its input.
 struct RenderStats {
     std::size_t non_finite_voxels = 0;  // NaN or +-Inf voxels (transparent; docs/accuracy.md)
+    // Timing (volref render --timing): the set-up (reading or generating the volumes, building the
+    // pipeline, the geometry and the camera) and each frame (every pixel, nothing else), in seconds.
+    double setup_s = 0.0;
+    std::vector<double> frames_s;
+    // RenderOptions::count_samples: the fixed step's sample positions in one frame, summed over every
+    // pixel, volume and interval (segment_count, SamplePlacement.h) before skipping and termination:
+    // the work of a marcher without empty-space skipping. 0 for the adaptive integrator.
+    std::uint64_t sample_positions = 0;
 };
 
 // `stats` (optional) receives what the render noticed (non-finite voxels).

@@ -1,6 +1,7 @@
 // The volref command: reference scenes render, and every bad input gives one line on stderr, a
 // non-zero exit status and no output file.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <thread>
@@ -97,6 +98,35 @@ TEST_F(Cli, ConstantBoxClosedFormThroughTheCommand) {
         EXPECT_NEAR(px[std::size_t(i) + 3], alpha, 1e-7);
         EXPECT_NEAR(px[std::size_t(i) + 1], 0.5 * alpha, 1e-7);
     }
+}
+
+// --timing --repeat 3 (issue 19): one line "volref: timing {...}" with three frame times, their median,
+// and the sample positions counted by hand: constant-box's 64 x 64 rays each cross the 10-unit box
+// (the view, 8 units high, lies inside it), ceil(10 / 0.7) = 15 segments each: 61,440.
+TEST_F(Cli, TimingReportsFramesMedianAndSamples) {
+    const fs::path out = dir_ / "box.exr";
+    const Result r = run("render " + std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/constant-box.json -o " +
+                         out.string() + " --threads 2 --timing --repeat 3 --set render.step=0.7");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string key = "volref: timing ";
+    const auto at = r.err.find(key);
+    ASSERT_NE(at, std::string::npos) << r.err;
+    const auto line_end = r.err.find('\n', at);
+    const nlohmann::json t = nlohmann::json::parse(r.err.substr(at + key.size(), line_end - at - key.size()));
+    ASSERT_EQ(t["frames_s"].size(), 3u);
+    std::vector<double> f;
+    for (const auto& x : t["frames_s"]) f.push_back(x.get<double>());
+    std::sort(f.begin(), f.end());
+    EXPECT_EQ(t["median_s"].get<double>(), f[1]);
+    EXPECT_GT(f[0], 0.0);
+    EXPECT_GE(t["setup_s"].get<double>(), 0.0);
+    EXPECT_EQ(t["samples"].get<std::uint64_t>(), 64u * 64u * 15u);
+    EXPECT_DOUBLE_EQ(t["samples_per_s"].get<double>(), 61440.0 / f[1]);
+    EXPECT_EQ(t["threads"].get<int>(), 2);
+    EXPECT_TRUE(fs::exists(out));
+    // --repeat below 1 is a usage error
+    EXPECT_EQ(run("render " + std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/constant-box.json -o " +
+                  (dir_ / "x.exr").string() + " --repeat 0").status, 2);
 }
 
 TEST_F(Cli, MissingSceneFile) {

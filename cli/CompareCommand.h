@@ -1,5 +1,5 @@
 // volref compare A B [--tolerance X] [--tolerance-from-error] [--background R,G,B,A] [--heatmap OUT.png]
-//                    [--heatmap-scale S] [--fit] [--json]            (docs/compare.md)
+//                    [--heatmap-scale S] [--fit [--scene SCENE.json]] [--json]   (docs/compare.md)
 // Exit status: 0 within tolerance, 1 not within tolerance, 2 usage errors and unreadable or
 // incompatible inputs (so that a test calling it can tell "differs" from "could not compare").
 #pragma once
@@ -17,6 +17,8 @@ struct CompareArgs {
     double heatmap_scale = 0.0;           // --heatmap-scale S (0: the max abs difference)
     bool fit = false;                     // --fit: gain, opacity exponent, shift (Ceres)
     bool json = false;                    // --json: the report as JSON on stdout
+    std::filesystem::path scene;          // --scene SCENE.json (with --fit): B's scene, re-rendered with
+                                          // each convention changed (Fits.h, ConventionVariant)
 };
 
 // Returns 0 (within tolerance) or 1 (not); throws volref::Error on bad input (main exits 2 for compare).

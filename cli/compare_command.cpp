@@ -15,6 +15,8 @@
 #include "core/compare/ImageMetrics.h"
 #include "core/compare/MetricsJson.h"
 #include "core/compare/Tolerance.h"
+#include "core/render/Renderer.h"
+#include "core/scene/SceneLoader.h"
 
 namespace volref::cli {
 
@@ -58,6 +60,53 @@ void print_row(const ChannelMetrics& c) {
                 c.ssim ? number(*c.ssim, "%.6f").c_str() : "n/a", c.over);
 }
 
+// B's scene re-rendered with each convention changed (issue 22): the vtk-js profile's options
+// flip_normal (shaded composite, one-sided lighting), ray_box and mip_correction (mip/minip). Other
+// profiles: not applicable (no such option).
+std::vector<ConventionVariant> convention_variants(const std::filesystem::path& path,
+                                                   const std::optional<glm::dvec4>& background) {
+    const Scene base = load_scene(path);
+    std::vector<ConventionVariant> out(3);
+    out[0].model = "normal";
+    out[1].model = "ray-box";
+    out[2].model = "mip-opacity";
+    const ProfileOptions& o = base.render.profile_options;
+    out[0].description = "a flipped normal under one-sided lighting";
+    out[1].description = o.ray_box_domain ? "a ray box half a voxel larger (the texel box)"
+                                          : "a ray box half a voxel smaller (the grid's domain, not the texel box)";
+    out[2].description = o.mip_correction ? "MIP without opacity correction" : "opacity correction applied to MIP";
+    const bool vtk_js = base.render.profile == ProfileId::VtkJs;
+    const bool mip = base.render.projection == Projection::Mip || base.render.projection == Projection::Minip;
+    const VolumeSpec& vs = base.volumes.front();
+    const bool one_sided_shaded = base.render.projection == Projection::Composite && vs.shading && !vs.shading->two_sided;
+    for (ConventionVariant& v : out) v.note = "only the vtk-js profile's conventions are re-rendered (render.profile)";
+    if (!vtk_js) return out;
+    out[0].applicable = one_sided_shaded;
+    if (!one_sided_shaded) out[0].note = "the scene is not a shaded composite with one-sided lighting";
+    out[1].applicable = true;
+    out[2].applicable = mip;
+    if (!mip) out[2].note = "the scene's projection is not mip or minip";
+    for (int k = 0; k < 3; ++k) {
+        if (!out[std::size_t(k)].applicable) continue;
+        Scene s = base;
+        ProfileOptions& po = s.render.profile_options;
+        if (k == 0) po.flip_normal = !po.flip_normal;
+        if (k == 1) po.ray_box_domain = !po.ray_box_domain;
+        if (k == 2) po.mip_correction = !po.mip_correction;
+        Image im = render_scene(s);
+        if (background) {  // as read_compared_image composites an associated input
+            const glm::dvec4 bg = *background;
+            for (std::size_t p = 0; p + 3 < im.pixels.size(); p += 4) {
+                const double t = 1.0 - im.pixels[p + 3];
+                for (int c = 0; c < 3; ++c) im.pixels[p + std::size_t(c)] += t * bg.a * bg[c];
+                im.pixels[p + 3] += t * bg.a;
+            }
+        }
+        out[std::size_t(k)].image = std::move(im);
+    }
+    return out;
+}
+
 }  // namespace
 
 int run_compare(const CompareArgs& args) {
@@ -85,8 +134,11 @@ int run_compare(const CompareArgs& args) {
         if (std::isnan(scale)) scale = 0.0;
         write_heatmap(max_abs_difference_map(a.rgba, b.rgba), a.rgba.width, a.rgba.height, scale, args.heatmap);
     }
+    if (!args.scene.empty() && !args.fit) throw Error("--scene: only with --fit");
     std::optional<DifferenceExplanation> fit;
-    if (args.fit) fit = explain_difference(a.rgba, b.rgba);
+    if (args.fit)
+        fit = explain_difference(a.rgba, b.rgba,
+                                 args.scene.empty() ? std::vector<ConventionVariant>{} : convention_variants(args.scene, background));
 
     if (args.json) {
         nlohmann::json j;
@@ -99,6 +151,7 @@ int run_compare(const CompareArgs& args) {
         j["overall"] = channel_json(m.overall, m.pixels);
         j["pixels"] = m.pixels;
         j["pixels_over"] = m.overall.over;
+        j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};
         j["fraction_over"] = m.fraction_over();
         j["within_tolerance"] = within;
         if (!args.heatmap.empty()) j["heatmap"] = {{"path", args.heatmap.string()}, {"scale", scale}};
@@ -111,7 +164,8 @@ int run_compare(const CompareArgs& args) {
                                      {"residual_after", f.residual_after},
                                      {"rgba_residual_before", f.rgba_before},
                                      {"rgba_residual_after", f.rgba_after},
-                                     {"note", f.note}};
+                                     {"note", f.note},
+                                     {"parameters", f.parameters}};
             j["fit"]["verdict"] = fit->verdict;
         }
         std::printf("%s\n", j.dump(2).c_str());
@@ -126,6 +180,9 @@ int run_compare(const CompareArgs& args) {
         print_row(m.overall);
         std::printf("pixels over tolerance: %ld of %ld (%s)\n", m.overall.over, m.pixels,
                     number(m.fraction_over()).c_str());
+        if (m.non_finite_a > 0 || m.non_finite_b > 0)
+            std::printf("non-finite pixels: %ld in A, %ld in B, %ld disagreeing (those are over the tolerance); all left "
+                        "out of the metrics and the fit\n", m.non_finite_a, m.non_finite_b, m.non_finite_disagree);
         if (!args.heatmap.empty())
             std::printf("heat map: %s (max abs difference per pixel, 0 black -> %s white)\n",
                         args.heatmap.string().c_str(), number(scale).c_str());
@@ -133,6 +190,9 @@ int run_compare(const CompareArgs& args) {
             for (const ModelFit& f : fit->fits) {
                 if (!f.fitted)
                     std::printf("fit %-8s not fitted: %s\n", f.model.c_str(), f.note.c_str());
+                else if (f.judged_on == "RGBA" && f.model != "gain" && f.model != "shift")
+                    std::printf("fit %-8s %s: RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
+                                number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
                 else if (f.judged_on == "RGBA")
                     std::printf("fit %-8s %s; RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
                                 number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());

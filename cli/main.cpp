@@ -96,6 +96,9 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     cmp->add_flag("--fit", compare.fit, "Fit a gain, an opacity exponent and a sub-pixel shift; name the likely cause");
     cmp->add_flag("--json", compare.json, "Print the report as JSON");
+    cmp->add_option("--scene", compare.scene,
+                    "With --fit: the scene B was rendered from; B is re-rendered with a flipped normal, a ray box half a "
+                    "voxel larger or smaller and MIP opacity correction changed, and each is fitted (vtk-js profile)");
 
     volref::cli::InfoArgs info;
     CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");

@@ -221,6 +221,7 @@ const char* profile_name(ProfileId p) {
         case ProfileId::CudaCurvilinear: return "cuda-curvilinear";
         case ProfileId::VtkCpu: return "vtk-cpu";
         case ProfileId::Fast: return "fast";
+        case ProfileId::VtkJs: return "vtk-js";
     }
     return "reference";
 }
@@ -242,6 +243,12 @@ json render_json(const RenderSpec& r) {
                                 {"transfer_scale", r.profile_options.transfer_scale},
                                 {"iso_threshold", r.profile_options.iso_threshold},
                                 {"brightness", r.profile_options.brightness}};
+    if (r.profile == ProfileId::GlslBasic) j["profile_options"] = {{"intensity", r.profile_options.intensity}};
+    if (r.profile == ProfileId::VtkJs)  // issue 22
+        j["profile_options"] = {{"jitter", r.profile_options.jitter}, {"fixed_normal", r.profile_options.fixed_normal},
+                                {"flip_normal", r.profile_options.flip_normal},
+                                {"ray_box", r.profile_options.ray_box_domain ? "domain" : "texel"},
+                                {"mip_correction", r.profile_options.mip_correction}};
     return j;
 }
 

@@ -379,6 +379,7 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     j["overall"] = compare::channel_json(m.overall, m.pixels);
     j["pixels"] = m.pixels;
     j["pixels_over"] = m.overall.over;
+    j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};  // issue 22
     j["fraction_over"] = m.fraction_over();
     j["within_tolerance"] = m.overall.over == 0;
     return json_loads(j.dump());
@@ -749,7 +750,7 @@ Arguments:
 
 Returns {"a", "b", "width", "height", "tolerance", "channels": {"R": {...}, ...}, "overall": {"max_abs",
 "mean_abs", "rmse", "psnr_db", "ssim", "pixels_over", "fraction_over"}, "pixels", "pixels_over",
-"fraction_over", "within_tolerance"}; +inf PSNR and missing SSIM are None, as in the CLI's JSON.)doc");
+"non_finite": {"a", "b", "disagree"}, "fraction_over", "within_tolerance"}; +inf PSNR and missing SSIM are None, as in the CLI's JSON.)doc");
 
     m.def("trace", &trace, py::arg("scene"), py::arg("pixel"), py::kw_only(), py::arg("overrides") = py::none(),
           py::arg("skipping") = true, py::arg("format") = "array", py::arg("max_memory") = py::none(),

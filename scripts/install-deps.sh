@@ -20,6 +20,11 @@ packages=(
   # the Python module (python/, docs/python.md): pybind11 and Python's headers to build it; pytest and
   # OpenImageIO's Python binding (reads the CLI's EXR) for its tests (numpy is listed above)
   pybind11-dev python3-dev python3-pytest python3-openimageio
+  # issue 17, the GLSL check (tests/gpu/glsl): seed 002's shader on Mesa llvmpipe through EGL's surfaceless
+  # platform (no X): EGL and desktop-GL headers and libraries (GLVND), Mesa's EGL driver and llvmpipe
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  # issue 22, the vtk.js check (tests/gpu/web): Debian's Chromium (headless, SwiftShader WebGL2) and node
+  chromium nodejs
 )
 missing=()
 for p in "${packages[@]}"; do
@@ -31,4 +36,17 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "volref: installing ${missing[*]}" >&2
   $sudo apt-get update -q
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+# issue 22: npm (Debian's, unless a node install already brings one), then the vtk.js check's npm
+# packages from tests/gpu/web/package-lock.json into tests/gpu/web/node_modules (git-ignored); the test
+# downloads nothing.
+if ! command -v npm >/dev/null; then
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends npm
+fi
+web="$(cd "$(dirname "$0")/.." && pwd)/tests/gpu/web"
+if [ ! -f "$web/node_modules/.package-lock.json" ] || ! cmp -s "$web/package-lock.json" "$web/node_modules/.volref-lock"; then
+  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error && cp package-lock.json node_modules/.volref-lock)
 fi

@@ -16,6 +16,7 @@
 
 #include "core/Error.h"
 #include "core/compare/CompareConstants.h"
+#include "core/compare/ImageMetrics.h"
 
 namespace volref::compare {
 
@@ -234,11 +235,50 @@ ModelFit fit_shift(const Image& a, const Image& b) {
     return fit;
 }
 
-DifferenceExplanation explain_difference(const Image& a, const Image& b) {
-    if (a.width != b.width || a.height != b.height || a.channel_count() != 4 || b.channel_count() != 4)
+ModelFit fit_convention(const ConventionVariant& v, const Image& a_in, const Image& b_in) {
+    ModelFit fit;
+    fit.model = v.model;
+    fit.judged_on = "RGBA";
+    fit.parameters = v.description;
+    if (!v.applicable) {
+        fit.note = v.note;
+        return fit;
+    }
+    if (v.image.width != a_in.width || v.image.height != a_in.height || v.image.channel_count() != 4)
+        throw Error("--fit: the re-rendered scene is not the images' size");
+    // Left out: pixels with a non-finite value in A, B or the variant.
+    double before = 0.0, after = 0.0, values = 0.0;
+    const Image& a = a_in;
+    const Image& b = b_in;
+    const Image& variant = v.image;
+    for (std::size_t p = 0; p < pixel_count(a); ++p) {
+        bool finite = true;
+        for (std::size_t c = 0; c < 4; ++c)
+            finite = finite && std::isfinite(a.pixels[p * 4 + c]) && std::isfinite(b.pixels[p * 4 + c]) &&
+                     std::isfinite(variant.pixels[p * 4 + c]);
+        if (!finite) continue;
+        for (std::size_t i = p * 4; i < p * 4 + 4; ++i) {
+            before += (b.pixels[i] - a.pixels[i]) * (b.pixels[i] - a.pixels[i]);
+            after += (variant.pixels[i] - a.pixels[i]) * (variant.pixels[i] - a.pixels[i]);
+        }
+        values += 4.0;
+    }
+    values = std::max(values, 1.0);
+    fit.rgba_before = fit.residual_before = std::sqrt(before / values);
+    fit.rgba_after = fit.residual_after = std::sqrt(after / values);
+    fit.fitted = true;
+    return fit;
+}
+
+DifferenceExplanation explain_difference(const Image& a_in, const Image& b_in,
+                                         const std::vector<ConventionVariant>& conventions) {
+    if (a_in.width != b_in.width || a_in.height != b_in.height || a_in.channel_count() != 4 || b_in.channel_count() != 4)
         throw Error("--fit: the images must have the same size and R, G, B, A");
+    Image a, b;
+    finite_copies(a_in, b_in, a, b);  // non-finite pixels never reach Ceres
     DifferenceExplanation e;
     e.fits = {fit_gain(a, b), fit_opacity_exponent(a, b), fit_shift(a, b)};
+    for (const ConventionVariant& v : conventions) e.fits.push_back(fit_convention(v, a_in, b_in));
     if (e.fits[0].rgba_before == 0.0) {
         e.verdict = "likely cause: none needed, the images are identical";
         return e;
@@ -247,7 +287,9 @@ DifferenceExplanation explain_difference(const Image& a, const Image& b) {
     for (const ModelFit& f : e.fits)
         if (f.fitted && (!best || f.ratio() < best->ratio())) best = &f;
     if (!best || best->ratio() > kExplainedResidualRatio) {
-        e.verdict = "likely cause: none of gain, opacity exponent or shift explains the difference";
+        e.verdict = conventions.empty() ? "likely cause: none of gain, opacity exponent or shift explains the difference"
+                                        : "likely cause: none of gain, opacity exponent, shift or the scene's conventions "
+                                          "explains the difference";
         if (best)
             e.verdict += " (the best, " + best->model + ", leaves " + format("%.0f", 100.0 * best->ratio()) +
                          "% of the RMS difference in " + best->judged_on + ")";
@@ -263,6 +305,8 @@ DifferenceExplanation explain_difference(const Image& a, const Image& b) {
         e.verdict = "likely cause: opacity correction, B has " + format("%.6g", best->values[0]) +
                     " times A's optical depth (its step, opacity unit distance or density scale differs by that "
                     "factor, or it does not correct opacity for the step; " + kept + ")";
+    else if (best->model != "shift")
+        e.verdict = "likely cause: " + best->parameters + " (B re-rendered with it; " + kept + ")";
     else
         e.verdict = "likely cause: a sub-pixel shift of " + format("(%.3g, %.3g)", best->values[0], best->values[1]) +
                     " pixels (pixel centres at (x + 0.5, y + 0.5) or (x, y), or a different camera; " + kept + ")";

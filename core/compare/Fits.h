@@ -12,6 +12,12 @@
 //   shift      B(x, y) = A(x - sx, y - sy)                                   (two parameters, pixels)
 //              (A interpolated by Ceres' bicubic (Catmull-Rom) interpolator; |s| <= kMaxShiftPixels;
 //              residual over pixels at least kMaxShiftPixels from the border)
+//   conventions (issue 22; `--scene`): B re-rendered by volref with one convention changed (a flipped
+//              normal under one-sided lighting, a ray box half a voxel larger or smaller, opacity correction
+//              applied to MIP or not; no parameter), judged on R, G, B, A: before = RMS(B - A), after =
+//              RMS(B' - A), B' the re-rendered image.
+// Pixels with a non-finite value in either image never reach a fit (ImageMetrics.h, finite_copies: they
+// are 0 in both images the fits see).
 // Residuals are reported as RMS over every value the model is judged on (gain, shift: R, G, B, A; opacity:
 // A), before (B - A) and after (B - model); rgba_before/after are over R, G, B, A for every model.
 //
@@ -41,14 +47,29 @@ ModelFit fit_gain(const Image& a, const Image& b);
 ModelFit fit_opacity_exponent(const Image& a, const Image& b);
 ModelFit fit_shift(const Image& a, const Image& b);
 
+// A convention B might differ in: B re-rendered with it changed (`image`), or not applicable (`note`).
+struct ConventionVariant {
+    std::string model;        // "normal", "ray-box", "mip-opacity"
+    std::string description;  // for the verdict, e.g. "a flipped normal under one-sided lighting"
+    bool applicable = false;
+    std::string note;         // why not applicable
+    Image image;              // B with the convention changed
+};
+
+// The convention model: before = RMS(B - A), after = RMS(variant - A) over R, G, B, A.
+ModelFit fit_convention(const ConventionVariant& v, const Image& a, const Image& b);
+
 struct DifferenceExplanation {
-    std::vector<ModelFit> fits;  // gain, opacity, shift
+    std::vector<ModelFit> fits;  // gain, opacity, shift, then the conventions
     std::string verdict;         // one line: "likely cause: ..."
 };
 
 // All three fits and the verdict: the model with the smallest residual ratio after/before is the likely
 // cause when that ratio is <= kExplainedResidualRatio; identical images have nothing to explain.
-DifferenceExplanation explain_difference(const Image& a, const Image& b);
+// Non-finite pixels are left out (finite_copies). `conventions`: B re-rendered with each convention
+// changed (compare --scene), fitted after the three models and judged the same way.
+DifferenceExplanation explain_difference(const Image& a, const Image& b,
+                                         const std::vector<ConventionVariant>& conventions = {});
 
 struct PowerLawFit {
     double c = 0.0, p = 0.0;   // error = c h^p

@@ -5,6 +5,11 @@
 //   SSIM (core/compare/Ssim.h), over = pixels with |d| > tol in that channel.
 // Overall: the same over every channel's values (N = pixels x channels); SSIM = the mean of the
 // channels' SSIMs; over = pixels over the tolerance in any channel. Sums are accumulated in double.
+// Non-finite values (issue 22: vtk.js's float framebuffer holds NaN where alpha is 0): a value pair
+// (a, b) with a non-finite member never enters the sums, the maxima or SSIM (N counts finite pairs;
+// SSIM and the fits see such pixels as 0 in both images, finite_copies). The pair agrees when both are
+// NaN or both the same infinity, and is then within any tolerance; otherwise it is over the tolerance.
+// The pixels with a non-finite value in a, in b, and with a disagreeing pair are counted.
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -27,6 +32,8 @@ struct ImageMetrics {
     std::vector<ChannelMetrics> channels;
     ChannelMetrics overall;
     long pixels = 0;
+    long non_finite_a = 0, non_finite_b = 0;  // pixels with a non-finite value in a (b)
+    long non_finite_disagree = 0;             // pixels with a non-finite pair that does not agree
     double fraction_over() const { return pixels > 0 ? double(overall.over) / double(pixels) : 0.0; }
 };
 
@@ -39,7 +46,11 @@ double psnr_db(double mse);
 ImageMetrics measure_difference(const Image& a, const Image& b, const std::vector<double>& tolerance = {},
                                 bool with_ssim = true);
 
-// Per pixel: max over channels of |a - b| (width * height, row 0 at the top).
+// Copies of a and b with every pixel that has a non-finite value in either set to 0 in both.
+void finite_copies(const Image& a, const Image& b, Image& a_out, Image& b_out);
+
+// Per pixel: max over channels of |a - b| (width * height, row 0 at the top); NaN (the heat map's
+// white) where a non-finite pair disagrees; agreeing non-finite pairs add nothing.
 std::vector<double> max_abs_difference_map(const Image& a, const Image& b);
 
 }  // namespace volref::compare

@@ -15,6 +15,7 @@
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/packet/FastProfile.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
+#include "core/integrate/profiles/VtkJsIntegrator.h"
 #include "core/integrate/profiles/VtkFixedPointRenderer.h"
 #include "core/io/VolumeReader.h"
 #include "geometry/ClipPlanes.h"
@@ -280,6 +281,8 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                         "\" casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
         image_space = std::make_unique<vtkcpu::VtkFixedPointRenderer>(volume, *classifier, shader.get(), scene.render.projection,
                                                                       step, scene.camera, scene.image, vs.interpolation);
+    } else if (p.renderer == Profile::Renderer::VtkJs) {  // issue 22
+        integrator = std::make_unique<VtkJsIntegrator>(*context, volume, vs, scene);
     } else {
         integrator = std::make_unique<ProfileIntegrator>(*context, p, volume);
     }

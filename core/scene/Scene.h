@@ -168,13 +168,19 @@ enum class StepUnits { Voxel, World };
 enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/profiles/Profile.h, conventions section 9);
 // Fast is volref's own float SIMD variant of the reference (core/integrate/packet/FastProfile.h).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast };
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs };
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {
     double density = 1.0;         // the lerp weight is col.a * density
     double transfer_scale = 1.0;  // the table is read at s * transfer_scale
     double iso_threshold = 0.0;   // samples with s below it are skipped (s: value normalised over the data range)
     double brightness = 1.0;      // x-ray: the maximum of s times this
+    // vtk-js (issue 22; VtkJsIntegrator.h): the jitter fraction in [0.01, 1] (vtk.js: 0.01 + 0.99 seed);
+    // fixed_normal drops vtk.js's diag(dims * spacing) normal scaling; flip_normal, ray_box_domain and
+    // mip_correction false are conventions `volref compare --fit --scene` tries.
+    double jitter = 1.0;
+    bool fixed_normal = false, flip_normal = false, ray_box_domain = false, mip_correction = true;
+    double intensity = 1.0;       // glsl-basic: seed 002's K, the sample's alpha is K times the opacity
 };
 
 struct RenderSpec {

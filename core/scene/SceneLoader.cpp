@@ -810,11 +810,23 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                      {"ospray", ProfileId::Ospray},
                                      {"cuda-curvilinear", ProfileId::CudaCurvilinear},
                                      {"vtk-cpu", ProfileId::VtkCpu},
-                                     {"fast", ProfileId::Fast}});
-    if (const Json* o = r.find("profile_options")) {
-        if (s.profile != ProfileId::CudaCurvilinear) r.fail("profile_options", "only the cuda-curvilinear profile has options");
+                                     {"fast", ProfileId::Fast},
+                                     {"vtk-js", ProfileId::VtkJs}});
+    if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
         ObjectReader po(*o, r.path("profile_options"), ctx);
-        po.allow({"density", "transfer_scale", "iso_threshold", "brightness"});
+        po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction"});
+        s.profile_options.jitter = po.number("jitter", 1.0, Range::closed(0.01, 1.0));
+        s.profile_options.fixed_normal = po.boolean("fixed_normal", false);
+        s.profile_options.flip_normal = po.boolean("flip_normal", false);
+        s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, {{"texel", false}, {"domain", true}});
+        s.profile_options.mip_correction = po.boolean("mip_correction", true);
+    } else if (const Json* o = r.find("profile_options")) {
+        if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic)
+            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic and vtk-js profiles have options");
+        ObjectReader po(*o, r.path("profile_options"), ctx);
+        if (s.profile == ProfileId::GlslBasic) po.allow({"intensity"});
+        else po.allow({"density", "transfer_scale", "iso_threshold", "brightness"});
+        s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());
         s.profile_options.density = po.number("density", 1.0, Range::non_negative());
         s.profile_options.transfer_scale = po.number("transfer_scale", 1.0, Range::non_negative());
         s.profile_options.iso_threshold = po.number("iso_threshold", 0.0);

@@ -890,7 +890,7 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-gpu"})")).render.profile, ProfileId::VtkGpu);
     EXPECT_EQ(parse(scene_with(R"("render": {})")).render.profile, ProfileId::Reference);
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-gpu", "profile_options": {}})"),
-                           "render.profile_options", "only the cuda-curvilinear profile"));
+                           "render.profile_options", "only the cuda-curvilinear"));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "cuda-curvilinear", "profile_options": {"gain": 1}})"),
                            "render.profile_options.gain", "unknown key"));
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "cuda-curvilinear", "profile_options": {"density": 0.25}})"))

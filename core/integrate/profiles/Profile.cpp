@@ -54,6 +54,12 @@ Profile make_glsl_basic() {
     p.termination.alpha_at_least = 1.0;
     p.gradient_offset = 0.0;
     p.gradient_offset_texture = 0.1;
+    // Seed 002 (issue 17): acc += (1 - acc.a) * K * tf(v).a * v.rrra, samples with v < 0.01 skipped,
+    // getNormalFromVol's normal = +grad f.
+    p.color_from_value = true;
+    p.value_cutoff = 0.01;
+    p.alpha_times_intensity = true;
+    p.normal_along_gradient = true;
     return p;
 }
 
@@ -85,7 +91,7 @@ Profile make_cuda_curvilinear() {
     Profile p;
     p.id = ProfileId::CudaCurvilinear;
     p.name = "cuda-curvilinear";
-    p.placement = Profile::Placement::FromEntry;
+    p.placement = Profile::Placement::FromExit;  // the seed marches from outAbs towards inAbs
     p.first = 0.0;
     p.correction = Profile::Correction::None;
     p.table_entries = 9;
@@ -95,6 +101,17 @@ Profile make_cuda_curvilinear() {
     p.xray = Profile::Xray::BrightnessTimesMaximum;
     p.voxel_length = Profile::VoxelLength::ExtentOverSamples;
     p.grids = Profile::Grids::CartesianAndShells;
+    p.seed_shell_reads = true;
+    return p;
+}
+
+// vtk.js 37.4.3's WebGL2 volume mapper (issue 22): its own integrator, VtkJsIntegrator.h (the fields
+// below are not read; check_profile_applies reads grids).
+Profile make_vtk_js() {
+    Profile p;
+    p.id = ProfileId::VtkJs;
+    p.name = "vtk-js";
+    p.renderer = Profile::Renderer::VtkJs;
     return p;
 }
 
@@ -103,7 +120,7 @@ Profile make_cuda_curvilinear() {
 const Profile& profile(ProfileId id) {
     static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), vtk_cpu = make_vtk_cpu(),
                          glsl_basic = make_glsl_basic(),
-                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear();
+                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear(), vtk_js = make_vtk_js();
     switch (id) {
         case ProfileId::Reference: return reference;
         case ProfileId::VtkGpu: return vtk_gpu;
@@ -111,6 +128,7 @@ const Profile& profile(ProfileId id) {
         case ProfileId::GlslBasic: return glsl_basic;
         case ProfileId::Ospray: return ospray;
         case ProfileId::CudaCurvilinear: return cuda_curvilinear;
+        case ProfileId::VtkJs: return vtk_js;
         case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
     }
     throw Error("render.profile: unknown profile");

@@ -20,13 +20,19 @@ struct Profile {
     // Which renderer reads the rest: a ray caster over the scene's rays (ProfileIntegrator), or VTK's
     // image-space fixed-point caster (VtkFixedPointRenderer.h: its own internal image, 15-bit fixed
     // point, texture display; the fields below are not read).
-    enum class Renderer { RayCaster, VtkFixedPoint };
+    enum class Renderer { RayCaster, VtkFixedPoint, VtkJs };  // VtkJs: VtkJsIntegrator.h (issue 22)
     Renderer renderer = Renderer::RayCaster;
 
     // The grids the renderer reads: Cartesian only (texture reads clamped to the domain), or beam-space
     // shells as well (no clamping: the intervals stay inside; no gradients).
     enum class Grids { Cartesian, CartesianAndShells };
     Grids grids = Grids::Cartesian;
+    // Seed 001's texture reads on shells (interpolateCyl / interpolateSpher; cuda-curvilinear, issue 17):
+    // per grid axis x = (c - lo) / ((hi - lo) / n) (an angle taken in [0, 360) from lo); a point with any
+    // x < 0 or x > n - 1 reads outVal = 0, here the data minimum (s = 0); otherwise tex3D with unnormalised
+    // coordinates and cudaAddressModeClamp: trilinear at grid index clamp(x - 0.5, 0, n - 1) (texel i is
+    // centred at i + 0.5). Off: the shell sampler (conventions section 2).
+    bool seed_shell_reads = false;
 
     // --- sample placement -------------------------------------------------------------------------
     // Where the samples of one interval [t0, t1] (length L, step h) lie.
@@ -37,6 +43,10 @@ struct Profile {
         // sample, even when the chord is shorter than first * h; VTK's GPU shader samples before it
         // tests the exit). Positions past t1 read the texture clamped to the domain.
         FromEntry,
+        // Seed 001 (cuda-curvilinear, issue 17): `for (s = outAbs; s >= inAbs; s -= step)` over one span
+        // [inAbs, outAbs] = [the first interval's t0, the last one's t1]: t1 - k h for k = 0 .. floor(L / h),
+        // back to front; samples in the gaps between intervals read the field as value() says.
+        FromExit,
     };
     Placement placement = Placement::Midpoints;
     double first = 0.0;  // FromEntry: the first sample's distance from the entry, in steps
@@ -60,6 +70,13 @@ struct Profile {
     // Which samples are composited: all, or those with s >= render.profile_options.iso_threshold.
     enum class SampleFilter { All, AtOrAboveIsoThreshold };
     SampleFilter sample_filter = SampleFilter::All;
+    // Seed 002's shader (glsl-basic, composite only): `color_from_value` composites the grey (v, v, v)
+    // of the sample's own value (its `textureValue.rrr`) instead of the transfer function's colour;
+    // samples with v < value_cutoff are skipped (its density cutoff 0.01); the sample's alpha is the
+    // opacity times render.profile_options.intensity when `alpha_times_intensity` (its K, not clamped).
+    bool color_from_value = false;
+    double value_cutoff = -1.0e300;
+    bool alpha_times_intensity = false;
 
     // --- opacity correction -----------------------------------------------------------------------
     // How a transfer-function opacity a (per unit distance l) becomes the alpha of one sample.

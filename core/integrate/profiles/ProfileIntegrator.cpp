@@ -1,6 +1,7 @@
 #include "core/integrate/profiles/ProfileIntegrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -13,6 +14,7 @@
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
+#include "geometry/ShellCoordinates.h"
 #include "transfer/OpacityCorrection.h"
 
 namespace volref {
@@ -43,6 +45,11 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
     domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
     step_ = ctx.step;
+    if (p_.seed_shell_reads && !cartesian) {
+        shell_ = ctx.pipeline.stages().shell_grid;
+        volume_ = &volume;
+        if (!shell_) throw Error(std::string("render.profile: \"") + p_.name + "\" needs the shell's grid");
+    }
     if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && ctx.render.step_units == StepUnits::Voxel) {
         int axis = 0;
         for (int a = 1; a < 3; ++a)
@@ -85,7 +92,38 @@ double ProfileIntegrator::alpha(double a, double d) const {
 
 // A texture read clamps to the edge: positions past the domain read its boundary.
 double ProfileIntegrator::value(const glm::dvec3& x) const {
+    if (shell_) return seed_shell_value(x);
     return ctx_.pipeline.sampler().value(glm::clamp(x, domain_lo_, domain_hi_));
+}
+
+// Seed 001's interpolateCyl / interpolateSpher with tex3D (Profile::seed_shell_reads).
+double ProfileIntegrator::seed_shell_value(const glm::dvec3& x) const {
+    const glm::dvec3 c = shell_->shell_coordinates(x);
+    glm::dvec3 u;
+    std::array<std::int64_t, 3> i0{}, i1{};
+    glm::dvec3 w;
+    for (int a = 0; a < 3; ++a) {
+        const ShellAxis& ax = shell_->axis(a);
+        const double n = double(ax.n);
+        double rel = c[shell_->coordinate_of_axis(a)] - ax.lo;
+        if (ax.angular) rel = std::fmod(std::fmod(rel, 360.0) + 360.0, 360.0);  // atan2 + 2 pi: [0, 360) from lo
+        const double tex = rel / ((ax.hi - ax.lo) / n);
+        if (!(tex >= 0.0 && tex <= n - 1.0)) return lo_;  // outVal (0: the data minimum, s = 0)
+        u[a] = std::clamp(tex - 0.5, 0.0, n - 1.0);       // texel i centred at i + 0.5, clamped
+        i0[std::size_t(a)] = ax.n > 1 ? std::min(std::int64_t(std::floor(u[a])), ax.n - 2) : 0;
+        i1[std::size_t(a)] = ax.n > 1 ? i0[std::size_t(a)] + 1 : 0;
+        w[a] = ax.n > 1 ? u[a] - double(i0[std::size_t(a)]) : 0.0;
+    }
+    const Volume& v = *volume_;
+    auto at = [&](int bx, int by, int bz) {
+        return v.at(bx ? i1[0] : i0[0], by ? i1[1] : i0[1], bz ? i1[2] : i0[2]);
+    };
+    const double x00 = at(0, 0, 0) + w.x * (at(1, 0, 0) - at(0, 0, 0));
+    const double x10 = at(0, 1, 0) + w.x * (at(1, 1, 0) - at(0, 1, 0));
+    const double x01 = at(0, 0, 1) + w.x * (at(1, 0, 1) - at(0, 0, 1));
+    const double x11 = at(0, 1, 1) + w.x * (at(1, 1, 1) - at(0, 1, 1));
+    const double y0 = x00 + w.y * (x10 - x00), y1 = x01 + w.y * (x11 - x01);
+    return y0 + w.z * (y1 - y0);
 }
 
 ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
@@ -127,6 +165,15 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
     const double h = step_;
     if (p_.placement == Profile::Placement::Midpoints) {
         for_each_segment(intervals, h, [&](const Segment& s) { return fn(s.midpoint(), s.length()); });
+        return;
+    }
+    if (p_.placement == Profile::Placement::FromExit) {  // seed 001: s = outAbs, outAbs - h, ... >= inAbs
+        if (intervals.empty()) return;
+        Interval span = intervals.front();
+        span.t1 = intervals.back().t1;
+        const double n = from_entry_count(span, h, 0.0);
+        for (double k = 0.0; k < n; k += 1.0)
+            if (!fn(span.t1 - k * h, h)) return;
         return;
     }
     for (const Interval& iv : intervals) {
@@ -175,7 +222,9 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
         const double v = value(x);
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         if constexpr (Rec::kOn) begin_record(rec, r, x, t, d, v);
-        const Lookup k = std::isfinite(v) ? lookup(v, d) : Lookup{};
+        Lookup k = std::isfinite(v) && !(v < p_.value_cutoff) ? lookup(v, d) : Lookup{};
+        if (p_.color_from_value && std::isfinite(v)) k.color = glm::dvec3(v);  // seed 002: textureValue.rrr
+        if (p_.alpha_times_intensity) k.alpha *= ctx_.render.profile_options.intensity;  // seed 002's K
         [[maybe_unused]] const double T_before = acc.transmittance();
         if (k.alpha > 0.0) {
             glm::dvec3 c = k.color;
@@ -227,8 +276,10 @@ PixelValue ProfileIntegrator::composite_lerp(const Ray& ray, const std::vector<I
     });
     const ProfileOptions& o = ctx_.render.profile_options;
     BackToFront<Scalar, BackToFrontRule::Lerp> acc;
-    for (auto it = samples.rbegin(); it != samples.rend(); ++it) {
-        const auto [t, d] = *it;
+    // Back to front: FromExit yields the samples in that order already; the other placements front to back.
+    const bool reverse = p_.placement != Profile::Placement::FromExit;
+    for (std::size_t j = 0; j < samples.size(); ++j) {
+        const auto [t, d] = samples[reverse ? samples.size() - 1 - j : j];
         const glm::dvec3 x = ray.at(t);
         const double v = value(x);
         const bool used = std::isfinite(v) && !(p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold && normalised(v) < o.iso_threshold);
@@ -298,7 +349,7 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
     const bool weighted = mean && p_.average == Profile::Average::MeanOpacityTimesNormalised;
     auto result = [&]() {
         if (!mean && p_.xray == Profile::Xray::BrightnessTimesMaximum)
-            return ctx_.render.profile_options.brightness * (acc.length() > 0.0 ? largest.value() : 0.0);
+            return ctx_.render.profile_options.brightness * (largest.any() ? std::max(0.0, largest.value()) : 0.0);
         return mean ? (acc.length() > 0.0 ? acc.mean() : 0.0) : ctx_.render.gain * acc.integral();
     };
     for_each_sample(intervals, [&](double t, double d) {
@@ -308,7 +359,10 @@ PixelValue ProfileIntegrator::line_integral(const Ray& ray, const std::vector<In
         if (std::isfinite(v)) {
             s = weighted ? lookup(v, d).opacity * normalised(v) : c.coordinate(v);
             acc.add(weighted ? s : s * d, weighted ? 1.0 : d);
-            largest.add(true, normalised(v), t);
+            // seed 001: maxVal = 0, then fmaxf(maxVal, sample) over the samples with sample >= isoValue
+            const bool kept = !(p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold &&
+                                normalised(v) < ctx_.render.profile_options.iso_threshold);
+            largest.add(kept, normalised(v), t);
         }
         if constexpr (Rec::kOn) {
             SampleRecord r{};

@@ -29,6 +29,8 @@
 
 namespace volref {
 
+class ShellGrid;
+
 // What every mirror profile needs of the scene (fixed step, front-to-back order, its own termination,
 // a grid it reads, post-classification by value alone); throws volref::Error naming render.profile.
 void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, const RenderSpec& render);
@@ -53,6 +55,7 @@ private:
     template <class Fn>
     void for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const;
     double value(const glm::dvec3& x) const;
+    double seed_shell_value(const glm::dvec3& x) const;  // Profile::seed_shell_reads
     Lookup lookup(double v, double d) const;
     double alpha(double a, double d) const;
     glm::dvec3 gradient(const glm::dvec3& x) const;
@@ -70,6 +73,8 @@ private:
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean, Rec& rec) const;
 
     const Profile& p_;
+    const Volume* volume_ = nullptr;          // seed_shell_reads: the beam-space data
+    const ShellGrid* shell_ = nullptr;        // seed_shell_reads: its grid (null on Cartesian grids)
     glm::dvec3 domain_lo_, domain_hi_;
     glm::dvec3 offset_;  // per-axis gradient offset, world units
     double step_ = 0.0;  // the profile's step, world units

@@ -1,0 +1,300 @@
+#include "core/integrate/profiles/VtkJsIntegrator.h"
+
+#include "core/integrate/march/Accumulators.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+#include "core/integrate/profiles/Profile.h"
+#include "core/integrate/profiles/ProfileIntegrator.h"
+#include "transfer/Shader.h"
+
+namespace volref {
+
+namespace {
+
+const std::string kWhere = "render.profile: \"vtk-js\" ";
+
+// vtk.js's colour table is a Uint8ClampedArray filled with 255 c (VolumeMapper.js, renderPiece):
+// conversion rounds to nearest, ties to even (ECMAScript ToUint8Clamp), and clamps to [0, 255].
+double to_uint8_clamped(double c) {
+    const double x = 255.0 * double(float(c));  // c comes from a Float32Array (getTable's tmpTable)
+    if (!(x > 0.0)) return 0.0;
+    if (x >= 255.0) return 1.0;
+    return std::nearbyint(x) / 255.0;  // the default rounding mode: ties to even
+}
+
+// GL_LINEAR over N texels with CLAMP_TO_EDGE at coordinate u: texel position u N - 0.5.
+template <class T>
+T read_linear(const std::vector<T>& table, double u) {
+    const int n = int(table.size());
+    const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
+    const int i = std::min(int(pos), n - 2);
+    const double w = pos - double(i);
+    return table[std::size_t(i)] + w * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
+}
+
+}  // namespace
+
+VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& volume, const VolumeSpec& spec,
+                                 const Scene& scene)
+    : OneLoopIntegrator(ctx) {
+    const Profile& p = profile(ProfileId::VtkJs);
+    check_profile_applies(p, ctx.pipeline, ctx.render);
+    const Projection proj = ctx.render.projection;
+    if (proj != Projection::Composite && proj != Projection::Mip && proj != Projection::Minip)
+        throw Error(kWhere + "mirrors the composite, mip and minip projections only");
+    if (!ctx.pipeline.cartesian_sampler()) throw Error(kWhere + "needs a Cartesian grid");
+    if (spec.bounds.type != BoundsSpec::Type::Box || spec.bounds.min || spec.bounds.max || spec.crop ||
+        !spec.clip_planes.empty())
+        throw Error(kWhere + "casts rays through the whole texel box (remove volume.bounds, crop and clip_planes)");
+    if (spec.interpolation != Interpolation::Trilinear)
+        throw Error(kWhere + "samples a linearly filtered texture (volume.interpolation \"trilinear\")");
+    if (spec.classification || spec.transfer.domain != TransferSpec::Domain::Data || !spec.transfer.gradient_opacity.empty())
+        throw Error(kWhere + "needs a transfer function over the data's values (no classification, "
+                             "normalized domain or gradient_opacity)");
+    const auto& color = spec.transfer.color;
+    const auto& opacity = spec.transfer.opacity;
+    if (color.size() < 2 || opacity.size() < 2 || !(color.back()[0] > color.front()[0]) ||
+        !(opacity.back()[0] > opacity.front()[0]))
+        throw Error(kWhere + "builds its tables over the transfer function's node range: volume.transfer.color "
+                             "and .opacity need at least two rows with different values");
+    const ProfileOptions& o = ctx.render.profile_options;
+    if (proj != Projection::Composite && ctx.pipeline.shader())
+        throw Error(kWhere + "does not mirror vtk.js's shaded mip/minip (remove volume.shading)");
+    if (const Shader* sh = ctx.pipeline.shader()) {
+        if (spec.shading->kl != 0.0 || spec.shading->kc != 1.0)
+            throw Error(kWhere + "has no depth cueing (volume.shading.kc 1, kl 0)");
+    }
+
+    domain_lo_ = volume.domain_min();
+    domain_hi_ = volume.domain_max();
+    spacing_ = volume.spacing;
+    const glm::dvec3 half = 0.5 * volume.spacing;
+    box_lo_ = o.ray_box_domain ? domain_lo_ : domain_lo_ - half;
+    box_hi_ = o.ray_box_domain ? domain_hi_ : domain_hi_ + half;
+    const glm::dvec3 dims(double(volume.dims[0]), double(volume.dims[1]), double(volume.dims[2]));
+    normal_scale_ = o.fixed_normal ? glm::dvec3(1.0) : dims * volume.spacing;
+    flip_normal_ = o.flip_normal;
+    step_ = ctx.step;
+    jitter_ = o.jitter;
+
+    switch (scene.camera.type) {
+        case CameraSpec::Type::Perspective:
+        case CameraSpec::Type::Orthographic: forward_ = glm::normalize(scene.camera.target - scene.camera.eye); break;
+        case CameraSpec::Type::Matrices:
+            forward_ = -glm::normalize(glm::dvec3(scene.camera.view[0][2], scene.camera.view[1][2], scene.camera.view[2][2]));
+            break;
+        case CameraSpec::Type::Default: forward_ = glm::dvec3(0.0, 0.0, -1.0); break;
+    }
+
+    // The tables (VolumeMapper.js renderPiece): getTable(range[0], range[1], 1024) samples the function at
+    // range[0] + i / 1023 (range[1] - range[0]); opacity entries 1 - (1 - a)^(sampleDistance / unitDistance)
+    // stored as float, colour entries as Uint8ClampedArray(255 c).
+    color_lo_ = color.front()[0];
+    color_width_ = color.back()[0] - color.front()[0];
+    opacity_lo_ = opacity.front()[0];
+    opacity_width_ = opacity.back()[0] - opacity.front()[0];
+    const Classifier& c = ctx.pipeline.classifier();
+    const double factor = step_ / c.unit_distance();
+    color_table_.resize(kTableEntries);
+    opacity_table_.resize(kTableEntries);
+    opacity_raw_table_.resize(kTableEntries);
+    for (int i = 0; i < kTableEntries; ++i) {
+        const double f = double(i) / double(kTableEntries - 1);
+        const glm::dvec3 rgb = c.classify(color_lo_ + f * color_width_, 0.0).color;
+        color_table_[std::size_t(i)] = glm::dvec3(to_uint8_clamped(rgb.r), to_uint8_clamped(rgb.g), to_uint8_clamped(rgb.b));
+        const double a = double(float(c.classify(opacity_lo_ + f * opacity_width_, 0.0).opacity));
+        opacity_table_[std::size_t(i)] = double(float(1.0 - std::pow(1.0 - a, factor)));
+        opacity_raw_table_[std::size_t(i)] = a;
+    }
+    if (!o.mip_correction && proj != Projection::Composite) opacity_table_ = opacity_raw_table_;
+}
+
+VtkJsIntegrator::~VtkJsIntegrator() = default;
+
+double VtkJsIntegrator::table_opacity(double v) const {
+    return read_linear(opacity_table_, (v - opacity_lo_) / opacity_width_);
+}
+
+glm::dvec3 VtkJsIntegrator::table_color(double v) const {
+    return read_linear(color_table_, (v - color_lo_) / color_width_);
+}
+
+// The texture read clamps to the edge texels: positions past the domain read its boundary.
+double VtkJsIntegrator::value(const glm::dvec3& x) const {
+    return ctx_.pipeline.sampler().value(glm::clamp(x, domain_lo_, domain_hi_));
+}
+
+// vtkVolumeFS.glsl rayIntersectVolumeDistances: the slab test against the box (in index space there,
+// the same t here); the entry is clamped to the ray's origin (computeRayDistances, dists.x = max(0, ..)).
+bool VtkJsIntegrator::box(const Ray& ray, double& t0, double& t1) const {
+    t0 = 0.0;
+    t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        const double inv = 1.0 / ray.direction[a];
+        double u = (box_lo_[a] - ray.origin[a]) * inv, w = (box_hi_[a] - ray.origin[a]) * inv;
+        if (std::isnan(u) || std::isnan(w)) {  // parallel to the slab, on its plane
+            u = -std::numeric_limits<double>::infinity();
+            w = std::numeric_limits<double>::infinity();
+        }
+        t0 = std::max(t0, std::min(u, w));
+        t1 = std::min(t1, std::max(u, w));
+    }
+    return t1 > t0 && t1 > 0.0;
+}
+
+// getColorForDependentComponents (one component): the tables, the drop below EPSILON = 0.001, then
+// applyAllLightning -> applySurfaceShadowLighting when the scene is shaded.
+VtkJsIntegrator::Sample VtkJsIntegrator::color_at(const glm::dvec3& x, const glm::dvec3& ray_dir) const {
+    Sample s;
+    const double v = value(x);
+    if (!std::isfinite(v)) return s;
+    const double a = table_opacity(v);
+    if (a < 0.001) return s;
+    s.alpha = a;
+    s.color = table_color(v);
+    if (ctx_.pipeline.shader()) s.color = shade(s.color, x, ray_dir);
+    return s;
+}
+
+// computeNormalForDensity: central differences of the texture at +-1 texel, times inverseSpacing, then
+// normalISToVCMatrix (diag(dims * spacing) times the rotations: the shipped scaling bug), normalised; a
+// zero gradient gives a zero normal (no diffuse or specular, ambient only). applySurfaceShadowLighting:
+// ndotL = N.L with L the light's direction of travel; two-sided lighting negates a negative ndotL;
+// where ndotL > 0: diffuse += ndotL colour, R = normalize(L - 2 ndotL N), specular += max(0, V.R)^p colour.
+glm::dvec3 VtkJsIntegrator::shade(const glm::dvec3& c, const glm::dvec3& x, const glm::dvec3& ray_dir) const {
+    const Shader& sh = *ctx_.pipeline.shader();
+    const ShadingSpec& sp = sh.spec();
+    glm::dvec3 g(0.0);
+    for (int a = 0; a < 3; ++a) {
+        glm::dvec3 e(0.0);
+        e[a] = spacing_[a];
+        g[a] = (value(x + e) - value(x - e)) / spacing_[a];
+    }
+    glm::dvec3 n = g * normal_scale_;
+    const double len = glm::length(n);
+    n = len > 0.0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);
+    if (flip_normal_) n = -n;
+    const double power = sp.n == 0.0 ? 1.0 : sp.n;  // VolumeMapper.js: specularPower 0 is sent as 1
+    glm::dvec3 diffuse(0.0), specular(0.0);
+    for (const LightSpec& l : sh.lights()) {
+        const glm::dvec3 L = l.type == LightSpec::Type::Headlight ? forward_ : -l.direction;
+        double ndotl = glm::dot(n, L);
+        if (ndotl < 0.0 && sp.two_sided) ndotl = -ndotl;
+        if (ndotl > 0.0) {
+            diffuse += ndotl * l.color;
+            const double vdotr = glm::dot(-ray_dir, glm::normalize(L - 2.0 * ndotl * n));
+            if (vdotr > 0.0) specular += std::pow(vdotr, power) * l.color;
+        }
+    }
+    return c * (diffuse * sp.kd + sp.ka) + specular * sp.ks;
+}
+
+template <class Rec>
+PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<Interval>&, Rec& rec) const {
+    PixelValue out;
+    Ray ray = ray_in;
+    const double dl = glm::length(ray.direction);
+    ray.direction /= dl;  // t below in world units along a unit direction
+    double t0 = 0.0, t1 = 0.0;
+    if (!box(ray, t0, t1)) return out;  // the fragment is discarded: the background stays
+    const double h = step_;
+    const double R = (t1 - t0) / h;  // raySteps
+    const double j = jitter_;
+    auto record = [&](double t, double alpha, const glm::dvec4& acc) {
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            rec.begin(r, (t - 0.5 * h) / dl, (t + 0.5 * h) / dl);
+            r.t = t / dl;
+            r.length = h / dl;
+            r.sample.position = ray.at(t);
+            r.sample.value = value(ray.at(t));
+            r.sample.classified = true;
+            r.composited = true;
+            r.alpha = alpha;
+            r.accumulated = acc;
+            rec.recorder.record(r);
+        } else {
+            (void)t, (void)alpha, (void)acc;
+        }
+    };
+
+    if (ctx_.render.projection == Projection::Composite) {
+        const glm::dvec3 d = ray.direction;
+        Sample first = color_at(ray.at(t0), d);
+        if (R <= 1.0) {  // "handle very thin volumes": the entry sample alone, alpha for R steps
+            const double a = 1.0 - std::pow(1.0 - first.alpha, R);
+            out.rgba = glm::dvec4(first.color * a, a);
+            record(t0, a, out.rgba);
+            return out;
+        }
+        // Front to back with the opacity sum (march/Accumulators.h): C += (1 - A) a c, A += (1 - A) a.
+        FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
+        auto add = [&](const Sample& s, double a) {
+            const double c[3] = {s.color.r, s.color.g, s.color.b};
+            acc.add(true, false, 0.0, a, c);
+        };
+        auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
+        add(first, 1.0 - std::pow(1.0 - first.alpha, j));  // the first sample counts for `jitter` of a step
+        record(t0, acc.alpha(), accumulated());
+        double travelled = j;
+        bool stopped = false;
+        while (travelled + 1.0 < R) {
+            const double t = t0 + travelled * h;
+            const Sample s = color_at(ray.at(t), d);
+            add(s, s.alpha);
+            travelled += 1.0;
+            record(t, s.alpha, accumulated());
+            if (acc.alpha() > 0.99) {  // alpha set to 1, the colour kept
+                const double C[3] = {acc.color(0), acc.color(1), acc.color(2)};
+                acc.resume(C, 1.0);
+                stopped = true;
+                break;
+            }
+        }
+        if (!stopped && acc.alpha() < 0.99 && R - travelled > 0.0) {  // the exit sample, for the remaining fraction
+            const Sample s = color_at(ray.at(t1), d);
+            const double a = 1.0 - std::pow(1.0 - s.alpha, R - travelled);
+            add(s, a);
+            record(t1, a, accumulated());
+        }
+        const glm::dvec3 C(acc.color(0), acc.color(1), acc.color(2));
+        const double A = acc.alpha();
+        // gl_FragData = (C / A, A), blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) over the cleared
+        // float framebuffer: (C / A) A, NaN where A = 0.
+        out.rgba = glm::dvec4((C / A) * A, A);
+        return out;
+    }
+
+    // mip / minip: the same positions (entry; entry + (j + k) h while j + k + 1 < R; exit).
+    const bool maximum = ctx_.render.projection == Projection::Mip;
+    auto better = [&](double v, double best) { return maximum ? v > best : v < best; };
+    double best = value(ray.at(t0));
+    record(t0, 0.0, glm::dvec4(0.0));
+    if (R > 1.0) {
+        double travelled = j;
+        while (travelled + 1.0 < R) {
+            const double v = value(ray.at(t0 + travelled * h));
+            if (better(v, best)) best = v;
+            record(t0 + travelled * h, 0.0, glm::dvec4(0.0));
+            travelled += 1.0;
+        }
+        const double v = value(ray.at(t1));
+        if (better(v, best)) best = v;
+        record(t1, 0.0, glm::dvec4(0.0));
+    }
+    if (!std::isfinite(best)) return out;
+    const double a = table_opacity(best);
+    if (a < 0.001) return out;  // getColorForDependentComponents returns vec4(0)
+    out.rgba = glm::dvec4(a * table_color(best), a);
+    return out;
+}
+
+}  // namespace volref

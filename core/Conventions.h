@@ -96,6 +96,10 @@ inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16
 // its ends are two cuts that coincide in exact arithmetic (a face and a row's root, found to rounding).
 inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
 inline constexpr int kAdaptiveOpaqueMinDoubles = 4;
+// Where kinks of the classification are not cuts (kAdaptiveWeakSafety below), a run of opacity 1 may
+// start inside a piece; it is found by sampling the piece at kAdaptiveRowSamples + 1 points, bisected
+// to rounding, and must also hold at t_s + kAdaptiveOpaqueColourOffset (b - a) (AdaptiveIntegrator::
+// opaque_from): the clamped sigma would otherwise spread the opaque colour over 1/36.7 of a unit length.
 // The colour of an opaque piece [a, b] is c(a+), read at a + kAdaptiveOpaqueColourOffset (b - a): just
 // inside the piece, so that a jump of the transfer function at a (a root found to rounding) is on
 // the piece's side.

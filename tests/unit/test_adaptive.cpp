@@ -708,3 +708,45 @@ TEST(Adaptive, CancelIsAnsweredInsideLongRays) {
     reset_cancel();
     EXPECT_LT(seconds, 1.3);
 }
+
+// Levoy's region boundaries clamp the opacity to 1 inside a cell (the weak class: the classification's
+// kinks are not cuts). f = 2x + 1 on [0, 8]^3, |grad f| = 2, regions (0, 0.1, blue) and (16, 1, red):
+// w = f / 16, a = min(1, 2 (0.1 + 0.9 w)) = 0.3125 + 0.225 x, reaching 1 at x* = 0.6875 / 0.225 (inside
+// the cell [3, 4]) and staying 1 behind it. A ray along +x is opaque at x* with the colour there. By
+// parts, C = c(0) + integral_0^x* c'(x) T(x) dx with T(x) = exp(-tau(x)),
+//   tau(x) = integral_0^x -log(0.225 (x* - v)) dv = -x log 0.225 - [u log u - u] from x* - x to x*,
+// integrated here by a 200,000-point midpoint rule (smooth integrand: error ~1e-11). With sigma clamped
+// at -log(2^-53) instead, the colour was spread over 1/36.7 of a unit behind x* (issue 18).
+TEST(Adaptive, OpacityClampedToOneInsideACellEndsTheRayThere) {
+    Scene s = field_scene(linear_field({2, 0, 0, 1}, {9, 9, 9}));
+    ClassificationSpec c;
+    c.type = ClassificationSpec::Type::Boundary;
+    c.regions = {{0.0, 0.1, {0, 0, 1}}, {16.0, 1.0, {1, 0, 0}}};
+    s.volume().classification = c;
+    s.camera.type = CameraSpec::Type::Orthographic;
+    s.camera.eye = glm::dvec3(-10.0, 4.3, 4.2);
+    s.camera.target = glm::dvec3(4.0, 4.3, 4.2);
+    s.camera.up = glm::dvec3(0.0, 0.0, 1.0);
+    s.camera.height = 0.01;
+    s.image.width = s.image.height = 1;
+    s.render.integrator = IntegrationMethod::Adaptive;
+    const Image im = render_scene(s, {.threads = 1});
+    const double xs = 0.6875 / 0.225;
+    auto F = [](double u) { return u > 0.0 ? u * std::log(u) - u : 0.0; };
+    auto T = [&](double x) { return std::exp(x * std::log(0.225) + F(xs) - F(xs - x)); };
+    auto colour = [](double x) {
+        const double w = (2.0 * x + 1.0) / 16.0;
+        return (w * glm::dvec3(1, 0, 0) + 0.1 * (1.0 - w) * glm::dvec3(0, 0, 1)) / (w + 0.1 * (1.0 - w));
+    };
+    const int n = 200000;
+    const double h = xs / n;
+    glm::dvec3 C = colour(0.0);
+    for (int i = 0; i < n; ++i) {
+        const double x = (i + 0.5) * h;
+        const glm::dvec3 dc = (colour(x + 1e-6) - colour(x - 1e-6)) / 2e-6;
+        C += h * T(x) * dc;
+    }
+    EXPECT_NEAR(im.at(0, 0, 3), 1.0, 1e-12);
+    EXPECT_LT(im.at(0, 0, 4), 1e-5);
+    for (std::size_t ch = 0; ch < 3; ++ch) EXPECT_NEAR(im.at(0, 0, ch), C[ch], im.at(0, 0, 4) + 1e-8) << ch;
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/Cancellation.h"
 #include "core/Conventions.h"
@@ -233,6 +234,41 @@ bool AdaptiveIntegrator::opaque_piece(const Ray& ray, double a, double b) const 
     return true;
 }
 
+double AdaptiveIntegrator::opaque_from(const Ray& ray, double a, double b) const {
+    if (opaque_piece(ray, a, b)) return a;
+    if (!weak_) return std::numeric_limits<double>::infinity();  // rows are cuts: opaque pieces are whole
+    // Kinks of the classification are not cuts here (Levoy's classification, gradient opacity, a
+    // shaded or tricubic pipeline), so the opacity may reach 1 inside the piece and stay there (a
+    // clamped boundary opacity). sigma is clamped (kAdaptiveMaxOpacity), which would spread the
+    // opaque surface's colour over 1/36.7 of a unit length; instead, the first of kAdaptiveRowSamples
+    // samples with opacity 1 is bisected back to the last sample below 1 to rounding (a double t_s),
+    // and where the opacity is also 1 just behind it (t_s + kAdaptiveOpaqueColourOffset (b - a):
+    // positive length, not a peak touching 1), the ray ends at t_s.
+    auto saturated = [&](double t) {
+        const PipelineSample p = ctx_.pipeline.sample(ray, t, SamplePipeline::Use::Composite);
+        return p.opacity >= 1.0 && std::isfinite(p.value);
+    };
+    const int n = conventions::kAdaptiveRowSamples;
+    const double d = conventions::kAdaptiveOpaqueColourOffset * (b - a);
+    double prev = a;
+    for (int k = 1; k <= n; ++k) {
+        const double t = k == n ? b - d : a + (b - a) * double(k) / double(n);
+        if (!saturated(t)) {
+            prev = t;
+            continue;
+        }
+        double lo = prev, hi = t;
+        for (;;) {
+            const double m = 0.5 * (lo + hi);
+            if (!(m > lo && m < hi)) break;
+            (saturated(m) ? hi : lo) = m;
+        }
+        if (hi + d < b && saturated(hi + d)) return hi;
+        prev = t;
+    }
+    return std::numeric_limits<double>::infinity();
+}
+
 bool AdaptiveIntegrator::empty_piece(const Ray& ray, double a, double b) const {
     // A piece lies in one cell (nearest: reads one voxel, a corner of the cell of its midpoint); in an
     // empty macrocell every sample of it has opacity 0.
@@ -271,10 +307,13 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
         for (std::size_t p = 0; p + 1 < cut.size() && !st.is_opaque(); ++p) {
             const double a = cut[p], b = cut[p + 1];
             if (!(b > a) || empty_piece(ray, a, b)) continue;
-            if (opaque_piece(ray, a, b))  // the ray ends at a
-                st.opaque(opaque_colour(ray, a, b));
-            else
+            const double ts = opaque_from(ray, a, b);
+            if (ts < b) {  // the ray ends at ts
+                if (ts > a) st.integrate(a, ts);
+                st.opaque(opaque_colour(ray, ts, b));
+            } else {
                 st.integrate(a, b);
+            }
         }
         if (st.is_opaque()) break;
     }

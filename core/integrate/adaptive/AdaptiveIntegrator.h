@@ -77,6 +77,9 @@ public:
     void medium(const Ray& ray, double t, double& sigma, glm::dvec3& c) const;
     // is the piece [a, b] opaque (opacity 1 on all of it; conventions.h, kAdaptiveMaxOpacity)?
     bool opaque_piece(const Ray& ray, double a, double b) const;
+    // where the piece [a, b] becomes opaque for good: a when opaque_piece; where kinks inside pieces
+    // are not cut, the entry of a run of opacity 1 found by sampling (conventions.h); else +infinity;
+    double opaque_from(const Ray& ray, double a, double b) const;
     // an opaque piece's colour, c(a+) (kAdaptiveOpaqueColourOffset);
     glm::dvec3 opaque_colour(const Ray& ray, double a, double b) const;
     // does the piece lie in an empty macrocell (every sample of it has opacity 0)?

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 
 #include "core/integrate/adaptive/AdaptiveComposite.h"
@@ -123,14 +124,21 @@ PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std:
         for (std::size_t i = 0; i + 1 < all.size() && !st.is_opaque(); ++i) {
             const double a = all[i], b = all[i + 1];
             if (!(b > a)) continue;
+            // Where the first present volume becomes opaque (AdaptiveIntegrator::opaque_from), and which.
             bool empty = true;
-            opaque.clear();
+            double ts = std::numeric_limits<double>::infinity();
             for (int k : p.present) {
                 const AdaptiveIntegrator& part = *adaptive_[std::size_t(k)];
                 if (!part.empty_piece(rays[k], a, b)) empty = false;
-                if (part.opaque_piece(rays[k], a, b)) opaque.push_back({0.0, part.opaque_colour(rays[k], a, b)});
+                const double from = part.opaque_from(rays[k], a, b);
+                if (from < ts) opaque.clear();
+                if (from <= ts && from < b) {
+                    ts = from;
+                    opaque.push_back({0.0, part.opaque_colour(rays[k], ts, b)});
+                }
             }
-            if (!opaque.empty()) {  // the mean of the opaque volumes' colours, in canonical order
+            if (ts < b) {  // the mean of the opaque volumes' colours, in canonical order
+                if (ts > a) st.integrate(a, ts);
                 std::sort(opaque.begin(), opaque.end());
                 glm::dvec3 c(0.0);
                 for (const Term& o : opaque) c += o.c;
@@ -138,6 +146,7 @@ PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std:
             } else if (!empty) {
                 st.integrate(a, b);
             }
+            opaque.clear();
         }
         if (st.is_opaque()) break;
     }

@@ -94,6 +94,34 @@ MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& cla
             return count;
         },
         [](std::int64_t a, std::int64_t b) { return a + b; });
+    compute_empty_radius();
+}
+
+void MacrocellGrid::compute_empty_radius() {
+    // Chebyshev distance to the nearest macrocell that is not empty, separably: per axis in turn,
+    // d'(x) = min over x' on the line of max(|x - x'|, d(x')), starting from 0 (not empty) or "far".
+    // Each pass is O(count^2) per line; the grids are small (a 256^3 volume has 32^3 macrocells).
+    const std::size_t total = empty_.size();
+    constexpr std::int64_t far = kMaxEmptyRadius;
+    std::vector<std::int64_t> d(total), next(total);
+    for (std::size_t i = 0; i < total; ++i) d[i] = empty_[i] ? far : 0;
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t n = counts_[a];
+        for (std::size_t id = 0; id < total; ++id) {
+            const std::int64_t s = std::int64_t(id);
+            Index m{s % counts_[0], (s / counts_[0]) % counts_[1], s / (counts_[0] * counts_[1])};
+            const std::int64_t x = m[a];
+            std::int64_t best = far;
+            for (std::int64_t y = 0; y < n && best > 0; ++y) {
+                m[a] = y;
+                best = std::min(best, std::max<std::int64_t>(y > x ? y - x : x - y, d[linear(m)]));
+            }
+            next[id] = best;
+        }
+        d.swap(next);
+    }
+    empty_radius_.resize(total);
+    for (std::size_t i = 0; i < total; ++i) empty_radius_[i] = std::uint8_t(std::min(d[i], far));
 }
 
 void MacrocellGrid::voxel_box(const Index& m, Index& first, Index& last) const {
@@ -114,14 +142,14 @@ MacrocellGrid::Index MacrocellGrid::macrocell_at(const glm::dvec3& world) const 
     return {cell[0] / M, cell[1] / M, cell[2] / M};
 }
 
-double MacrocellGrid::exit_distance(const Ray& ray, const Index& m) const {
+double MacrocellGrid::exit_distance(const Ray& ray, const Index& m, std::int64_t r) const {
     const Volume& v = sampler_.volume();
     double t = kInf;
     for (int a = 0; a < 3; ++a) {
         const double d = ray.direction[a];
         std::int64_t plane;
-        if (d > 0.0 && m[a] + 1 < counts_[a]) plane = (m[a] + 1) * M;
-        else if (d < 0.0 && m[a] > 0) plane = m[a] * M;
+        if (d > 0.0 && m[a] + r < counts_[a]) plane = (m[a] + r) * M;
+        else if (d < 0.0 && m[a] - (r - 1) > 0) plane = (m[a] - (r - 1)) * M;
         else continue;
         t = std::min(t, (v.origin[a] + double(plane) * v.spacing[a] - ray.origin[a]) / d);
     }

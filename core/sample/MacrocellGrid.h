@@ -57,10 +57,16 @@ public:
     // The macrocell of a sample at world point x (the cell of VolumeSampler::locate divided by M);
     // {-1, -1, -1} if x is NaN.
     Index macrocell_at(const glm::dvec3& world) const;
+    // The Chebyshev distance, in macrocells, from m to the nearest macrocell that is not empty: 0 when m
+    // is not empty, r >= 1 when every macrocell within r - 1 of m (per axis) is empty; capped at
+    // kMaxEmptyRadius (also when no macrocell is non-empty).
+    std::int64_t empty_radius(const Index& m) const { return inside(m) ? empty_radius_[linear(m)] : 0; }
+    static constexpr std::int64_t kMaxEmptyRadius = 255;
     // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
     // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
-    // integrator checks it against macrocell_at.
-    double exit_distance(const Ray& ray, const Index& m) const;
+    // integrator checks it against macrocell_at. exit_distance with r > 1: where the ray leaves the box
+    // of the macrocells within r - 1 of m (per axis), through a face with a macrocell behind it.
+    double exit_distance(const Ray& ray, const Index& m, std::int64_t r = 1) const;
     double entry_distance(const Ray& ray, const Index& m) const;
 
     // An interval that holds every value the interpolation can reconstruct, rounding included, from
@@ -90,7 +96,9 @@ private:
     Index cells_{1, 1, 1};
     std::int64_t apron_ = 0;
     std::vector<std::array<double, 2>> ranges_;
+    void compute_empty_radius();
     std::vector<unsigned char> empty_;
+    std::vector<std::uint8_t> empty_radius_;  // empty_radius(m)
     std::int64_t empty_count_ = 0;
 };
 

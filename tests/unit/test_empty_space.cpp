@@ -154,6 +154,35 @@ TEST(MacrocellGrid, RangesByHand) {
     }
 }
 
+// empty_radius by hand: one non-zero voxel at (20, 20, 20) of a 41^3 volume of zeros (40 cells per axis,
+// 5 macrocells of 8): only macrocell (2, 2, 2) reads it (cells 16..23 read voxels 16..24), so every
+// other macrocell's radius is its Chebyshev distance max_a |m_a - 2| to it; with no non-zero voxel,
+// every radius is the cap.
+TEST(MacrocellGrid, EmptyRadiusIsTheChebyshevDistanceToTheNearestNonEmptyMacrocell) {
+    for (const bool spike : {true, false}) {
+        FieldSpec f;
+        f.kind = FieldSpec::Kind::Cells;
+        f.dims = {41, 41, 41};
+        f.values.assign(41 * 41 * 41, 0.0);
+        if (spike) f.values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
+        const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
+        TransferSpec ts;
+        ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
+        const TransferFunction tf(ts, v);
+        const VolumeSampler sampler(v, Interpolation::Trilinear);
+        const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
+        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{5, 5, 5}));
+        for (std::int64_t k = 0; k < 5; ++k)
+            for (std::int64_t j = 0; j < 5; ++j)
+                for (std::int64_t i = 0; i < 5; ++i) {
+                    const std::int64_t d = std::max({std::abs(i - 2), std::abs(j - 2), std::abs(k - 2)});
+                    const std::int64_t want = spike ? d : MacrocellGrid::kMaxEmptyRadius;
+                    EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
+                    EXPECT_EQ(g.empty({i, j, k}), !spike || d > 0);
+                }
+    }
+}
+
 // One non-zero voxel in a 20^3 volume of zeros (19 cells per axis: macrocells of 8, 8 and 3 cells):
 // the macrocells whose samples can read it are not empty, all others are.
 TEST(MacrocellGrid, SpikeAndApron) {

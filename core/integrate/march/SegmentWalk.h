@@ -94,10 +94,15 @@ public:
                 continue;
             }
             const MacrocellGrid::Index m = macrocell_of(*grid_, *ray_, iv, step_, k_, n_);
-            // The estimate: segments k .. end - 1 have their midpoints before the ray leaves m.
+            const bool skip = skippable(m);
+            // Composite: an empty m with every macrocell within r - 1 of it empty (empty_radius) is
+            // passed over with that whole box; the segments in the box form one run (each axis'
+            // macrocell index is monotone in k), so the same segments are visited.
+            const std::int64_t r = skip && !extremum_ ? std::max<std::int64_t>(1, grid_->empty_radius(m)) : 1;
+            // The estimate: segments k .. end - 1 have their midpoints before the ray leaves the box.
             const std::int64_t end =
-                std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m), n_), k_ + 1, n_);
-            if (!skippable(m)) {
+                std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m, r), n_), k_ + 1, n_);
+            if (!skip) {
                 end_ = end;
                 if (extremum_) {
                     // Extremum mode backs off on rays where the checks keep failing (the ray's
@@ -110,7 +115,12 @@ public:
                 continue;
             }
             failed_checks_ = 0;
-            auto in_m = [&](std::int64_t j) { return macrocell_of(*grid_, *ray_, iv, step_, j, n_) == m; };
+            auto in_m = [&](std::int64_t j) {
+                const MacrocellGrid::Index c = macrocell_of(*grid_, *ray_, iv, step_, j, n_);
+                for (int a = 0; a < 3; ++a)
+                    if (c[a] < m[a] - (r - 1) || c[a] > m[a] + (r - 1)) return false;
+                return true;
+            };
             std::int64_t in = end - 1, out = n_;  // the run's last segment is in [in, out)
             if (in > k_ && !in_m(in)) {
                 out = in;  // the estimate is too long

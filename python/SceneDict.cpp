@@ -244,6 +244,13 @@ json render_json(const RenderSpec& r) {
                                 {"iso_threshold", r.profile_options.iso_threshold},
                                 {"brightness", r.profile_options.brightness}};
     if (r.profile == ProfileId::GlslBasic) j["profile_options"] = {{"intensity", r.profile_options.intensity}};
+    if (r.profile == ProfileId::CudaCurvilinear || r.profile == ProfileId::GlslBasic || r.profile == ProfileId::VtkGpu) {
+        // issue 17: listed when not the defaults
+        if (r.profile_options.texture_unit == ProfileOptions::TextureUnit::Hardware)
+            j["profile_options"]["texture_unit"] = "hardware";
+        if (r.profile_options.texture_band) j["profile_options"]["texture_band"] = true;
+        if (r.profile_options.data_unorm16) j["profile_options"]["texture_format"] = "unorm16";
+    }
     if (r.profile == ProfileId::VtkJs)  // issue 22
         j["profile_options"] = {{"jitter", r.profile_options.jitter}, {"fixed_normal", r.profile_options.fixed_normal},
                                 {"flip_normal", r.profile_options.flip_normal},

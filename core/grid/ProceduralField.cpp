@@ -76,4 +76,33 @@ Volume make_procedural_volume(const FieldSpec& field,
     return v;
 }
 
+Volume make_procedural_brick(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing,
+                             const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& dims) {
+    Volume whole;  // the whole grid's dims (indices of marschner-lobb and cells); no values
+    whole.dims = field.dims;
+    if (field.kind == FieldSpec::Kind::Cells &&
+        field.values.size() != std::size_t(whole.dims[0]) * std::size_t(whole.dims[1]) * std::size_t(whole.dims[2]))
+        throw Error("volume.source.values: expected " + std::to_string(whole.dims[0] * whole.dims[1] * whole.dims[2]) +
+                    " values (dims product), got " + std::to_string(field.values.size()));
+    Volume v;
+    v.dims = dims;
+    v.type = ScalarType::F64;
+    v.origin = origin + glm::dvec3(double(lo[0]), double(lo[1]), double(lo[2])) * spacing;
+    v.spacing = spacing;
+    const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims (this rank's brick)");
+    v.values.allocate(ScalarType::F64, count, false);
+    double* out = v.values.data<double>();
+    const Volume& grid = v;
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
+        for (std::int64_t k = r.begin(); k != r.end(); ++k)
+            for (std::int64_t j = 0; j < grid.dims[1]; ++j)
+                for (std::int64_t i = 0; i < grid.dims[0]; ++i) {
+                    const std::int64_t gi = i + lo[0], gj = j + lo[1], gk = k + lo[2];
+                    const glm::dvec3 p = origin + glm::dvec3(double(gi), double(gj), double(gk)) * spacing;
+                    out[grid.index(i, j, k)] = field_value(field, whole, p, gi, gj, gk);
+                }
+    });
+    return v;
+}
+
 }  // namespace volref

@@ -22,4 +22,10 @@ Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, 
 Volume make_procedural_volume(const FieldSpec& field,
                               const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position);
 
+// The sub-box of make_procedural_volume(field, origin, spacing) with voxels lo .. lo + dims - 1 (each
+// value computed from its global indices and position, so the same bits); its origin is voxel lo's
+// position. volref-mpi's bricks (cli/mpi/).
+Volume make_procedural_brick(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing,
+                             const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& dims);
+
 }  // namespace volref

@@ -1,4 +1,5 @@
 #include "core/render/Renderer.h"
+#include "core/render/VolumeLoaderHook.h"
 #include "core/render/PreparedScene.h"
 
 #include <algorithm>
@@ -45,6 +46,7 @@
 namespace volref {
 
 Volume load_volume(const VolumeSpec& spec) {
+    if (const VolumeLoaderHook& hook = volume_loader_hook()) return hook(spec);  // volref-mpi: the rank's brick
     Volume v;
     if (spec.source.field) {
         v = make_procedural_volume(*spec.source.field, spec.origin.value_or(glm::dvec3(0.0)),

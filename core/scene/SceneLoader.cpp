@@ -821,11 +821,17 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, {{"texel", false}, {"domain", true}});
         s.profile_options.mip_correction = po.boolean("mip_correction", true);
     } else if (const Json* o = r.find("profile_options")) {
-        if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic)
-            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic and vtk-js profiles have options");
+        if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic && s.profile != ProfileId::VtkGpu)
+            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu and vtk-js profiles have options");
         ObjectReader po(*o, r.path("profile_options"), ctx);
-        if (s.profile == ProfileId::GlslBasic) po.allow({"intensity"});
-        else po.allow({"density", "transfer_scale", "iso_threshold", "brightness"});
+        if (s.profile == ProfileId::GlslBasic) po.allow({"intensity", "texture_unit", "texture_band"});
+        else if (s.profile == ProfileId::VtkGpu) po.allow({"texture_unit", "texture_band"});
+        else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format"});
+        // issue 17: the texture unit's weights (TextureUnit.h) and the band in the "error" channel
+        using TU = ProfileOptions::TextureUnit;
+        s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, {{"exact", TU::Exact}, {"hardware", TU::Hardware}});
+        s.profile_options.texture_band = po.boolean("texture_band", false);
+        s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, {{"float", false}, {"unorm16", true}});
         s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());
         s.profile_options.density = po.number("density", 1.0, Range::non_negative());
         s.profile_options.transfer_scale = po.number("transfer_scale", 1.0, Range::non_negative());

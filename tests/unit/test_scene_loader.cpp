@@ -889,7 +889,7 @@ TEST(SceneLoaderErrors, NotImplementedYet) {
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-cpu"})")).render.profile, ProfileId::VtkCpu);
     EXPECT_EQ(parse(scene_with(R"("render": {"profile": "vtk-gpu"})")).render.profile, ProfileId::VtkGpu);
     EXPECT_EQ(parse(scene_with(R"("render": {})")).render.profile, ProfileId::Reference);
-    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "vtk-gpu", "profile_options": {}})"),
+    EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "ospray", "profile_options": {}})"),
                            "render.profile_options", "only the cuda-curvilinear"));
     EXPECT_TRUE(fails_with(scene_with(R"("render": {"profile": "cuda-curvilinear", "profile_options": {"gain": 1}})"),
                            "render.profile_options.gain", "unknown key"));

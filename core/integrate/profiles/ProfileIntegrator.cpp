@@ -14,8 +14,11 @@
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
+#include "core/integrate/profiles/TextureUnit.h"
+#include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"
 #include "transfer/OpacityCorrection.h"
+#include "transfer/TransferFunction.h"
 
 namespace volref {
 
@@ -49,6 +52,29 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         shell_ = ctx.pipeline.stages().shell_grid;
         volume_ = &volume;
         if (!shell_) throw Error(std::string("render.profile: \"") + p_.name + "\" needs the shell's grid");
+    }
+    // issue 17: the texture unit and its band (TextureUnit.h; conventions section 9, "The texture unit")
+    const ProfileOptions& po = ctx.render.profile_options;
+    if (po.data_unorm16 && !shell_)
+        throw Error("render.profile_options.texture_format: \"unorm16\" is seed 001's data texture on a shell (cylindrical or spherical bounds)");
+    texture_unit_ = po.texture_unit;
+    band_ = po.texture_band;
+    if (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_) {
+        const std::string key = band_ ? "render.profile_options.texture_band" : "render.profile_options.texture_unit";
+        if (p_.id != ProfileId::VtkGpu && p_.id != ProfileId::GlslBasic && p_.id != ProfileId::CudaCurvilinear)
+            throw Error(key + ": only the vtk-gpu, glsl-basic and cuda-curvilinear profiles model a texture unit");
+        if (!shell_) {
+            cartesian_ = cartesian;
+            if (!cartesian_ || &ctx.pipeline.sampler() != static_cast<const FieldSampler*>(cartesian_) ||
+                cartesian_->interpolation() != Interpolation::Trilinear)
+                throw Error(key + ": the texture unit filters trilinearly (volume.interpolation \"trilinear\", one Cartesian grid)");
+        }
+        if (band_ && ctx.pipeline.shaded() && ctx.render.projection == Projection::Composite)
+            throw Error(key + ": the band is not propagated through shading (remove volume.shading)");
+        if (band_ && p_.table_entries <= 1) {
+            transfer_ = ctx.pipeline.stages().transfer_function;
+            if (!transfer_) throw Error(key + ": the band needs a transfer function (volume.transfer)");
+        }
     }
     if (p_.voxel_length == Profile::VoxelLength::ExtentOverSamples && ctx.render.step_units == StepUnits::Voxel) {
         int axis = 0;
@@ -93,37 +119,98 @@ double ProfileIntegrator::alpha(double a, double d) const {
 // A texture read clamps to the edge: positions past the domain read its boundary.
 double ProfileIntegrator::value(const glm::dvec3& x) const {
     if (shell_) return seed_shell_value(x);
+    if (texture_unit_ != ProfileOptions::TextureUnit::Exact) return texture_fetch(x).value;
     return ctx_.pipeline.sampler().value(glm::clamp(x, domain_lo_, domain_hi_));
 }
 
 // Seed 001's interpolateCyl / interpolateSpher with tex3D (Profile::seed_shell_reads).
-double ProfileIntegrator::seed_shell_value(const glm::dvec3& x) const {
+namespace {
+
+// Exact trilinear interpolation of corners c = x + 2 y + 4 z, as seed_shell_value always computed it.
+double lerp_corners(const std::array<double, 8>& k, const glm::dvec3& w) {
+    const double x00 = k[0] + w.x * (k[1] - k[0]);
+    const double x10 = k[2] + w.x * (k[3] - k[2]);
+    const double x01 = k[4] + w.x * (k[5] - k[4]);
+    const double x11 = k[6] + w.x * (k[7] - k[6]);
+    const double y0 = x00 + w.y * (x10 - x00), y1 = x01 + w.y * (x11 - x01);
+    return y0 + w.z * (y1 - y0);
+}
+
+}  // namespace
+
+// The texels of seed 001's read at x (corners c = x + 2 y + 4 z, fractions w); false: outVal.
+bool ProfileIntegrator::shell_texels(const glm::dvec3& x, std::array<double, 8>& k, glm::dvec3& w) const {
     const glm::dvec3 c = shell_->shell_coordinates(x);
     glm::dvec3 u;
     std::array<std::int64_t, 3> i0{}, i1{};
-    glm::dvec3 w;
     for (int a = 0; a < 3; ++a) {
         const ShellAxis& ax = shell_->axis(a);
         const double n = double(ax.n);
         double rel = c[shell_->coordinate_of_axis(a)] - ax.lo;
         if (ax.angular) rel = std::fmod(std::fmod(rel, 360.0) + 360.0, 360.0);  // atan2 + 2 pi: [0, 360) from lo
         const double tex = rel / ((ax.hi - ax.lo) / n);
-        if (!(tex >= 0.0 && tex <= n - 1.0)) return lo_;  // outVal (0: the data minimum, s = 0)
+        if (!(tex >= 0.0 && tex <= n - 1.0)) return false;  // outVal (0: the data minimum, s = 0)
         u[a] = std::clamp(tex - 0.5, 0.0, n - 1.0);       // texel i centred at i + 0.5, clamped
         i0[std::size_t(a)] = ax.n > 1 ? std::min(std::int64_t(std::floor(u[a])), ax.n - 2) : 0;
         i1[std::size_t(a)] = ax.n > 1 ? i0[std::size_t(a)] + 1 : 0;
         w[a] = ax.n > 1 ? u[a] - double(i0[std::size_t(a)]) : 0.0;
     }
     const Volume& v = *volume_;
-    auto at = [&](int bx, int by, int bz) {
-        return v.at(bx ? i1[0] : i0[0], by ? i1[1] : i0[1], bz ? i1[2] : i0[2]);
-    };
-    const double x00 = at(0, 0, 0) + w.x * (at(1, 0, 0) - at(0, 0, 0));
-    const double x10 = at(0, 1, 0) + w.x * (at(1, 1, 0) - at(0, 1, 0));
-    const double x01 = at(0, 0, 1) + w.x * (at(1, 0, 1) - at(0, 0, 1));
-    const double x11 = at(0, 1, 1) + w.x * (at(1, 1, 1) - at(0, 1, 1));
-    const double y0 = x00 + w.y * (x10 - x00), y1 = x01 + w.y * (x11 - x01);
-    return y0 + w.z * (y1 - y0);
+    for (int j = 0; j < 8; ++j)
+        k[std::size_t(j)] = v.at((j & 1) ? i1[0] : i0[0], (j & 2) ? i1[1] : i0[1], (j & 4) ? i1[2] : i0[2]);
+    if (ctx_.render.profile_options.data_unorm16)  // seed 001's unsigned shorts over the data range, v / 65535
+        for (double& x : k) {
+            const double u = width_ > 0.0 ? std::clamp((x - lo_) / width_, 0.0, 1.0) : 0.0;
+            x = lo_ + width_ * (std::nearbyint(u * 65535.0) / 65535.0);
+        }
+    return true;
+}
+
+double ProfileIntegrator::seed_shell_value(const glm::dvec3& x) const {
+    if (texture_unit_ != ProfileOptions::TextureUnit::Exact) return texture_fetch(x).value;
+    std::array<double, 8> k;
+    glm::dvec3 w;
+    if (!shell_texels(x, k, w)) return lo_;
+    return lerp_corners(k, w);
+}
+
+// TextureUnit.h: exact, the hardware model or an admissible unit, and the band around exact.
+ProfileIntegrator::Fetch ProfileIntegrator::texture_fetch(const glm::dvec3& x) const {
+    std::array<double, 8> k;
+    glm::dvec3 w;
+    Fetch out;
+    if (shell_) {
+        if (!shell_texels(x, k, w)) {
+            out.value = out.exact = lo_;  // outVal: no texture read
+            return out;
+        }
+        out.exact = lerp_corners(k, w);
+    } else {  // VolumeSampler::trilinear, the exact path's value
+        std::array<std::int64_t, 3> cell;
+        cartesian_->locate(cartesian_->continuous_index(glm::clamp(x, domain_lo_, domain_hi_)), cell, w);
+        const std::array<double, 8> L = cartesian_->corners(cell);  // Levoy's order
+        k = {L[0], L[1], L[3], L[2], L[4], L[5], L[7], L[6]};
+        out.exact = volref::trilinear(L, w.x, w.y, w.z);
+    }
+    out.band = texture_unit::fetch_error_band_3d(k, w.x, w.y, w.z);
+    switch (texture_unit_) {
+        case ProfileOptions::TextureUnit::Exact: out.value = out.exact; break;
+        case ProfileOptions::TextureUnit::Hardware: out.value = texture_unit::fetch_3d(k, w.x, w.y, w.z, texture_unit::Model::Hardware); break;
+        case ProfileOptions::TextureUnit::Admissible: {
+            texture_unit::Admissible r(ctx_.render.profile_options.texture_seed, x.x, x.y, x.z);
+            const std::array<double, 8> wc = texture_unit::admissible_corner_weights(w.x, w.y, w.z, r);
+            out.value = 0.0;
+            for (int c = 0; c < 8; ++c) out.value += wc[std::size_t(c)] * k[std::size_t(c)];
+            break;
+        }
+    }
+    return out;
+}
+
+double ProfileIntegrator::table_weight(double w, double pos) const {
+    if (texture_unit_ == ProfileOptions::TextureUnit::Hardware) return texture_unit::weight(w, texture_unit::Model::Hardware);
+    texture_unit::Admissible r(ctx_.render.profile_options.texture_seed, pos, 0.25, -1.0);
+    return texture_unit::admissible_weight(w, r);
 }
 
 ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
@@ -141,7 +228,7 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
                                      : normalised(v);
     const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
     const int i = std::min(int(pos), n - 2);
-    const double w = pos - double(i);
+    const double w = texture_unit_ == ProfileOptions::TextureUnit::Exact ? pos - double(i) : table_weight(pos - double(i), pos);
     const glm::dvec4 e = table_[std::size_t(i)] + w * (table_[std::size_t(i) + 1] - table_[std::size_t(i)]);
     out.color = glm::dvec3(e);
     out.opacity = e.a;
@@ -199,15 +286,297 @@ void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, doub
 
 template <class Rec>
 PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    PixelValue out;
     switch (ctx_.render.projection) {
-        case Projection::Composite: return composite(ray, intervals, rec);
-        case Projection::Mip: return extremum(ray, intervals, true, rec);
-        case Projection::Minip: return extremum(ray, intervals, false, rec);
-        case Projection::Average: return line_integral(ray, intervals, true, rec);
-        case Projection::Xray: return line_integral(ray, intervals, false, rec);
+        case Projection::Composite: out = composite(ray, intervals, rec); break;
+        case Projection::Mip: out = extremum(ray, intervals, true, rec); break;
+        case Projection::Minip: out = extremum(ray, intervals, false, rec); break;
+        case Projection::Average: out = line_integral(ray, intervals, true, rec); break;
+        case Projection::Xray: out = line_integral(ray, intervals, false, rec); break;
         case Projection::FirstHit: break;
     }
-    return {};
+    if (band_) out.error = band(ray, intervals, out.rgba);
+    return out;
+}
+
+// --- the texture band (conventions section 9, "The texture unit") ------------------------------------
+// Every quantity is carried as an interval [lo, hi] holding its value for every texture unit within the
+// model: a fetch within [exact - band, exact + band] (TextureUnit.h), a table read anywhere on the
+// table's piecewise-linear curve over the fetch's interval and off it by at most 1/512 of the step
+// between the two texels it reads; every later step is multilinear in its inputs, so its extremes over
+// a box of inputs lie at the box's corners. The pixel's error channel is the largest distance from
+// the rendered value to its interval's ends over R, G, B, A, plus 1e-12 for the rounding of this
+// double-precision arithmetic against the render's own.
+
+namespace {
+
+constexpr double kBandRounding = 1e-12;
+
+struct Iv {
+    double lo = 0.0, hi = 0.0;
+    void hull(double v) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    }
+};
+
+// The range of x y over x in a, y in b.
+Iv product(Iv a, Iv b) {
+    Iv r{a.lo * b.lo, a.lo * b.lo};
+    r.hull(a.lo * b.hi);
+    r.hull(a.hi * b.lo);
+    r.hull(a.hi * b.hi);
+    return r;
+}
+
+Iv sum(Iv a, Iv b) { return {a.lo + b.lo, a.hi + b.hi}; }
+
+}  // namespace
+
+ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, double d) const {
+    Box b;
+    auto start = [&](const double* c) {
+        for (int j = 0; j < 5; ++j) b.lo[j] = b.hi[j] = c[j];
+    };
+    auto add = [&](const double* c) {
+        for (int j = 0; j < 5; ++j) {
+            b.lo[j] = std::min(b.lo[j], c[j]);
+            b.hi[j] = std::max(b.hi[j], c[j]);
+        }
+    };
+    if (table_.empty()) {  // the transfer function read exactly: its extremes at the ends and its knots
+        auto at = [&](double v) {
+            const Classified k = ctx_.pipeline.classifier().classify(v, 0.0);
+            const double c[5] = {k.color.r, k.color.g, k.color.b, k.opacity, alpha(k.opacity, d)};
+            return std::array<double, 5>{c[0], c[1], c[2], c[3], c[4]};
+        };
+        std::array<double, 5> c = at(vlo);
+        start(c.data());
+        c = at(vhi);
+        add(c.data());
+        const double inv = transfer_->normalized() ? transfer_->inverse_window_width() : 1.0;
+        const double w0 = transfer_->normalized() ? transfer_->window()[0] : 0.0;
+        auto knots = [&](const std::vector<double>& xs) {
+            for (double x : xs) {
+                const double v = w0 + x / inv;
+                if (v > vlo && v < vhi) {
+                    c = at(v);
+                    add(c.data());
+                }
+            }
+        };
+        knots(transfer_->color_function().xs());
+        knots(transfer_->opacity_function().xs());
+        if (p_.correction == Profile::Correction::Power) {  // the floor: a jump in the corrected alpha
+            const Classified klo = ctx_.pipeline.classifier().classify(vlo, 0.0);
+            const Classified khi = ctx_.pipeline.classifier().classify(vhi, 0.0);
+            const double f = p_.correction_floor;
+            if (std::min(klo.opacity, khi.opacity) <= f && std::max(klo.opacity, khi.opacity) >= f) {
+                const double l = ctx_.pipeline.classifier().unit_distance();
+                b.lo[4] = std::min({b.lo[4], f, opacity_for_length(f, d, l)});
+                b.hi[4] = std::max({b.hi[4], f, opacity_for_length(f, d, l)});
+            }
+        }
+        return b;
+    }
+    // A table of n texels read at pos(v), monotone in v: its curve's extremes at the ends and the texel
+    // centres between, and the weight's 1/512 of each segment it can read.
+    const int n = p_.table_entries;
+    auto pos = [&](double v) {
+        const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale
+                             ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
+                             : normalised(v);
+        return std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
+    };
+    auto entry = [&](std::size_t j, double* c) {
+        c[0] = table_[j].r, c[1] = table_[j].g, c[2] = table_[j].b, c[3] = table_[j].a, c[4] = table_alpha_[j];
+    };
+    auto curve = [&](double p, double* c) {
+        const int i = std::min(int(p), n - 2);
+        const double w = p - double(i);
+        double a[5], e[5];
+        entry(std::size_t(i), a);
+        entry(std::size_t(i) + 1, e);
+        for (int j = 0; j < 5; ++j) c[j] = a[j] + w * (e[j] - a[j]);
+    };
+    const double plo = pos(vlo), phi = pos(vhi);
+    double c[5];
+    curve(plo, c);
+    start(c);
+    curve(phi, c);
+    add(c);
+    for (int j = int(std::ceil(plo)); j <= int(std::floor(phi)) && j < n; ++j) {
+        entry(std::size_t(j), c);
+        add(c);
+    }
+    double slack[5] = {0, 0, 0, 0, 0};
+    const int s0 = std::clamp(int(std::ceil(plo)) - 1, 0, n - 2), s1 = std::clamp(int(std::floor(phi)), 0, n - 2);
+    for (int i = s0; i <= s1; ++i) {
+        double a[5], e[5];
+        entry(std::size_t(i), a);
+        entry(std::size_t(i) + 1, e);
+        for (int j = 0; j < 5; ++j) slack[j] = std::max(slack[j], texture_unit::kWeightError * std::fabs(e[j] - a[j]));
+    }
+    for (int j = 0; j < 5; ++j) {
+        b.lo[j] -= slack[j];
+        b.hi[j] += slack[j];
+    }
+    return b;
+}
+
+// A composited sample as composite() / composite_lerp() build it, over v in [vlo, vhi].
+ProfileIntegrator::Box ProfileIntegrator::sample_range(double vlo, double vhi, double d) const {
+    const ProfileOptions& o = ctx_.render.profile_options;
+    // Which values the sample is used for: composite() skips v < value_cutoff; composite_lerp() skips s < iso.
+    double cut = -std::numeric_limits<double>::infinity();
+    if (p_.value_cutoff > cut) cut = p_.value_cutoff;
+    const bool lerp = p_.compositing == Profile::Compositing::BackToFrontLerp;
+    if (lerp && p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold) cut = lo_ + o.iso_threshold * width_;
+    const bool never = vhi < cut, always = !(vlo < cut);
+    Box b{};
+    if (never) {
+        for (int j = 0; j < 5; ++j) b.lo[j] = b.hi[j] = 0.0;
+    } else {
+        b = lookup_range(std::max(vlo, cut), vhi, d);
+        if (!always)  // skipped for some units: Lookup{} (colour 0, opacity 0)
+            for (int j = 0; j < 5; ++j) {
+                b.lo[j] = std::min(b.lo[j], 0.0);
+                b.hi[j] = std::max(b.hi[j], 0.0);
+            }
+    }
+    if (p_.color_from_value)  // seed 002: textureValue.rrr, whether or not the sample is used
+        for (int j = 0; j < 3; ++j) b.lo[j] = vlo, b.hi[j] = vhi;
+    if (p_.alpha_times_intensity) b.lo[4] *= o.intensity, b.hi[4] *= o.intensity;
+    return b;
+}
+
+double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& intervals, const glm::dvec4& rendered) const {
+    const ProfileOptions& o = ctx_.render.profile_options;
+    Iv F[4];  // the pixel's R, G, B, A over all units
+    bool any = false;
+    auto hull_into = [&](const Iv* p) {
+        for (int j = 0; j < 4; ++j) F[j] = any ? Iv{std::min(F[j].lo, p[j].lo), std::max(F[j].hi, p[j].hi)} : p[j];
+        any = true;
+    };
+    struct S {
+        double t, d, vlo, vhi;
+    };
+    std::vector<S> samples;
+    for_each_sample(intervals, [&](double t, double d) {
+        const Fetch f = texture_fetch(ray.at(t));
+        if (std::isfinite(f.exact)) samples.push_back({t, d, f.exact - f.band, f.exact + f.band});
+        else samples.push_back({t, d, f.exact, f.exact});
+        return true;
+    });
+    switch (ctx_.render.projection) {
+        case Projection::Composite:
+            if (p_.compositing == Profile::Compositing::BackToFrontLerp) {
+                // sum = sum (1 - w) + col w per channel, w = opacity density, col = (rgb, opacity)
+                Iv sum[4] = {};
+                const bool reverse = p_.placement != Profile::Placement::FromExit;
+                for (std::size_t j = 0; j < samples.size(); ++j) {
+                    const S& q = samples[reverse ? samples.size() - 1 - j : j];
+                    if (!std::isfinite(q.vlo)) continue;
+                    const Box b = sample_range(q.vlo, q.vhi, q.d);
+                    const Iv w{b.lo[3] * o.density, b.hi[3] * o.density};
+                    for (int c = 0; c < 4; ++c) {
+                        const Iv col{b.lo[c == 3 ? 3 : c], b.hi[c == 3 ? 3 : c]};
+                        Iv r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+                        for (double sv : {sum[c].lo, sum[c].hi})
+                            for (double cv : {col.lo, col.hi})
+                                for (double wv : {w.lo, w.hi}) r.hull(sv * (1.0 - wv) + cv * wv);
+                        sum[c] = r;
+                    }
+                }
+                hull_into(sum);
+            } else {
+                // C += T alpha c, T *= 1 - alpha; the unit stops after the first sample where its own A
+                // passes the profile's test: the pixel lies in the hull of the boxes where some unit may stop.
+                Iv C[3] = {}, T{1.0, 1.0};
+                const Termination& term = p_.termination;
+                auto stops = [&](double A) {
+                    return (term.test_alpha_above && A > term.alpha_above) ||
+                           (term.test_alpha_at_least && A >= term.alpha_at_least) ||
+                           (term.test_transmittance && 1.0 - A <= term.transmittance_at_most);
+                };
+                bool certain = false;
+                for (const S& q : samples) {
+                    if (!std::isfinite(q.vlo)) continue;
+                    const Box b = sample_range(q.vlo, q.vhi, q.d);
+                    const Iv a{b.lo[4], b.hi[4]};
+                    const Iv Ta = product(T, a);
+                    for (int c = 0; c < 3; ++c) C[c] = sum(C[c], product(Ta, Iv{b.lo[c], b.hi[c]}));
+                    T = product(T, Iv{1.0 - a.hi, 1.0 - a.lo});
+                    const Iv box[4] = {C[0], C[1], C[2], Iv{1.0 - T.hi, 1.0 - T.lo}};
+                    if (stops(1.0 - T.lo)) hull_into(box);  // some unit may stop here
+                    if (stops(1.0 - T.hi)) {                // every unit has stopped
+                        certain = true;
+                        break;
+                    }
+                }
+                if (!certain) {
+                    const Iv box[4] = {C[0], C[1], C[2], Iv{1.0 - T.hi, 1.0 - T.lo}};
+                    hull_into(box);
+                }
+            }
+            break;
+        case Projection::Mip:
+        case Projection::Minip: {
+            const bool maximum = ctx_.render.projection == Projection::Mip;
+            Iv v{};
+            bool found = false;
+            for (const S& q : samples) {
+                if (!std::isfinite(q.vlo)) continue;
+                if (!found) v = {q.vlo, q.vhi};
+                else if (maximum) v = {std::max(v.lo, q.vlo), std::max(v.hi, q.vhi)};
+                else v = {std::min(v.lo, q.vlo), std::min(v.hi, q.vhi)};
+                found = true;
+            }
+            if (!found) return 0.0;
+            const Box b = lookup_range(v.lo, v.hi, step_);
+            const Iv a{b.lo[3], b.hi[3]};
+            const Iv p[4] = {product(a, {b.lo[0], b.hi[0]}), product(a, {b.lo[1], b.hi[1]}), product(a, {b.lo[2], b.hi[2]}), a};
+            hull_into(p);
+            break;
+        }
+        case Projection::Average:
+        case Projection::Xray: {
+            const bool mean = ctx_.render.projection == Projection::Average;
+            const Classifier& cl = ctx_.pipeline.classifier();
+            const bool weighted = mean && p_.average == Profile::Average::MeanOpacityTimesNormalised;
+            Iv g{}, largest{0.0, 0.0};
+            double length = 0.0;
+            for (const S& q : samples) {
+                if (!std::isfinite(q.vlo)) continue;
+                Iv s;
+                if (weighted) {
+                    const Box b = lookup_range(q.vlo, q.vhi, q.d);
+                    s = product({b.lo[3], b.hi[3]}, {normalised(q.vlo), normalised(q.vhi)});
+                } else {
+                    s = {std::min(cl.coordinate(q.vlo), cl.coordinate(q.vhi)), std::max(cl.coordinate(q.vlo), cl.coordinate(q.vhi))};
+                }
+                g = sum(g, weighted ? s : Iv{s.lo * q.d, s.hi * q.d});
+                length += weighted ? 1.0 : q.d;
+                // seed 001's maximum over the samples kept by the iso threshold (0 when none)
+                const double cut = p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold ? o.iso_threshold : -std::numeric_limits<double>::infinity();
+                if (!(normalised(q.vlo) < cut)) largest.lo = std::max(largest.lo, normalised(q.vlo));
+                if (!(normalised(q.vhi) < cut)) largest.hi = std::max(largest.hi, normalised(q.vhi));
+            }
+            if (intervals.empty()) return 0.0;
+            Iv r;
+            if (!mean && p_.xray == Profile::Xray::BrightnessTimesMaximum) r = {o.brightness * largest.lo, o.brightness * largest.hi};
+            else if (mean) r = length > 0.0 ? Iv{g.lo / length, g.hi / length} : Iv{};
+            else r = {ctx_.render.gain * g.lo, ctx_.render.gain * g.hi};
+            const Iv p[4] = {r, r, r, Iv{1.0, 1.0}};
+            hull_into(p);
+            break;
+        }
+        case Projection::FirstHit: break;
+    }
+    if (!any) return 0.0;
+    double e = 0.0;
+    for (int j = 0; j < 4; ++j) e = std::max({e, F[j].hi - rendered[j], rendered[j] - F[j].lo});
+    return e + kBandRounding * (1.0 + std::max({std::fabs(rendered.r), std::fabs(rendered.g), std::fabs(rendered.b), std::fabs(rendered.a)}));
 }
 
 template <class Rec>

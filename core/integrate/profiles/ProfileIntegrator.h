@@ -17,6 +17,7 @@
 // vtk-cpu (Renderer::VtkFixedPoint) is not a ray integrator: VtkFixedPointRenderer.h renders its image
 // in image space, called from the render step (PreparedScene::pixels).
 #pragma once
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -43,6 +44,8 @@ public:
     // Throws volref::Error naming render.profile for what the profile cannot render.
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
     ~ProfileIntegrator() override;
+    // render.profile_options.texture_band (issue 17): PixelValue::error is the texture band (band()).
+    bool writes_error() const override { return band_; }
 
 private:
     friend class OneLoopIntegrator<ProfileIntegrator>;
@@ -56,6 +59,22 @@ private:
     void for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const;
     double value(const glm::dvec3& x) const;
     double seed_shell_value(const glm::dvec3& x) const;  // Profile::seed_shell_reads
+    // A texture fetch under render.profile_options.texture_unit (TextureUnit.h): the value the unit
+    // returns, the exact trilinear value and the band |fetch - exact| <= band for any unit in the model.
+    struct Fetch {
+        double value = 0.0, exact = 0.0, band = 0.0;
+    };
+    Fetch texture_fetch(const glm::dvec3& x) const;
+    bool shell_texels(const glm::dvec3& x, std::array<double, 8>& corners, glm::dvec3& w) const;
+    double table_weight(double w, double pos) const;  // a 1D table texel weight under the texture unit
+    // The texture band (conventions section 9, "The texture unit"): intervals of every sample's value,
+    // classification and the projection's accumulation over all units within the model.
+    struct Box {
+        double lo[5], hi[5];  // r, g, b, uncorrected opacity, alpha
+    };
+    Box lookup_range(double vlo, double vhi, double d) const;
+    Box sample_range(double vlo, double vhi, double d) const;  // composite: cutoff, colour, K, filter
+    double band(const Ray& ray, const std::vector<Interval>& intervals, const glm::dvec4& rendered) const;
     Lookup lookup(double v, double d) const;
     double alpha(double a, double d) const;
     glm::dvec3 gradient(const glm::dvec3& x) const;
@@ -81,6 +100,10 @@ private:
     double lo_ = 0.0, width_ = 0.0;  // the data range [lo, lo + width]
     std::vector<glm::dvec4> table_;  // rgb + uncorrected opacity
     std::vector<double> table_alpha_;  // corrected for the step (composite)
+    ProfileOptions::TextureUnit texture_unit_ = ProfileOptions::TextureUnit::Exact;
+    bool band_ = false;
+    const VolumeSampler* cartesian_ = nullptr;         // texture_unit / band on Cartesian grids
+    const class TransferFunction* transfer_ = nullptr;  // band without a table: its knots
 };
 
 }  // namespace volref

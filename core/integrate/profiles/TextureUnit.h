@@ -1,6 +1,7 @@
 // TextureUnit: how a GPU's linearly filtered texture fetch differs from exact interpolation (issue 17,
-// part 4), as measured on an NVIDIA H100 (../shared/gpu/README.md). Math only: no profile reads it yet
-// (docs/gpu-checking.md says so); docs/conventions.md section 9, "The texture unit", states each rule.
+// part 4), as measured on an NVIDIA H100 (../shared/gpu/README.md). The profiles vtk-gpu, glsl-basic
+// and cuda-curvilinear read it (render.profile_options.texture_unit, texture_band; ProfileIntegrator);
+// docs/conventions.md section 9, "The texture unit", states each rule.
 //
 //   exact:    the weight of the upper texel is the fraction f of the texel position (llvmpipe, volref).
 //   hardware: 1D weight q(f) = floor(f * 256 + 0.5) / 256 (matched 65,537 of 65,537 measured points);
@@ -16,6 +17,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace volref::texture_unit {
 
@@ -78,6 +81,47 @@ inline double fetch_error_band_3d(const std::array<double, 8>& v, double fx, dou
         band += ec * std::fabs(v[std::size_t(c)]);
     }
     return band;
+}
+
+// --- admissible units (tests: the Monte Carlo of the units the band covers) ------------------------
+// A deterministic stream of numbers in [-1, 1] from a key (splitmix64): a quarter of them exactly -1 or
+// +1 (the extremes of the tolerance), the rest uniform.
+struct Admissible {
+    std::uint64_t state;
+    static std::uint64_t mix(std::uint64_t z) {
+        z += 0x9e3779b97f4a7c15ull;
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return z ^ (z >> 31);
+    }
+    static std::uint64_t bits(double x) {
+        std::uint64_t b;
+        std::memcpy(&b, &x, sizeof b);
+        return b;
+    }
+    Admissible(std::uint64_t seed, double a, double b, double c)
+        : state(mix(mix(mix(mix(seed) ^ bits(a)) ^ bits(b)) ^ bits(c))) {}
+    double next() {
+        state = mix(state);
+        if ((state & 3u) == 0u) return (state & 4u) ? 1.0 : -1.0;
+        return double(state >> 11) * 0x1.0p-53 * 2.0 - 1.0;
+    }
+};
+
+// A 1D weight within kWeightError of f.
+inline double admissible_weight(double f, Admissible& r) { return f + kWeightError * r.next(); }
+
+// Corner weights within the model's tolerances: per-axis weights within kWeightError of exact, each
+// corner's product moved by at most kWeightError.
+inline std::array<double, 8> admissible_corner_weights(double fx, double fy, double fz, Admissible& r) {
+    const double a[3] = {admissible_weight(fx, r), admissible_weight(fy, r), admissible_weight(fz, r)};
+    std::array<double, 8> w{};
+    for (int c = 0; c < 8; ++c) {
+        double p = 1.0;
+        for (int k = 0; k < 3; ++k) p *= ((c >> k) & 1) ? a[k] : 1.0 - a[k];
+        w[std::size_t(c)] = p + kWeightError * r.next();
+    }
+    return w;
 }
 
 }  // namespace volref::texture_unit

@@ -1,0 +1,274 @@
+#!/usr/bin/python3
+"""volref-mpi against the single-process `volref render` (cli/mpi/CMakeLists.txt registers each mode).
+
+equal --np N : every supported projection and order, orthographic and perspective, unshaded and
+               shaded, crop and clip planes, on a procedural field: `mpirun -np N volref-mpi render`
+               equals `volref render` within 1e-12 (`volref compare --tolerance 1e-12`; conventions §14).
+raw          : a raw file read as bricks (sub-box reads) by 2, 3 and 4 ranks equals `volref render`.
+memory       : a raw volume over one rank's --max-memory: refused in one line by 1 rank, rendered by 4
+               (and equal to `volref render` without the limit).
+failed       : a truncated raw file whose last brick cannot be read: exit status != 0, exactly one
+               `volref: error:` line naming the file, no image.
+refusals     : scenes outside the first version's scope are refused in one line naming the key.
+"""
+import argparse, json, os, shutil, struct, subprocess, sys, math
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--mpirun", required=True)
+ap.add_argument("--volref", required=True)
+ap.add_argument("--volref-mpi", required=True)
+ap.add_argument("--dump", required=True, help="volref_image_dump (tests/identity): the reference as doubles")
+ap.add_argument("--work", required=True)
+ap.add_argument("mode")
+ap.add_argument("--np", type=int, default=2)
+a = ap.parse_args()
+
+# ctest sets these (cli/mpi/CMakeLists.txt); the defaults let the script run by hand too. Root (CI) needs
+# the first two; 4 ranks on a 2-core machine need oversubscription; containers often forbid the
+# shared-memory transport's cross-memory attach (ptrace), which would only add warnings.
+for k, v in (("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
+             ("OMPI_MCA_rmaps_base_oversubscribe", "1"), ("OMPI_MCA_btl_vader_single_copy_mechanism", "none")):
+    os.environ.setdefault(k, v)
+shutil.rmtree(a.work, ignore_errors=True)
+os.makedirs(a.work)
+failures = []
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, **kw)
+
+
+def mpirun(np, args):
+    return run([a.mpirun, "-q", "--oversubscribe", "-np", str(np), a.volref_mpi] + args)
+
+
+def write_scene(name, scene):
+    path = os.path.join(a.work, name + ".json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    return path
+
+
+def read_img(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"\n")
+    head = data[:end].decode().split()
+    w, h, channels = int(head[0]), int(head[1]), head[2:]
+    n = w * h * len(channels)
+    return w, h, channels, struct.unpack("<%dd" % n, data[end + 1:end + 1 + 8 * n])
+
+
+def check_equal(name, scene_path, np, extra=(), tolerance=1e-12):
+    """volref-mpi's doubles (.img) against volref_image_dump's render_scene doubles: max abs <= 1e-12."""
+    cases = os.path.join(a.work, name + ".cases")
+    with open(cases, "w") as f:
+        f.write("%s|%s||threads=1\n" % (name, scene_path))
+    r = run([a.dump, cases, a.work])
+    ref = os.path.join(a.work, name + ".img")
+    if r.returncode != 0 or not os.path.exists(ref):
+        err = os.path.join(a.work, name + ".err")
+        failures.append("%s: the single-process render failed: %s %s" % (
+            name, r.stderr.strip(), open(err).read().strip() if os.path.exists(err) else ""))
+        return
+    out = os.path.join(a.work, name + ".np%d.img" % np)
+    r = mpirun(np, ["render", scene_path, "-o", out, "--threads", "1"] + list(extra))
+    if r.returncode != 0 or not os.path.exists(out):
+        failures.append("%s np=%d: volref-mpi failed (%d): %s" % (name, np, r.returncode, r.stderr.strip()))
+        return
+    w0, h0, c0, p0 = read_img(ref)
+    w1, h1, c1, p1 = read_img(out)
+    if (w0, h0, c0) != (w1, h1, c1):
+        failures.append("%s np=%d: image %s differs from the reference's %s" % (name, np, (w1, h1, c1), (w0, h0, c0)))
+        return
+    diff = max((abs(x - y) for x, y in zip(p0, p1)), default=0.0)
+    covered = sum(1 for i in range(3, len(p0), 4) if p0[i] != 0.0)
+    if not diff <= tolerance:
+        failures.append("%s np=%d: max abs difference %.3e over %g" % (name, np, diff, tolerance))
+    elif covered == 0:
+        failures.append("%s: the reference image is empty (the case tests nothing)" % name)
+    else:
+        print("ok %s np=%d: max abs difference %.3e (%d pixels covered)" % (name, np, diff, covered))
+
+
+def check_exr(name, scene_path, np):
+    """The user's path: an EXR written by rank 0 and `volref compare` (floats: 1e-6)."""
+    ref = os.path.join(a.work, name + ".ref.exr")
+    out = os.path.join(a.work, name + ".np%d.exr" % np)
+    r = run([a.volref, "render", scene_path, "-o", ref])
+    r2 = mpirun(np, ["render", scene_path, "-o", out])
+    if r.returncode != 0 or r2.returncode != 0:
+        failures.append("%s: EXR renders failed: %s %s" % (name, r.stderr.strip(), r2.stderr.strip()))
+        return
+    c = run([a.volref, "compare", ref, out, "--tolerance", "1e-6"])
+    if c.returncode != 0:
+        failures.append("%s np=%d: EXR differs: %s" % (name, np, c.stdout.strip()[-300:]))
+    else:
+        print("ok %s np=%d: EXR within 1e-6 (float storage)" % (name, np))
+
+
+def base_scene(projection, camera, shaded=False, order="front-to-back"):
+    vol = {
+        "source": {"field": "marschner-lobb", "dims": [21, 17, 25]},
+        "spacing": [1.0, 1.25, 0.8],
+        "origin": [-3.0, 1.0, 0.5],
+        "transfer": {"color": [[0.0, 0.1, 0.3, 0.9], [0.5, 1.0, 0.8, 0.4], [1.0, 0.9, 0.1, 0.1]],
+                     "opacity": [[0.0, 0.0], [0.45, 0.0], [0.5, 0.6], [1.0, 0.3]]},
+    }
+    if shaded:
+        vol["shading"] = {"model": "blinn-phong", "ka": 0.15, "kd": 0.7, "ks": 0.4, "n": 30}
+    cams = {
+        "ortho": {"type": "orthographic", "eye": [40, -30, 45], "target": [7, 11, 10], "up": [0, 0, 1], "height": 40},
+        "persp": {"type": "perspective", "eye": [35, 40, -25], "target": [7, 11, 10], "up": [0, 1, 0], "fov_y": 40},
+        # The eye inside the volume: rays start inside a brick.
+        "inside": {"type": "perspective", "eye": [6, 9, 8], "target": [14, 18, 1], "up": [0, 0, 1], "fov_y": 70},
+    }
+    render = {"projection": projection, "step": 0.37}
+    if projection == "composite":
+        render["order"] = order
+    return {"volume": vol, "camera": cams[camera], "image": {"width": 33, "height": 27}, "render": render}
+
+
+if a.mode == "equal":
+    cases = []
+    for cam in ("ortho", "persp", "inside"):
+        cases.append(("composite-ftb-" + cam, base_scene("composite", cam)))
+        cases.append(("composite-btf-" + cam, base_scene("composite", cam, order="back-to-front")))
+        cases.append(("shaded-ftb-" + cam, base_scene("composite", cam, shaded=True)))
+        for p in ("mip", "minip", "average", "xray"):
+            cases.append((p + "-" + cam, base_scene(p, cam)))
+    s = base_scene("composite", "persp", shaded=True, order="back-to-front")
+    s["volume"]["interpolation"] = "tricubic-catmull-rom"
+    cases.append(("shaded-btf-tricubic-persp", s))
+    s = base_scene("composite", "ortho")
+    s["volume"]["crop"] = {"planes": [0, 8, 4, 14, 3, 12], "regions": 134217727 ^ (1 << 13)}
+    s["volume"]["clip_planes"] = [{"point": [7, 11, 10], "normal": [1, 1, 0]}]
+    cases.append(("composite-crop-clip-ortho", s))
+    s = base_scene("xray", "persp")
+    s["render"]["gain"] = 0.01
+    s["volume"]["transfer"]["domain"] = "normalized"
+    cases.append(("xray-normalized-persp", s))
+    for name, scene in cases:
+        check_equal(name, write_scene(name, scene), a.np)
+    check_exr("composite-ftb-persp", os.path.join(a.work, "composite-ftb-persp.json"), a.np)
+    # Hand-checkable: a constant medium (value 1, opacity a = 0.5 per unit length, colour c) 32 units
+    # deep along z, seen by an orthographic camera along -z: every pixel is C = c A, A = 1 - 0.5^32
+    # (the opacity correction telescopes); x-ray = gain 32; average = 1. Split along z (the longest
+    # axis) into N bricks, so the combination across bricks is what is checked.
+    closed = {
+        "composite": lambda ch: ([1.0, 0.5, 0.25][ch] if ch < 3 else 1.0) * (1.0 - 0.5 ** 32),
+        "xray": lambda ch: 32.0 * 0.125 if ch < 3 else 1.0,
+        "average": lambda ch: 1.0,
+    }
+    for projection, expect in closed.items():
+        name = "constant-" + projection
+        scene = {"volume": {"source": {"field": "constant", "value": 1.0, "dims": [9, 9, 33]},
+                            "transfer": {"color": [[0.0, 1.0, 0.5, 0.25], [2.0, 1.0, 0.5, 0.25]],
+                                         "opacity": [[0.0, 0.5], [2.0, 0.5]]}},
+                 "camera": {"type": "orthographic", "eye": [4, 4, 100], "target": [4, 4, 16], "up": [0, 1, 0], "height": 4},
+                 "image": {"width": 16, "height": 12},
+                 "render": {"projection": projection, "step": 0.37, "gain": 0.125}}
+        path = write_scene(name, scene)
+        out = os.path.join(a.work, name + ".np%d.img" % a.np)
+        r = mpirun(a.np, ["render", path, "-o", out, "--threads", "1"])
+        if r.returncode != 0:
+            failures.append("%s: volref-mpi failed: %s" % (name, r.stderr.strip()))
+            continue
+        _, _, _, px = read_img(out)
+        worst = max(abs(px[i] - expect(i % 4)) for i in range(len(px)))
+        if not worst <= 1e-12:
+            failures.append("%s np=%d: %.3e from the closed form" % (name, a.np, worst))
+        else:
+            print("ok %s np=%d: closed form within %.3e" % (name, a.np, worst))
+
+
+def write_raw(name, dims, fmt, value, truncate_to=None):
+    path = os.path.join(a.work, name + ".raw")
+    nx, ny, nz = dims
+    data = bytearray()
+    for k in range(nz):
+        for j in range(ny):
+            data += struct.pack("<%d%s" % (nx, fmt), *[value(i, j, k) for i in range(nx)])
+    if truncate_to is not None:
+        data = data[:truncate_to]
+    with open(path, "wb") as f:
+        f.write(data)
+    with open(path + ".json", "w") as f:
+        json.dump({"dims": dims, "type": {"f": "f32", "d": "f64", "B": "u8"}[fmt], "spacing": [1.0, 0.9, 1.1]}, f)
+    return path
+
+
+def smooth(i, j, k):
+    return 0.5 + 0.25 * math.sin(0.3 * i + 0.1 * j) * math.cos(0.2 * k) + 0.01 * ((i * 7 + j * 3 + k) % 5)
+
+
+def raw_scene(path, projection="composite", shaded=False):
+    s = base_scene(projection, "persp", shaded=shaded)
+    s["volume"] = {"source": {"file": path},
+                   "transfer": {"color": [[0.0, 0.2, 0.3, 0.9], [1.0, 1.0, 0.6, 0.2]],
+                                "opacity": [[0.0, 0.0], [0.6, 0.0], [0.8, 0.5]]}}
+    if shaded:
+        s["volume"]["shading"] = {"model": "phong"}
+    s["camera"] = {"type": "perspective", "eye": [60, 50, -40], "target": [12, 10, 14], "up": [0, 1, 0], "fov_y": 35}
+    return s
+
+
+if a.mode == "raw":
+    path = write_raw("field", [26, 22, 30], "f", smooth)
+    for np in (2, 3, 4):
+        check_equal("raw-composite", write_scene("raw-composite", raw_scene(path)), np)
+        check_equal("raw-shaded", write_scene("raw-shaded", raw_scene(path, shaded=True)), np)
+        check_equal("raw-mip", write_scene("raw-mip", raw_scene(path, "mip")), np)
+
+if a.mode == "memory":
+    # 64^3 f64 = 2 MiB: over a 1.5 MiB limit on one rank; a quarter (+ ghost) fits on each of 4.
+    path = write_raw("big", [64, 64, 64], "d", smooth)
+    scene = write_scene("big", raw_scene(path))
+    out1 = os.path.join(a.work, "big.np1.exr")
+    r = mpirun(1, ["--max-memory", "1536K", "render", scene, "-o", out1, "--threads", "1"])
+    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+    if r.returncode == 0 or len(lines) != 1 or "memory" not in lines[0] or os.path.exists(out1):
+        failures.append("1 rank under --max-memory 1536K: expected one error line about memory and no image, got %d: %r"
+                        % (r.returncode, r.stderr))
+    else:
+        print("ok refused by 1 rank: " + lines[0])
+    check_equal("big", scene, 4, extra=["--max-memory", "1536K"])
+
+if a.mode == "failed":
+    # 16 x 16 x 64 u8, split along z; the file holds 40 of the 64 slices: the last brick's rank fails.
+    path = write_raw("short", [16, 16, 64], "B", lambda i, j, k: (i + j + k) % 200, truncate_to=16 * 16 * 40)
+    scene = write_scene("short", raw_scene(path))
+    out = os.path.join(a.work, "short.exr")
+    r = mpirun(2, ["render", scene, "-o", out])
+    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+    # mpirun -q: stderr is that one line and nothing else (no line per rank, no launcher notice).
+    if r.returncode == 0 or len(lines) != 1 or "short.raw: the file ends before this rank's brick" not in lines[0] \
+            or r.stderr.strip().splitlines() != lines or os.path.exists(out):
+        failures.append("truncated brick: expected exit != 0, one error line, no image; got %d, %r, image %s"
+                        % (r.returncode, r.stderr, os.path.exists(out)))
+    else:
+        print("ok failed brick: " + lines[0])
+
+if a.mode == "refusals":
+    cases = {
+        "render.early_termination": ("render", "early_termination", 0.99),
+        "render.integrator": ("render", "integrator", "adaptive"),
+        "render.profile": ("render", "profile", "vtk-gpu"),
+        "render.projection": ("render", "projection", "first-hit"),
+    }
+    for key, (section, k, v) in cases.items():
+        s = base_scene("composite", "ortho")
+        s[section][k] = v
+        if v == "first-hit":
+            s["render"]["isovalue"] = 0.5
+        out = os.path.join(a.work, "refused.exr")
+        r = mpirun(2, ["render", write_scene("refused", s), "-o", out])
+        lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+        if r.returncode == 0 or len(lines) != 1 or not lines[0].startswith("volref: error: " + key) or os.path.exists(out):
+            failures.append("%s: expected one error line naming it, got %d %r" % (key, r.returncode, r.stderr))
+        else:
+            print("ok " + lines[0])
+
+for f in failures:
+    print("FAIL " + f)
+sys.exit(1 if failures else 0)

@@ -183,6 +183,43 @@ TEST(MacrocellGrid, EmptyRadiusIsTheChebyshevDistanceToTheNearestNonEmptyMacroce
     }
 }
 
+// The same against brute force (every pair of macrocells) on scattered spikes: 57^3 voxels (7
+// macrocells per axis), spikes at fixed pseudo-random voxels, the radius of each empty macrocell the
+// smallest Chebyshev distance to a macrocell the grid says is not empty.
+TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
+    FieldSpec f;
+    f.kind = FieldSpec::Kind::Cells;
+    f.dims = {57, 57, 57};
+    f.values.assign(57 * 57 * 57, 0.0);
+    std::uint32_t x = 12345;
+    for (int k = 0; k < 5; ++k) {
+        x = x * 1664525u + 1013904223u;
+        f.values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
+    }
+    const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
+    TransferSpec ts;
+    ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
+    const TransferFunction tf(ts, v);
+    const VolumeSampler sampler(v, Interpolation::Trilinear);
+    const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
+    const auto n = g.counts();
+    ASSERT_EQ(n, (MacrocellGrid::Index{7, 7, 7}));
+    int non_empty = 0;
+    for (std::int64_t k = 0; k < 7; ++k)
+        for (std::int64_t j = 0; j < 7; ++j)
+            for (std::int64_t i = 0; i < 7; ++i) {
+                std::int64_t want = MacrocellGrid::kMaxEmptyRadius;
+                for (std::int64_t c = 0; c < 7; ++c)
+                    for (std::int64_t b = 0; b < 7; ++b)
+                        for (std::int64_t a = 0; a < 7; ++a)
+                            if (!g.empty({a, b, c}))
+                                want = std::min(want, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
+                non_empty += want == 0;
+                EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
+            }
+    EXPECT_GE(non_empty, 5);
+}
+
 // One non-zero voxel in a 20^3 volume of zeros (19 cells per axis: macrocells of 8, 8 and 3 cells):
 // the macrocells whose samples can read it are not empty, all others are.
 TEST(MacrocellGrid, SpikeAndApron) {

@@ -40,6 +40,21 @@ inline FieldSpec linear_field(std::array<double, 4> coefficients, std::array<std
     return f;
 }
 
+// f = z on [0, 4]^3 (data range [0, 4]); colour white, opacity a(v) = v / 4; one pixel looking down z
+// through (2, 2), the step in world units.
+inline Scene ramp_scene(ProfileId profile, Projection projection, double step = 0.5) {
+    Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
+    s.volume().transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
+    s.volume().transfer.opacity = {{0, 0}, {4, 1}};
+    s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
+    s.image.width = s.image.height = 1;
+    s.render.projection = projection;
+    s.render.step = step;
+    s.render.step_units = StepUnits::World;
+    s.render.profile = profile;
+    return s;
+}
+
 inline glm::dvec4 rgba(const Image& im, int x, int y) {
     return {im.at(x, y, 0), im.at(x, y, 1), im.at(x, y, 2), im.at(x, y, 3)};
 }

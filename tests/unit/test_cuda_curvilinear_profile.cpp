@@ -19,18 +19,7 @@ using namespace volref::test;
 
 namespace {
 
-Scene ramp(Projection projection) {
-    Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
-    s.volume().transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
-    s.volume().transfer.opacity = {{0, 0}, {4, 1}};
-    s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
-    s.image.width = s.image.height = 1;
-    s.render.projection = projection;
-    s.render.step = 0.75;
-    s.render.step_units = StepUnits::World;
-    s.render.profile = ProfileId::CudaCurvilinear;
-    return s;
-}
+Scene ramp(Projection projection) { return ramp_scene(ProfileId::CudaCurvilinear, projection, 0.75); }
 
 }  // namespace
 

@@ -33,19 +33,6 @@ double alpha_of(ProfileId profile, double value, double opacity, std::int64_t n,
     return rgba(render_scene(box_scene(profile, value, opacity, n, step), {1, false}), 0, 0).a;
 }
 
-// f = z on [0, 4]^3 (data range [0, 4]); colour white, opacity a(v) = v / 4.
-Scene ramp_scene(ProfileId profile, Projection projection) {
-    Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
-    s.volume().transfer.color = {{0, 1, 1, 1}, {4, 1, 1, 1}};
-    s.volume().transfer.opacity = {{0, 0}, {4, 1}};
-    s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
-    s.image.width = s.image.height = 1;
-    s.render.projection = projection;
-    s.render.step = 0.5;
-    s.render.step_units = StepUnits::World;
-    s.render.profile = profile;
-    return s;
-}
 
 }  // namespace
 

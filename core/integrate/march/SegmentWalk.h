@@ -75,15 +75,37 @@ public:
         maximum_ = maximum;
     }
 
+    // The next segment to visit; false after the last.
     bool next(Segment& s) {
+        if (k_ >= end_ && !advance()) return false;
+        s = segment((*intervals_)[iv_], step_, k_, n_);
+        ++k_;
+        return true;
+    }
+
+    // The next run of segments to visit, all of one interval: segments [k, end) of `iv`'s n (the same
+    // segments next() would return one by one, in the same order); false after the last. The SIMD
+    // packets take runs and place the segments themselves (segment()'s arithmetic, inline).
+    struct Run {
+        const Interval* iv;
+        std::int64_t k, end, n;
+    };
+    bool next_run(Run& r) {
+        if (k_ >= end_ && !advance()) return false;
+        r = {&(*intervals_)[iv_], k_, end_, n_};
+        k_ = end_;
+        return true;
+    }
+
+private:
+    static constexpr std::int64_t kMinVisitedRun = 16;
+
+    // Moves to the next non-empty run [k_, end_) of segments to visit; false when there is none.
+    bool advance() {
         using namespace segment_walk;
         while (iv_ < intervals_->size()) {
             const Interval& iv = (*intervals_)[iv_];
-            if (k_ < end_) {
-                s = segment(iv, step_, k_, n_);
-                ++k_;
-                return true;
-            }
+            if (k_ < end_) return true;
             if (k_ >= n_) {
                 if (++iv_ < intervals_->size()) n_ = segment_count((*intervals_)[iv_], step_);
                 k_ = end_ = 0;
@@ -103,7 +125,10 @@ public:
             const std::int64_t end =
                 std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m, r), n_), k_ + 1, n_);
             if (!skip) {
-                end_ = end;
+                // Composite: a run that is visited is at least kMinVisitedRun segments long (it may
+                // run on into empty macrocells, whose segments have opacity 0 and change nothing), so
+                // a ray that grazes many small non-empty runs pays fewer checks.
+                end_ = extremum_ ? end : std::max(end, std::min(n_, k_ + kMinVisitedRun));
                 if (extremum_) {
                     // Extremum mode backs off on rays where the checks keep failing (the ray's
                     // extremum is not yet beyond what the macrocells hold): after f failed checks in a
@@ -121,25 +146,17 @@ public:
                     if (c[a] < m[a] - (r - 1) || c[a] > m[a] + (r - 1)) return false;
                 return true;
             };
-            std::int64_t in = end - 1, out = n_;  // the run's last segment is in [in, out)
-            if (in > k_ && !in_m(in)) {
-                out = in;  // the estimate is too long
-                in = k_;
-            } else {  // too short? gallop forward
-                for (std::int64_t d = 1; in + d < n_; d *= 2) {
-                    if (!in_m(in + d)) {
-                        out = in + d;
-                        break;
-                    }
-                    in += d;
-                }
-            }
-            k_ = end_ = last_in_run(in, out, in_m) + 1;  // every segment up to there lies in m: opacity 0
+            // Segments k .. end - 1 are passed over when the estimate's last one lies in the box (each
+            // axis' index is monotone in k, so all before it do); else the run ends earlier and is found
+            // by bisection. An estimate that is too short only leaves the rest of the box to the next
+            // check, which passes over it in turn.
+            std::int64_t last = end - 1;
+            if (last > k_ && !in_m(last)) last = last_in_run(k_, last, in_m);
+            k_ = end_ = last + 1;  // every segment up to there lies in the empty box: opacity 0
         }
         return false;
     }
 
-private:
     bool skippable(const MacrocellGrid::Index& m) const {
         if (!extremum_) return grid_->empty(m);
         const std::array<double, 2> b = grid_->value_bounds(m);

@@ -37,13 +37,13 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
 
 PreparedScene::~PreparedScene() = default;
 
-void PreparedScene::pixels(int x0, int y, int count, PixelValue* out, bool simd, Scratch& scratch) const {
+void PreparedScene::pixels(const int* x, const int* y, int count, PixelValue* out, bool simd, Scratch& scratch) const {
     if (const vtkcpu::VtkFixedPointRenderer* r = image_space()) {
-        for (int i = 0; i < count; ++i) out[i] = PixelValue{r->display(x0 + i, y, nullptr)};
+        for (int i = 0; i < count; ++i) out[i] = PixelValue{r->display(x[i], y[i], nullptr)};
         return;
     }
     Ray rays[kMaxPacketRays];
-    for (int i = 0; i < count; ++i) rays[i] = camera->pixel_ray(x0 + i, y);
+    for (int i = 0; i < count; ++i) rays[i] = camera->pixel_ray(x[i], y[i]);
     integrate(rays, count, out, simd, scratch);
 }
 
@@ -98,7 +98,7 @@ std::vector<Interval> PreparedScene::intervals(const Ray& ray) const {
 PixelValue PreparedScene::render_pixel(int x, int y) const {
     Scratch scratch;
     PixelValue out;
-    pixels(x, y, 1, &out, false, scratch);
+    pixels(&x, &y, 1, &out, false, scratch);
     return out;
 }
 

@@ -57,9 +57,10 @@ struct PreparedScene {
     // the mix. The result does not depend on `simd` beyond the packet path's documented rounding.
     void integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const;
 
-    // Pixels (x0 .. x0 + count - 1, y) of the image (count <= kMaxPacketRays): the camera's rays
-    // integrated (integrate), or the image-space renderer's pixels. The render step's one call.
-    void pixels(int x0, int y, int count, PixelValue* out, bool simd, Scratch& scratch) const;
+    // Pixels (x[i], y[i]) of the image, i < count <= kMaxPacketRays: the camera's rays integrated
+    // (integrate), or the image-space renderer's pixels. The render step's one call (with blocks of
+    // kPacketBlock pixels: Renderer.cpp).
+    void pixels(const int* x, const int* y, int count, PixelValue* out, bool simd, Scratch& scratch) const;
 
     // The one volume `volref trace` and `volref explain ray` follow; an Error for several volumes.
     const PreparedVolume& traced_volume() const;

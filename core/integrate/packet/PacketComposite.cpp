@@ -226,8 +226,10 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen);
             a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
         }
+        // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
+        if (hn::AllFalse(d, hn::And(alive, hn::Gt(a, zero)))) continue;
         const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
-        if (!hn::AllFalse(d, o.visible)) {
+        {
             const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x);
             V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x),
                       table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x),

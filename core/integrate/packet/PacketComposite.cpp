@@ -37,8 +37,34 @@ struct TableLookup {
     MT<T> below, above;
 };
 
+// A table of at most as many rows as a vector has lanes, held in registers (x, and y per channel,
+// padded with the last row): its rows are picked by TableLookupLanes instead of gathers (the same
+// values; gathers are microcoded on AMD's CPUs). `rows` > lanes: none (`in_register` false).
 template <typename T>
-HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v) {
+struct RegisterTable {
+    bool in_register = false;
+    VT<T> x, y[3];
+    RegisterTable(DT<T> d, const T* xs, const T* ys, int rows, int stride) {
+        const std::size_t n = hn::Lanes(d);
+        if (rows < 1 || std::size_t(rows) > n) return;
+        in_register = true;
+        HWY_ALIGN T buf[hn::MaxLanes(DT<T>())];
+        for (std::size_t i = 0; i < n; ++i) buf[i] = xs[std::min<std::size_t>(i, std::size_t(rows - 1))];
+        x = hn::Load(d, buf);
+        for (int c = 0; c < stride && c < 3; ++c) {
+            for (std::size_t i = 0; i < n; ++i) buf[i] = ys[std::min<std::size_t>(i, std::size_t(rows - 1)) * std::size_t(stride) + std::size_t(c)];
+            y[c] = hn::Load(d, buf);
+        }
+    }
+    // Row `row` (exact integers as T) of `v`.
+    static HWY_INLINE VT<T> pick(DT<T> d, VT<T> v, VT<T> row) {
+        const hn::RebindToSigned<DT<T>> di;
+        return hn::TableLookupLanes(v, hn::IndicesFromVec(d, hn::ConvertTo(di, row)));
+    }
+};
+
+template <typename T>
+HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v, const RegisterTable<T>& reg) {
     const hn::RebindToSigned<DT<T>> di;
     VT<T> k = hn::Zero(d);
     const VT<T> one = hn::Set(d, T(1));
@@ -48,17 +74,29 @@ HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v) {
     t.above = hn::Eq(k, hn::Set(d, T(rows)));
     t.lo_row = hn::Max(hn::Sub(k, one), hn::Zero(d));
     t.hi_row = hn::Min(k, hn::Set(d, T(rows - 1)));
-    t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
-    t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
+    if (reg.in_register) {
+        t.lo_x = RegisterTable<T>::pick(d, reg.x, t.lo_row);
+        t.hi_x = RegisterTable<T>::pick(d, reg.x, t.hi_row);
+    } else {
+        t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
+        t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
+    }
     return t;
 }
 
 template <typename T>
-HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, int rows, int stride, int channel, VT<T> v) {
+HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, int rows, int stride, int channel, VT<T> v,
+                               const RegisterTable<T>& reg) {
     const hn::RebindToSigned<DT<T>> di;
-    const VT<T> s = hn::Set(d, T(stride)), c = hn::Set(d, T(channel));
-    const VT<T> y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));
-    const VT<T> y1 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.hi_row, s), c)));
+    VT<T> y0, y1;
+    if (reg.in_register) {
+        y0 = RegisterTable<T>::pick(d, reg.y[channel], t.lo_row);
+        y1 = RegisterTable<T>::pick(d, reg.y[channel], t.hi_row);
+    } else {
+        const VT<T> s = hn::Set(d, T(stride)), c = hn::Set(d, T(channel));
+        y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));
+        y1 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.hi_row, s), c)));
+    }
     const VT<T> w = hn::Div(hn::Sub(v, t.lo_x), hn::Sub(t.hi_x, t.lo_x));
     const VT<T> inner = hn::Add(y0, hn::Mul(w, hn::Sub(y1, y0)));
     const VT<T> first = hn::Set(d, ys[channel]), last = hn::Set(d, ys[(rows - 1) * stride + channel]);
@@ -205,6 +243,9 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     constexpr TransmittanceRule kRule = kFast ? TransmittanceRule::Product : TransmittanceRule::OpticalDepthSum;
     FrontToBack<SL, kRule> acc;
     const V l_unit = hn::Set(d, T(in.unit_distance));
+    const RegisterTable<T> opacity_reg(d, tab.opacity_x, tab.opacity_y, in.opacity_rows, 1);
+    const RegisterTable<T> color_reg(d, tab.color_x, tab.color_y, in.color_rows, 3);
+    const RegisterTable<T> gradient_reg(d, tab.gradient_opacity_x, tab.gradient_opacity_y, in.gradient_opacity_rows, 1);
 
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
@@ -213,8 +254,8 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         const V v = trilinear(P[0], P[1], P[2]);
         // Transfer function.
         const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
-        const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x);
-        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, x);
+        const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x, opacity_reg);
+        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, x, opacity_reg);
         V g[3];
         bool have_gradient = false;
         if (in.gradient_opacity_rows > 0) {
@@ -222,18 +263,18 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             gradient(P, v, g);
             have_gradient = true;
             const V glen = hn::Sqrt(dot3(g, g));
-            const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen);
-            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen);
+            const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen, gradient_reg);
+            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen, gradient_reg);
             a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
         }
         // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
         if (hn::AllFalse(d, hn::And(alive, hn::Gt(a, zero)))) continue;
         const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
         {
-            const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x);
-            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, x)};
+            const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x, color_reg);
+            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x, color_reg),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x, color_reg),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, x, color_reg)};
             if (in.shaded) {
                 if (!have_gradient) gradient(P, v, g);
                 shade<T>(in, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t

@@ -137,15 +137,6 @@ void MacrocellGrid::voxel_box(const Index& m, Index& first, Index& last) const {
     }
 }
 
-MacrocellGrid::Index MacrocellGrid::macrocell_at(const glm::dvec3& world) const {
-    const glm::dvec3 u = sampler_.continuous_index(world);
-    if (std::isnan(u.x) || std::isnan(u.y) || std::isnan(u.z)) return {-1, -1, -1};
-    std::array<std::int64_t, 3> cell;
-    glm::dvec3 frac;
-    sampler_.locate(u, cell, frac);
-    return {cell[0] / M, cell[1] / M, cell[2] / M};
-}
-
 double MacrocellGrid::exit_distance(const Ray& ray, const Index& m, std::int64_t r) const {
     const Volume& v = sampler_.volume();
     double t = kInf;

@@ -21,11 +21,13 @@
 // (SegmentWalk.h).
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "core/Conventions.h"
 #include "core/camera/Ray.h"
 #include "core/sample/VolumeSampler.h"
 #include "transfer/Classifier.h"
@@ -56,7 +58,15 @@ public:
 
     // The macrocell of a sample at world point x (the cell of VolumeSampler::locate divided by M);
     // {-1, -1, -1} if x is NaN.
-    Index macrocell_at(const glm::dvec3& world) const;
+    Index macrocell_at(const glm::dvec3& world) const {  // inline: once per run of every ray
+        const glm::dvec3 u = sampler_.continuous_index(world);
+        if (std::isnan(u.x) || std::isnan(u.y) || std::isnan(u.z)) return {-1, -1, -1};
+        std::array<std::int64_t, 3> cell;
+        glm::dvec3 frac;
+        sampler_.locate(u, cell, frac);
+        constexpr std::int64_t M = conventions::kMacrocellSize;
+        return {cell[0] / M, cell[1] / M, cell[2] / M};
+    }
     // The Chebyshev distance, in macrocells, from m to the nearest macrocell that is not empty: 0 when m
     // is not empty, r >= 1 when every macrocell within r - 1 of m (per axis) is empty; capped at
     // kMaxEmptyRadius (also when no macrocell is non-empty).

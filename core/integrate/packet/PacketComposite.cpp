@@ -34,6 +34,7 @@ using MT = hn::Mask<DT<T>>;
 template <typename T>
 struct TableLookup {
     VT<T> lo_row, hi_row, lo_x, hi_x;  // row indices as T (exact)
+    VT<T> w;  // (v - x_lo) / (x_hi - x_lo), shared by the channels
     MT<T> below, above;
 };
 
@@ -81,11 +82,12 @@ HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v, c
         t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
         t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
     }
+    t.w = hn::Div(hn::Sub(v, t.lo_x), hn::Sub(t.hi_x, t.lo_x));
     return t;
 }
 
 template <typename T>
-HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, int rows, int stride, int channel, VT<T> v,
+HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, int rows, int stride, int channel,
                                const RegisterTable<T>& reg) {
     const hn::RebindToSigned<DT<T>> di;
     VT<T> y0, y1;
@@ -97,8 +99,7 @@ HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, in
         y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));
         y1 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.hi_row, s), c)));
     }
-    const VT<T> w = hn::Div(hn::Sub(v, t.lo_x), hn::Sub(t.hi_x, t.lo_x));
-    const VT<T> inner = hn::Add(y0, hn::Mul(w, hn::Sub(y1, y0)));
+    const VT<T> inner = hn::Add(y0, hn::Mul(t.w, hn::Sub(y1, y0)));
     const VT<T> first = hn::Set(d, ys[channel]), last = hn::Set(d, ys[(rows - 1) * stride + channel]);
     return hn::IfThenElse(t.below, first, hn::IfThenElse(t.above, last, inner));
 }
@@ -255,7 +256,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         // Transfer function.
         const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
         const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x, opacity_reg);
-        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, x, opacity_reg);
+        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, opacity_reg);
         V g[3];
         bool have_gradient = false;
         if (in.gradient_opacity_rows > 0) {
@@ -264,7 +265,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             have_gradient = true;
             const V glen = hn::Sqrt(dot3(g, g));
             const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen, gradient_reg);
-            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, glen, gradient_reg);
+            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, gradient_reg);
             a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
         }
         // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
@@ -272,9 +273,9 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
         {
             const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x, color_reg);
-            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, x, color_reg),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, x, color_reg),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, x, color_reg)};
+            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, color_reg),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, color_reg),
+                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, color_reg)};
             if (in.shaded) {
                 if (!have_gradient) gradient(P, v, g);
                 shade<T>(in, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t

@@ -68,7 +68,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
     const ProfileOptions& o = ctx.render.profile_options;
     if (proj != Projection::Composite && ctx.pipeline.shader())
         throw Error(kWhere + "does not mirror vtk.js's shaded mip/minip (remove volume.shading)");
-    if (const Shader* sh = ctx.pipeline.shader()) {
+    if (ctx.pipeline.shader()) {
         if (spec.shading->kl != 0.0 || spec.shading->kc != 1.0)
             throw Error(kWhere + "has no depth cueing (volume.shading.kc 1, kl 0)");
     }

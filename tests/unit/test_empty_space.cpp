@@ -767,6 +767,83 @@ TEST(EmptySpace, SpotsNextToEmptyMacrocells) {
         }
 }
 
+// The composite walk against every segment of the chord, checked without the walk's own logic: each
+// segment it passes over has its midpoint in an empty macrocell (MacrocellGrid::empty at the
+// sampler's macrocell of that midpoint), each segment in a non-empty macrocell is visited, in order
+// and once; next_run hands out exactly the segments next() returns one by one, in runs within one
+// interval. Scattered spots (nearly every ray meets empty and non-empty macrocells in turn), two
+// intervals per ray (the chord split in the middle), random directions and steps.
+TEST(EmptySpace, WalkVisitsEveryNonEmptySegmentAndRunsMatchSegments) {
+    std::mt19937_64 rng(11);
+    FieldSpec f;
+    f.kind = FieldSpec::Kind::Cells;
+    f.dims = {50, 43, 37};
+    f.values.assign(50 * 43 * 37, 0.0);
+    std::uniform_int_distribution<int> ix(0, 49), iy(0, 42), iz(0, 36);
+    for (int n = 0; n < 40; ++n) f.values[std::size_t(ix(rng) + 50 * (iy(rng) + 43 * iz(rng)))] = 1.0;
+    const Volume volume = make_procedural_volume(f, glm::dvec3(-3.0, 2.0, 0.5), glm::dvec3(1.0, 0.75, 1.25));
+    const VolumeSampler sampler(volume, Interpolation::Trilinear);
+    TransferSpec ts;
+    ts.opacity = {{0.0, 0.0}, {1.0, 0.5}};
+    const TransferFunction tf(ts, volume);
+    const MacrocellGrid grid(sampler, tf, MacrocellGrid::Classification::Post);
+    ASSERT_GT(grid.empty_count(), 0);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const glm::dvec3 centre = 0.5 * (volume.domain_min() + volume.domain_max());
+    std::int64_t visited = 0, all = 0, runs = 0;
+    for (int n = 0; n < 300; ++n) {
+        Ray ray;
+        ray.origin = centre + 80.0 * glm::normalize(glm::dvec3(u(rng), u(rng), u(rng)));
+        ray.direction = glm::normalize(centre + 20.0 * glm::dvec3(u(rng), u(rng), u(rng)) - ray.origin);
+        Interval chord;
+        if (!intersect_box(ray, volume.domain_min(), volume.domain_max(), chord)) continue;
+        const double mid = 0.5 * (chord.t0 + chord.t1);
+        const std::vector<Interval> iv{{chord.t0, mid}, {mid, chord.t1}};
+        const double step = 0.2 + 0.15 * (n % 9);
+        // Every segment, and whether the walk may pass over it.
+        std::vector<Segment> every;
+        std::vector<bool> in_empty;
+        for_each_segment(iv, step, [&](const Segment& sg) {
+            every.push_back(sg);
+            in_empty.push_back(grid.empty(grid.macrocell_at(ray.at(sg.midpoint()))));
+            return true;
+        });
+        all += std::int64_t(every.size());
+        // next(): a subsequence of `every` (compared bitwise) holding every non-empty segment.
+        ForwardSegmentWalk walk(&grid, ray, iv, step);
+        std::vector<Segment> by_segment;
+        Segment sg;
+        while (walk.next(sg)) by_segment.push_back(sg);
+        std::size_t j = 0;
+        for (const Segment& v : by_segment) {
+            while (j < every.size() && std::memcmp(&every[j], &v, sizeof(Segment)) != 0) {
+                EXPECT_TRUE(in_empty[j]) << "ray " << n << ": segment " << j << " passed over in a non-empty macrocell";
+                ++j;
+            }
+            ASSERT_LT(j, every.size()) << "ray " << n << ": a visited segment that is not one of the chord's, or out of order";
+            ++j;
+        }
+        for (; j < every.size(); ++j) EXPECT_TRUE(in_empty[j]) << "ray " << n << ": trailing segment " << j;
+        visited += std::int64_t(by_segment.size());
+        // next_run(): the same segments, placed by segment() from (iv, k, n).
+        ForwardSegmentWalk run_walk(&grid, ray, iv, step);
+        ForwardSegmentWalk::Run r;
+        std::vector<Segment> by_run;
+        while (run_walk.next_run(r)) {
+            ++runs;
+            ASSERT_LT(r.k, r.end);
+            ASSERT_LE(r.end, r.n);
+            EXPECT_EQ(r.n, segment_count(*r.iv, step));
+            for (std::int64_t k = r.k; k < r.end; ++k) by_run.push_back(segment(*r.iv, step, k, r.n));
+        }
+        ASSERT_EQ(by_run.size(), by_segment.size()) << "ray " << n;
+        EXPECT_EQ(std::memcmp(by_run.data(), by_segment.data(), by_run.size() * sizeof(Segment)), 0) << "ray " << n;
+    }
+    EXPECT_GT(all, 10000);
+    EXPECT_LT(visited, all);  // something was passed over
+    std::printf("visited %lld of %lld segments in %lld runs\n", (long long)visited, (long long)all, (long long)runs);
+}
+
 // ---- mip / minip: macrocells whose values cannot beat a ray's extremum so far -----------------
 
 // The walk in extremum mode against every segment: the same extremum, first reached at the same t,

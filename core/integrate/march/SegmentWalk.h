@@ -12,9 +12,11 @@
 //
 // Per interval, per run: the macrocell m of segment k's midpoint (macrocell_of, the sampler's own
 // placement); the segments up to where the ray leaves m (exit_distance, an estimate); if m is empty
-// the estimate is checked (bisected back when too long, extended by doubling when too short) and the
-// run is skipped: each axis' macrocell index is monotone in k (ray.at, the index map, floor and the
-// midpoints are monotone in floating point), so every segment between two in m is in m.
+// the estimate's last segment is checked (bisected back when it is outside; a short estimate leaves the
+// rest to the next check) and the run is skipped: each axis' macrocell index is monotone in k (ray.at,
+// the index map, floor and the midpoints are monotone in floating point), so every segment between two
+// in m is in m. A visited composite run is at least kMinVisitedRun segments long (empty segments in it
+// have opacity 0 and change nothing), to save checks.
 #pragma once
 #include <algorithm>
 #include <cmath>

@@ -91,11 +91,13 @@ struct RayPacketT {
     // point t_ref, relative to `local_origin` (the volume's origin), both in double before rounding,
     // and tm holds t - t_ref; so a volume far from the world origin loses no float precision
     // (issue 18: 0.235 off at origin 5e5). t_ref = 0 and world coordinates otherwise.
-    double t_ref[kLanes] = {};
+    HWY_ALIGN double t_ref[kLanes] = {};
     HWY_ALIGN T t_ref_lane[kLanes] = {};
     ForwardSegmentWalk walk[kLanes];
-    ForwardSegmentWalk::Run run[kLanes] = {};  // each lane's current run and its next segment
-    std::int64_t run_k[kLanes] = {};
+    // Each lane's current run (ForwardSegmentWalk::next_run) as doubles (integers exact below 2^53):
+    // its next segment k, the end of the run, n - 1 of its interval, and the interval's t0 and t1.
+    HWY_ALIGN double run_k[kLanes] = {}, run_end[kLanes] = {}, run_last[kLanes] = {}, run_t0[kLanes] = {},
+                     run_t1[kLanes] = {}, run_live[kLanes] = {};
     double step = 1.0;
     bool active[kLanes];
     std::size_t lanes = 0;
@@ -132,29 +134,49 @@ struct RayPacketT {
         }
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live
-    // (1/0); false when no lane is active any more. Each lane takes runs of segments from its walk
-    // (ForwardSegmentWalk::next_run) and places them with segment()'s arithmetic (SamplePlacement.h:
-    // a = t0 + k h, b = t0 + (k + 1) h or t1 for the last, midpoint (a + b) / 2, length b - a).
+    // (1/0); false when no lane is active any more. A lane whose run is used up takes the next one from
+    // its walk (ForwardSegmentWalk::next_run); then every lane's segment k is placed at once, on double
+    // vectors, with segment()'s arithmetic (SamplePlacement.h): a = t0 + k h, b = t1 for the last
+    // segment (k = n - 1), else t0 + (k + 1) h; midpoint (a + b) / 2, length b - a; then rounded to T.
     bool next() {
         bool any = false;
         for (std::size_t l = 0; l < lanes; ++l) {
-            if (active[l] && run_k[l] >= run[l].end) {
-                if (walk[l].next_run(run[l])) run_k[l] = run[l].k;
-                else active[l] = false;
+            if (active[l] && run_k[l] >= run_end[l]) {
+                ForwardSegmentWalk::Run r;
+                if (walk[l].next_run(r)) {
+                    run_k[l] = double(r.k);
+                    run_end[l] = double(r.end);
+                    run_last[l] = double(r.n - 1);
+                    run_t0[l] = r.iv->t0;
+                    run_t1[l] = r.iv->t1;
+                } else {
+                    active[l] = false;
+                }
             }
-            if (active[l]) {
-                const std::int64_t k = run_k[l]++;
-                const Interval& iv = *run[l].iv;
-                const double a = iv.t0 + double(k) * step;
-                const double b = k + 1 == run[l].n ? iv.t1 : iv.t0 + double(k + 1) * step;
-                tm[l] = T(0.5 * (a + b) - t_ref[l]);
-                len[l] = T(b - a);
-                live[l] = T(1);
-                any = true;
+            run_live[l] = active[l] ? 1.0 : 0.0;
+            any = any || active[l];
+        }
+        const hn::ScalableTag<double> dd;
+        const std::size_t nd = hn::Lanes(dd);
+        const auto h = hn::Set(dd, step), half = hn::Set(dd, 0.5), one = hn::Set(dd, 1.0), zero = hn::Zero(dd);
+        for (std::size_t i = 0; i < lanes; i += nd) {
+            const auto k = hn::Load(dd, run_k + i), t0 = hn::Load(dd, run_t0 + i);
+            const auto on = hn::Gt(hn::Load(dd, run_live + i), zero);
+            const auto a = hn::Add(t0, hn::Mul(k, h));
+            const auto b = hn::IfThenElse(hn::Eq(k, hn::Load(dd, run_last + i)), hn::Load(dd, run_t1 + i),
+                                          hn::Add(t0, hn::Mul(hn::Add(k, one), h)));
+            const auto mid = hn::IfThenElseZero(on, hn::Sub(hn::Mul(half, hn::Add(a, b)), hn::Load(dd, t_ref + i)));
+            const auto length = hn::IfThenElseZero(on, hn::Sub(b, a));
+            hn::Store(hn::IfThenElse(on, hn::Add(k, one), k), dd, run_k + i);
+            if constexpr (std::is_same_v<T, double>) {
+                hn::Store(mid, dd, tm + i);
+                hn::Store(length, dd, len + i);
+                hn::Store(hn::IfThenElseZero(on, one), dd, live + i);
             } else {
-                tm[l] = T(0);
-                len[l] = T(0);
-                live[l] = T(0);
+                const hn::Rebind<T, decltype(dd)> dt;
+                hn::Store(hn::DemoteTo(dt, mid), dt, tm + i);
+                hn::Store(hn::DemoteTo(dt, length), dt, len + i);
+                hn::Store(hn::DemoteTo(dt, hn::IfThenElseZero(on, one)), dt, live + i);
             }
         }
         return any;

@@ -282,9 +282,11 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             }
             acc.add(o.visible, o.solid, o.tau, o.alpha, m);
             const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));
-            hn::Store(hn::IfThenElseZero(stop, one), d, buf);
-            for (std::size_t l = 0; l < L; ++l)
-                if (buf[l] != T(0)) packet.active[l] = false;
+            if (!hn::AllFalse(d, stop)) {
+                hn::Store(hn::IfThenElseZero(stop, one), d, buf);
+                for (std::size_t l = 0; l < L; ++l)
+                    if (buf[l] != T(0)) packet.retire(l);
+            }
         }
     }
     const V A = acc.alpha();

@@ -139,25 +139,35 @@ struct RayPacketT {
     // vectors, with segment()'s arithmetic (SamplePlacement.h): a = t0 + k h, b = t1 for the last
     // segment (k = n - 1), else t0 + (k + 1) h; midpoint (a + b) / 2, length b - a; then rounded to T.
     bool next() {
-        bool any = false;
-        for (std::size_t l = 0; l < lanes; ++l) {
-            if (active[l] && run_k[l] >= run_end[l]) {
-                ForwardSegmentWalk::Run r;
-                if (walk[l].next_run(r)) {
-                    run_k[l] = double(r.k);
-                    run_end[l] = double(r.end);
-                    run_last[l] = double(r.n - 1);
-                    run_t0[l] = r.iv->t0;
-                    run_t1[l] = r.iv->t1;
-                } else {
-                    active[l] = false;
-                }
-            }
-            run_live[l] = active[l] ? 1.0 : 0.0;
-            any = any || active[l];
-        }
         const hn::ScalableTag<double> dd;
         const std::size_t nd = hn::Lanes(dd);
+        // Lanes whose run is used up (k >= end) go back to their walk; the check is on vectors, the
+        // refill lane by lane (one lane in a run's length of steps).
+        bool refill = !started_;
+        started_ = true;
+        for (std::size_t i = 0; i < lanes && !refill; i += nd)
+            refill = !hn::AllFalse(dd, hn::And(hn::Gt(hn::Load(dd, run_live + i), hn::Zero(dd)),
+                                               hn::Ge(hn::Load(dd, run_k + i), hn::Load(dd, run_end + i))));
+        if (refill) {
+            live_count_ = 0;
+            for (std::size_t l = 0; l < lanes; ++l) {
+                if (active[l] && run_k[l] >= run_end[l]) {
+                    ForwardSegmentWalk::Run r;
+                    if (walk[l].next_run(r)) {
+                        run_k[l] = double(r.k);
+                        run_end[l] = double(r.end);
+                        run_last[l] = double(r.n - 1);
+                        run_t0[l] = r.iv->t0;
+                        run_t1[l] = r.iv->t1;
+                    } else {
+                        active[l] = false;
+                    }
+                }
+                run_live[l] = active[l] ? 1.0 : 0.0;
+                live_count_ += active[l] ? 1 : 0;
+            }
+        }
+        if (live_count_ == 0) return false;
         const auto h = hn::Set(dd, step), half = hn::Set(dd, 0.5), one = hn::Set(dd, 1.0), zero = hn::Zero(dd);
         for (std::size_t i = 0; i < lanes; i += nd) {
             const auto k = hn::Load(dd, run_k + i), t0 = hn::Load(dd, run_t0 + i);
@@ -179,8 +189,19 @@ struct RayPacketT {
                 hn::Store(hn::DemoteTo(dt, hn::IfThenElseZero(on, one)), dt, live + i);
             }
         }
-        return any;
+        return true;
     }
+    // Ends lane l's ray (opaque or terminated early): the lane is inactive from the next step on.
+    void retire(std::size_t l) {
+        if (!active[l]) return;
+        active[l] = false;
+        run_live[l] = 0.0;
+        --live_count_;
+    }
+
+private:
+    bool started_ = false;
+    std::size_t live_count_ = 0;
 };
 using RayPacket = RayPacketT<double>;
 

@@ -59,6 +59,15 @@ std::array<double, 2> Volume::value_range() const {
 
 std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const std::string& what,
                                 std::size_t bytes_per_value) {
+    const std::size_t count = checked_voxel_count_unlimited(dims, what, bytes_per_value);
+    check_memory(count * std::max<std::size_t>(bytes_per_value, 1),
+                 what + ": a volume of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                     std::to_string(dims[2]));
+    return count;
+}
+
+std::size_t checked_voxel_count_unlimited(const std::array<std::int64_t, 3>& dims, const std::string& what,
+                                          std::size_t bytes_per_value) {
     // The largest volume volref accepts: 2^38 bytes (256 GiB) of doubles; a later --max-memory may lower it.
     constexpr std::size_t kMaxBytes = std::size_t(1) << 38;
     std::size_t count = 1;
@@ -75,9 +84,6 @@ std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const s
     if (count > kMaxBytes / std::max<std::size_t>(bytes_per_value, 1))
         throw Error(what + ": dims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
                     std::to_string(dims[2]) + " need more than 256 GiB");
-    check_memory(count * std::max<std::size_t>(bytes_per_value, 1),
-                 what + ": a volume of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-                     std::to_string(dims[2]));
     return count;
 }
 

@@ -56,5 +56,9 @@ struct Volume {
 // naming `what` otherwise. Returns the voxel count.
 std::size_t checked_voxel_count(const std::array<std::int64_t, 3>& dims, const std::string& what,
                                 std::size_t bytes_per_value = sizeof(double));
+// The same checks without the memory limit: for a header whose samples are not all read here (a
+// brick of the file is; core/io/VolumeLayout.h).
+std::size_t checked_voxel_count_unlimited(const std::array<std::int64_t, 3>& dims, const std::string& what,
+                                          std::size_t bytes_per_value = sizeof(double));
 
 }  // namespace volref

@@ -1,5 +1,6 @@
 #include "core/io/MetaImageReader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -10,6 +11,7 @@
 
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/VolumeLayout.h"
 
 namespace volref {
 
@@ -159,10 +161,27 @@ ScalarType element_type(const Fields& fields) {
 
 }  // namespace
 
-Volume read_metaimage(const std::filesystem::path& path) {
+namespace {
+
+// The header and what it says about the data, shared by read_metaimage and metaimage_layout.
+struct ParsedMetaImage {
+    Header header;
+    Volume volume;  // dims, spacing, origin; no samples
+    ScalarType type = ScalarType::U8;
+    bool msb = false, compressed = false;
+    std::optional<std::int64_t> compressed_size;
+    std::int64_t header_size = 0;
+    bool local = false;            // ElementDataFile = LOCAL
+    std::filesystem::path data;    // the data file (the file itself when local)
+    std::string at;                // how errors in the data name it
+};
+
+// `limited`: the whole volume is about to be read (its size is checked against the memory limit).
+ParsedMetaImage parse_metaimage(const std::filesystem::path& path, const std::string& file, bool limited) {
     const std::string where = path.string();
-    const std::string file = io::read_file_bytes(path);
-    const Header header = parse_header(file, where);
+    ParsedMetaImage p;
+    p.header = parse_header(file, where);
+    const Header& header = p.header;
     const Fields fields(header, where);
 
     if (const Field* f = fields.find("objecttype"); f && lower(f->value) != "image")
@@ -172,7 +191,7 @@ Volume read_metaimage(const std::filesystem::path& path) {
     if (ndims > 3) fields.fail(ndims_field, std::to_string(ndims) + " dimensions are not supported (volref reads 1 to 3)");
     const auto n = static_cast<std::size_t>(ndims);
 
-    Volume volume;
+    Volume& volume = p.volume;
     volume.dims = {1, 1, 1};
     const Field& dim_field = fields.require("dimsize", "DimSize");
     const std::vector<double> dims = fields.numbers(dim_field, n, true);
@@ -181,7 +200,7 @@ Volume read_metaimage(const std::filesystem::path& path) {
             fields.fail(dim_field, "expected integers >= 1, got " + io::quoted(dim_field.value));
         volume.dims[a] = static_cast<std::int64_t>(dims[a]);
     }
-    const ScalarType type = element_type(fields);
+    p.type = element_type(fields);
     if (const Field* f = fields.find("elementnumberofchannels"); f && fields.integer(*f, 1) != 1)
         fields.fail(*f, "only 1 channel is supported, got " + io::quoted(f->value));
     if (const Field* f = fields.find_any({"elementspacing", "elementsize"})) {
@@ -202,53 +221,100 @@ Volume read_metaimage(const std::filesystem::path& path) {
     }
     if (const Field* f = fields.find("binarydata"); f && !fields.boolean(*f))
         fields.fail(*f, "ASCII MetaImage data (BinaryData = False) is not supported");
-    bool msb = false;
-    if (const Field* f = fields.find_any({"binarydatabyteordermsb", "elementbyteordermsb"})) msb = fields.boolean(*f);
-    bool compressed = false;
-    if (const Field* f = fields.find("compresseddata")) compressed = fields.boolean(*f);
-    std::optional<std::int64_t> compressed_size;
-    if (const Field* f = fields.find("compresseddatasize")) compressed_size = fields.integer(*f, 0);
-    std::int64_t header_size = 0;
-    if (const Field* f = fields.find("headersize")) header_size = fields.integer(*f, -1);
-    checked_voxel_count(volume.dims, where, scalar_type_size(type));
+    if (const Field* f = fields.find_any({"binarydatabyteordermsb", "elementbyteordermsb"})) p.msb = fields.boolean(*f);
+    if (const Field* f = fields.find("compresseddata")) p.compressed = fields.boolean(*f);
+    if (const Field* f = fields.find("compresseddatasize")) p.compressed_size = fields.integer(*f, 0);
+    if (const Field* f = fields.find("headersize")) p.header_size = fields.integer(*f, -1);
+    if (limited) checked_voxel_count(volume.dims, where, scalar_type_size(p.type));
+    else checked_voxel_count_unlimited(volume.dims, where, scalar_type_size(p.type));
     if (!header.has_data_file) throw Error(where + ": missing required key 'ElementDataFile'");
     const Field& data_field = *fields.find("elementdatafile");
+    if (p.compressed && p.header_size != 0)
+        fields.fail(*fields.find("headersize"), "HeaderSize with CompressedData is not supported");
 
-    // The data region: after the header line (LOCAL), or the named file (read in pieces, straight
-    // into the volume).
-    std::string data_where = where;
-    std::optional<io::ByteSource> source;
+    // The data region: after the header line (LOCAL), or the named file.
     const std::string data_name = data_field.value;
-    if (lower(data_name) == "local") {
-        source.emplace(std::string_view(file).substr(header.data_offset));
+    p.local = lower(data_name) == "local";
+    if (p.local) {
+        p.data = path;
+        p.at = where;
     } else {
         if (lower(data_name) == "list" || data_name.find('%') != std::string::npos ||
             split_words(data_name).size() > 1)
             fields.fail(data_field, "several data files are not supported (give one file or LOCAL)");
-        std::filesystem::path p(data_name);
-        if (p.is_relative()) p = path.parent_path() / p;
-        source.emplace(p, 0, p.string());
-        data_where = p.string() + " (data file of " + where + ")";
+        p.data = std::filesystem::path(data_name);
+        if (p.data.is_relative()) p.data = path.parent_path() / p.data;
+        // Errors in a data file name it first.
+        p.at = p.data.string() + " (data file of " + where + ")";
     }
-    // Errors in a data file name it first.
-    const std::string at = lower(data_name) == "local" ? where : data_where;
+    return p;
+}
+
+}  // namespace
+
+Volume read_metaimage(const std::filesystem::path& path) {
+    const std::string file = io::read_file_bytes(path);
+    ParsedMetaImage p = parse_metaimage(path, file, true);
+    Volume& volume = p.volume;
+    // The data: after the header line (LOCAL), or the named file (read in pieces, straight into the
+    // volume).
+    std::optional<io::ByteSource> source;
+    if (p.local) source.emplace(std::string_view(file).substr(p.header.data_offset));
+    else source.emplace(p.data, 0, p.data.string());
+    const std::string& at = p.at;
     const std::uint64_t region_size = source->size();
-    const std::endian order = msb ? std::endian::big : std::endian::little;
-    if (compressed) {
-        if (header_size != 0) fields.fail(*fields.find("headersize"), "HeaderSize with CompressedData is not supported");
-        if (compressed_size) {
-            if (std::uint64_t(*compressed_size) > region_size)
-                throw Error(at + ": truncated: CompressedDataSize is " + std::to_string(*compressed_size) +
+    const std::endian order = p.msb ? std::endian::big : std::endian::little;
+    if (p.compressed) {
+        if (p.compressed_size) {
+            if (std::uint64_t(*p.compressed_size) > region_size)
+                throw Error(at + ": truncated: CompressedDataSize is " + std::to_string(*p.compressed_size) +
                             " bytes, found " + std::to_string(region_size));
-            if (std::uint64_t(*compressed_size) < region_size)
-                throw Error(at + ": CompressedDataSize is " + std::to_string(*compressed_size) + " bytes, but " +
+            if (std::uint64_t(*p.compressed_size) < region_size)
+                throw Error(at + ": CompressedDataSize is " + std::to_string(*p.compressed_size) + " bytes, but " +
                             std::to_string(region_size) + " bytes of compressed data follow");
         }
-        io::read_samples(volume, type, order, *source, io::BinaryEncoding::Gzip, 0, at);
+        io::read_samples(volume, p.type, order, *source, io::BinaryEncoding::Gzip, 0, at);
     } else {
-        io::read_samples(volume, type, order, *source, io::BinaryEncoding::Raw, header_size, at);
+        io::read_samples(volume, p.type, order, *source, io::BinaryEncoding::Raw, p.header_size, at);
     }
     return volume;
+}
+
+VolumeLayout metaimage_layout(const std::filesystem::path& path) {
+    // The header only: it ends with the ElementDataFile line (an .mha's samples follow it).
+    constexpr std::size_t kPrefix = std::size_t(1) << 20;
+    bool whole = false;
+    std::string file = io::read_file_prefix(path, kPrefix, whole);
+    ParsedMetaImage p = parse_metaimage(path, file, false);
+    if (!whole && (!p.header.has_data_file || p.header.data_offset >= file.size())) {
+        file = io::read_file_bytes(path);  // a header longer than the prefix
+        p = parse_metaimage(path, file, false);
+    }
+    VolumeLayout out;
+    out.dims = p.volume.dims;
+    out.origin = p.volume.origin;
+    out.spacing = p.volume.spacing;
+    out.type = p.type;
+    out.endian = p.msb ? std::endian::big : std::endian::little;
+    out.data = p.data;
+    out.data_where = p.at;
+    if (p.compressed) {
+        out.not_direct = "compressed data (CompressedData = True)";
+        return out;
+    }
+    const std::uint64_t base = p.local ? p.header.data_offset : 0;
+    if (p.header_size >= 0) {
+        out.offset = base + std::uint64_t(p.header_size);
+    } else {  // -1: the samples end the file
+        const std::uint64_t bytes = std::uint64_t(checked_voxel_count_unlimited(out.dims, path.string(), scalar_type_size(out.type))) *
+                                    scalar_type_size(out.type);
+        std::error_code ec;
+        const std::uint64_t size = std::filesystem::file_size(out.data, ec);
+        if (ec) throw Error(out.data_where + ": cannot read the file's size");
+        if (size < base + bytes) throw Error(io::truncated_message(out.data_where, bytes, size - std::min(size, base)));
+        out.offset = size - bytes;
+    }
+    return out;
 }
 
 }  // namespace volref

@@ -13,6 +13,7 @@
 
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/VolumeLayout.h"
 
 namespace volref {
 
@@ -185,7 +186,22 @@ Orientation orientation(const nifti_image& nim, const std::string& where) {
 
 }  // namespace
 
-Volume read_nifti(const std::filesystem::path& path) {
+namespace {
+
+// The header and what it says about the image bytes, shared by read_nifti and nifti_layout.
+struct ParsedNifti {
+    ScalarType type = ScalarType::U8;
+    std::array<std::int64_t, 3> file_dims{1, 1, 1};
+    std::size_t count = 0;
+    Orientation o;
+    std::filesystem::path image_path;
+    std::uint64_t offset = 0;
+    std::endian order = std::endian::little;
+    double slope = 0.0, inter = 0.0;
+};
+
+// `limited`: the whole volume is about to be read (its size is checked against the memory limit).
+ParsedNifti parse_nifti(const std::filesystem::path& path, bool limited) {
     const std::string where = path.string();
     io::open_for_reading(path);
     static std::once_flag quiet;
@@ -205,23 +221,70 @@ Volume read_nifti(const std::filesystem::path& path) {
         if (raw.dim[std::size_t(i)] > 1)
             throw Error(where + ": dim[" + std::to_string(i) + "] is " + std::to_string(raw.dim[std::size_t(i)]) +
                         ": images of more than 3 dimensions (time series, vectors) are not supported");
-    const ScalarType type = scalar_type(raw.datatype, version, where);
+    ParsedNifti p;
+    p.type = scalar_type(raw.datatype, version, where);
 
     std::unique_ptr<nifti_image, ImageDeleter> nim(nifti_image_read(path.c_str(), 0));
     if (!nim) throw Error(where + ": nifti_clib could not read the header (see nifti_tool -check_hdr)");
-    const std::array<std::int64_t, 3> file_dims{raw.dim[1], ndim >= 2 ? raw.dim[2] : 1, ndim >= 3 ? raw.dim[3] : 1};
-    const std::size_t count = checked_voxel_count(file_dims, where, scalar_type_size(type));
-    const Orientation o = orientation(*nim, where);
+    p.file_dims = {raw.dim[1], ndim >= 2 ? raw.dim[2] : 1, ndim >= 3 ? raw.dim[3] : 1};
+    p.count = limited ? checked_voxel_count(p.file_dims, where, scalar_type_size(p.type))
+                      : checked_voxel_count_unlimited(p.file_dims, where, scalar_type_size(p.type));
+    p.o = orientation(*nim, where);
 
     // The image bytes: in the same file after vox_offset (.nii), or in the .img file.
-    const std::filesystem::path image_path = nim->iname ? std::filesystem::path(nim->iname) : path;
+    p.image_path = nim->iname ? std::filesystem::path(nim->iname) : path;
     if (nim->iname_offset < 0) throw Error(where + ": vox_offset must be >= 0");
-    const auto offset = static_cast<std::uint64_t>(nim->iname_offset);
+    p.offset = static_cast<std::uint64_t>(nim->iname_offset);
+    // nifti_clib's MSB_FIRST (2) is defined only inside the library.
+    p.order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
+    p.slope = nim->scl_slope;
+    p.inter = nim->scl_inter;
+    return p;
+}
+
+// Scaling: value = slope * stored + inter, when slope is set and not the identity (f64 values).
+bool scales(double slope, double inter) {
+    return std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0);
+}
+
+}  // namespace
+
+VolumeLayout nifti_layout(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    const ParsedNifti p = parse_nifti(path, false);
+    VolumeLayout out;
+    out.dims = p.file_dims;
+    out.type = p.type;
+    out.endian = p.order;
+    out.data = p.image_path;
+    out.data_where = p.image_path == path ? where : p.image_path.string() + " (image file of " + where + ")";
+    out.offset = p.offset;
+    out.scaled = scales(p.slope, p.inter);
+    out.slope = p.slope;
+    out.inter = p.inter;
+    const bool identity = p.o.axis == std::array<int, 3>{0, 1, 2} && !p.o.flip[0] && !p.o.flip[1] && !p.o.flip[2];
+    for (int a = 0; a < 3; ++a) {
+        out.spacing[a] = p.o.spacing[a];
+        out.origin[a] = p.o.offset[a];
+    }
+    if (nifti_is_gzfile(p.image_path.c_str())) out.not_direct = "gzip compression";
+    else if (!identity) out.not_direct = "a flipped or permuted orientation (the " + p.o.source + ")";
+    return out;
+}
+
+Volume read_nifti(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    const ParsedNifti p = parse_nifti(path, true);
+    const ScalarType type = p.type;
+    const std::array<std::int64_t, 3>& file_dims = p.file_dims;
+    const std::size_t count = p.count;
+    const Orientation& o = p.o;
+    const std::filesystem::path& image_path = p.image_path;
+    const std::uint64_t offset = p.offset;
     const std::size_t expected = count * scalar_type_size(type);
     // Errors in a separate .img file start with its path and end with "(image file of HEADER)".
     const std::string at = image_path.string();
-    // nifti_clib's MSB_FIRST (2) is defined only inside the library.
-    const std::endian order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
+    const std::endian order = p.order;
     // The stored samples, in the file's type and voxel order, read in pieces straight into memory.
     Volume stored;
     stored.dims = file_dims;
@@ -250,8 +313,8 @@ Volume read_nifti(const std::filesystem::path& path) {
     io::to_native_order(stored.values, order);
 
     // Scaling: value = slope * stored + inter, when slope is set and not the identity (f64 values).
-    const double slope = nim->scl_slope, inter = nim->scl_inter;
-    if (std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) && (slope != 1.0 || inter != 0.0)) {
+    const double slope = p.slope, inter = p.inter;
+    if (scales(slope, inter)) {
         checked_voxel_count(file_dims, where + ": scaled by scl_slope", sizeof(double));
         VoxelArray scaled(ScalarType::F64, count);
         double* out = scaled.data<double>();

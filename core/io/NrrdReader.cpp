@@ -1,5 +1,6 @@
 #include "core/io/NrrdReader.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/VolumeLayout.h"
 
 namespace volref {
 
@@ -558,27 +560,40 @@ bool has_header_end(std::string_view prefix) {
 
 }  // namespace
 
-Volume read_nrrd(const std::filesystem::path& path) {
+namespace {
+
+// The header and what it says about the data, shared by read_nrrd and nrrd_layout.
+struct ParsedNrrd {
+    std::string file;  // the start of the file (all of it when `whole`)
+    bool whole = false;
+    NrrdHeader header;
+    Volume volume;  // dims, type, spacing, origin; no samples
+    DataLayout layout;
+    std::optional<std::filesystem::path> data_path;  // a detached header's data file
+};
+
+// `limited`: the whole volume is about to be read (its size is checked against the memory limit).
+ParsedNrrd parse_nrrd(const std::filesystem::path& path, bool limited) {
     const std::string where = path.string();
+    ParsedNrrd p;
     // The header, from the start of the file: a big file's attached data is not read here.
     constexpr std::size_t kPrefix = std::size_t(1) << 20;
-    bool whole = false;
-    std::string file = io::read_file_prefix(path, kPrefix, whole);
-    if (!whole && !has_header_end(file)) {
-        file = io::read_file_bytes(path);
-        whole = true;
+    p.file = io::read_file_prefix(path, kPrefix, p.whole);
+    if (!p.whole && !has_header_end(p.file)) {
+        p.file = io::read_file_bytes(path);
+        p.whole = true;
     }
-    const NrrdHeader header = parse_header(file, where);
-    const Fields fields(header, where);
+    p.header = parse_header(p.file, where);
+    const Fields fields(p.header, where);
 
-    Volume volume;
+    Volume& volume = p.volume;
     const int dimension = parse_dimension(fields);
     volume.type = parse_type(fields);
     volume.dims = parse_sizes(fields, dimension);
     volume.spacing = parse_spacing(fields, dimension);
     volume.origin = parse_origin(fields, dimension);
 
-    DataLayout layout;
+    DataLayout& layout = p.layout;
     layout.type = volume.type;
     layout.encoding = parse_encoding(fields);
     // The NRRD format requires `endian` whenever byte order matters: multi-byte raw or gzip data.
@@ -591,10 +606,25 @@ Volume read_nrrd(const std::filesystem::path& path) {
     layout.byte_skip = parse_skip(fields, "byte skip", -1);
     if (layout.byte_skip == -1 && layout.encoding != Encoding::Raw)
         fields.fail("byte skip", "-1 (data at the end of the file) is only allowed with raw encoding");
-    layout.count = checked_voxel_count(volume.dims, where, scalar_type_size(volume.type));
+    layout.count = limited ? checked_voxel_count(volume.dims, where, scalar_type_size(volume.type))
+                           : checked_voxel_count_unlimited(volume.dims, where, scalar_type_size(volume.type));
+    if (fields.find("data file")) p.data_path = parse_data_file(fields, path);
+    return p;
+}
 
-    if (fields.find("data file")) {
-        const std::filesystem::path data_path = parse_data_file(fields, path);
+[[noreturn]] void no_data(const std::string& where) {
+    throw Error(where + ": no data: the header has no 'data file' field and no blank line before attached data");
+}
+
+}  // namespace
+
+Volume read_nrrd(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    ParsedNrrd p = parse_nrrd(path, true);
+    Volume& volume = p.volume;
+    const DataLayout& layout = p.layout;
+    if (p.data_path) {
+        const std::filesystem::path& data_path = *p.data_path;
         try {
             if (streamable(layout)) {
                 io::ByteSource source(data_path, 0, data_path.string());
@@ -606,20 +636,57 @@ Volume read_nrrd(const std::filesystem::path& path) {
         } catch (const Error& e) {
             throw Error(std::string(e.what()) + " (data file of " + where + ")");
         }
-    } else if (header.data_offset) {
+    } else if (p.header.data_offset) {
         if (streamable(layout)) {
-            io::ByteSource source(path, *header.data_offset, where);
+            io::ByteSource source(path, *p.header.data_offset, where);
             io::read_samples(volume, layout.type, layout.endian, source, binary_encoding(layout), layout.byte_skip, where);
         } else {
-            if (!whole) file = io::read_file_bytes(path);
-            decode_data(volume, std::string_view(file).substr(*header.data_offset), layout, where);
+            if (!p.whole) p.file = io::read_file_bytes(path);
+            decode_data(volume, std::string_view(p.file).substr(*p.header.data_offset), layout, where);
         }
     } else {
-        throw Error(where +
-                    ": no data: the header has no 'data file' field and no blank line before attached data");
+        no_data(where);
     }
     volume.type = layout.type;
     return volume;
+}
+
+VolumeLayout nrrd_layout(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    const ParsedNrrd p = parse_nrrd(path, false);
+    const DataLayout& layout = p.layout;
+    VolumeLayout out;
+    out.dims = p.volume.dims;
+    out.origin = p.volume.origin;
+    out.spacing = p.volume.spacing;
+    out.type = layout.type;
+    out.endian = layout.endian;
+    std::uint64_t base = 0;
+    if (p.data_path) {
+        out.data = *p.data_path;
+        out.data_where = p.data_path->string() + " (data file of " + where + ")";
+    } else if (p.header.data_offset) {
+        out.data = path;
+        out.data_where = where;
+        base = *p.header.data_offset;
+    } else {
+        no_data(where);
+    }
+    if (layout.encoding == Encoding::Gzip) out.not_direct = "gzip encoding";
+    else if (layout.encoding == Encoding::Ascii) out.not_direct = "ascii encoding";
+    else if (layout.line_skip != 0) out.not_direct = "a line skip";
+    if (!out.not_direct.empty()) return out;
+    if (layout.byte_skip >= 0) {
+        out.offset = base + std::uint64_t(layout.byte_skip);
+    } else {  // -1: the samples end the file
+        const std::uint64_t bytes = std::uint64_t(layout.count) * scalar_type_size(layout.type);
+        std::error_code ec;
+        const std::uint64_t size = std::filesystem::file_size(out.data, ec);
+        if (ec) throw Error(out.data_where + ": cannot read the file's size");
+        if (size < base + bytes) throw Error(io::truncated_message(out.data_where, bytes, size - std::min(size, base)));
+        out.offset = size - bytes;
+    }
+    return out;
 }
 
 }  // namespace volref

@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/VolumeLayout.h"
 
 namespace volref {
 
@@ -182,6 +183,26 @@ Volume read_raw_volume(const std::filesystem::path& path) {
     io::ByteSource data(path, 0, where);
     io::read_samples(volume, sidecar.type, sidecar.endian, data, sidecar.encoding, sidecar.header_bytes, where);
     return volume;
+}
+
+VolumeLayout raw_layout(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    io::open_for_reading(path);  // as read_raw_volume: a wrong data path is reported as such
+    std::filesystem::path sidecar_path = path;
+    sidecar_path += ".json";
+    const Sidecar sidecar = read_sidecar(sidecar_path, where);
+    checked_voxel_count_unlimited(sidecar.dims, sidecar_path.string(), scalar_type_size(sidecar.type));
+    VolumeLayout out;
+    out.dims = sidecar.dims;
+    out.origin = sidecar.origin;
+    out.spacing = sidecar.spacing;
+    out.type = sidecar.type;
+    out.endian = sidecar.endian;
+    out.data = path;
+    out.data_where = where;
+    out.offset = std::uint64_t(sidecar.header_bytes);
+    if (sidecar.encoding == io::BinaryEncoding::Gzip) out.not_direct = "gzip encoding";
+    return out;
 }
 
 }  // namespace volref

@@ -9,6 +9,7 @@
 #include "core/io/NiftiReader.h"
 #include "core/io/NrrdReader.h"
 #include "core/io/RawReader.h"
+#include "core/io/VolumeLayout.h"
 #include "core/io/VtiReader.h"
 #include "core/io/VtkLegacyReader.h"
 
@@ -64,6 +65,16 @@ Volume read_volume(const std::filesystem::path& path, const std::string& format)
     if (chosen == "vtk") return read_vtk_legacy(path);
     if (chosen == "vti") return read_vti(path);
     return read_den(path);
+}
+
+VolumeLayout volume_layout(const std::filesystem::path& path, const std::string& format) {
+    const std::string chosen = volume_format(path, format);
+    if (chosen == "nrrd") return nrrd_layout(path);
+    if (chosen == "raw") return raw_layout(path);
+    if (chosen == "nifti") return nifti_layout(path);
+    if (chosen == "metaimage") return metaimage_layout(path);
+    throw Error(path.string() + ": the " + chosen +
+                " format has no sub-box reader (nrrd, raw, nifti and metaimage do; convert with `volref convert`)");
 }
 
 }  // namespace volref

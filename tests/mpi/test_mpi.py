@@ -1,14 +1,18 @@
 #!/usr/bin/python3
 """volref-mpi against the single-process `volref render` (cli/mpi/CMakeLists.txt registers each mode).
 
-equal --np N : every supported projection and order, orthographic and perspective, unshaded and
-               shaded, crop and clip planes, on a procedural field: `mpirun -np N volref-mpi render`
-               equals `volref render` within 1e-12 (`volref compare --tolerance 1e-12`; conventions §14).
+equal --np N [--compositing direct|swap]
+             : every supported projection (first hit included) and order, orthographic and
+               perspective, unshaded and shaded, crop and clip planes, on a procedural field:
+               `mpirun -np N volref-mpi render` equals `volref render` within 1e-12 (conventions §14),
+               with binary swap or direct send compositing; closed forms for constant media and f = z.
 raw          : a raw file read as bricks (sub-box reads) by 2, 3 and 4 ranks equals `volref render`.
 memory       : a raw volume over one rank's --max-memory: refused in one line by 1 rank, rendered by 4
                (and equal to `volref render` without the limit).
 failed       : a truncated raw file whose last brick cannot be read: exit status != 0, exactly one
                `volref: error:` line naming the file, no image.
+formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.nii, scaled) read as bricks
+               by 2, 3 and 4 ranks equal `volref render`; gzip data and a flipped NIfTI are one-line errors.
 refusals     : scenes outside the first version's scope are refused in one line naming the key.
 """
 import argparse, json, os, shutil, struct, subprocess, sys, math
@@ -21,7 +25,9 @@ ap.add_argument("--dump", required=True, help="volref_image_dump (tests/identity
 ap.add_argument("--work", required=True)
 ap.add_argument("mode")
 ap.add_argument("--np", type=int, default=2)
+ap.add_argument("--compositing", choices=("direct", "swap"), help="volref-mpi's --compositing (default: its default)")
 a = ap.parse_args()
+comp = ["--compositing", a.compositing] if a.compositing else []
 
 # ctest sets these (cli/mpi/CMakeLists.txt); the defaults let the script run by hand too. Root (CI) needs
 # the first two; 4 ranks on a 2-core machine need oversubscription; containers often forbid the
@@ -72,7 +78,7 @@ def check_equal(name, scene_path, np, extra=(), tolerance=1e-12):
             name, r.stderr.strip(), open(err).read().strip() if os.path.exists(err) else ""))
         return
     out = os.path.join(a.work, name + ".np%d.img" % np)
-    r = mpirun(np, ["render", scene_path, "-o", out, "--threads", "1"] + list(extra))
+    r = mpirun(np, ["render", scene_path, "-o", out, "--threads", "1"] + comp + list(extra))
     if r.returncode != 0 or not os.path.exists(out):
         failures.append("%s np=%d: volref-mpi failed (%d): %s" % (name, np, r.returncode, r.stderr.strip()))
         return
@@ -81,8 +87,9 @@ def check_equal(name, scene_path, np, extra=(), tolerance=1e-12):
     if (w0, h0, c0) != (w1, h1, c1):
         failures.append("%s np=%d: image %s differs from the reference's %s" % (name, np, (w1, h1, c1), (w0, h0, c0)))
         return
-    diff = max((abs(x - y) for x, y in zip(p0, p1)), default=0.0)
-    covered = sum(1 for i in range(3, len(p0), 4) if p0[i] != 0.0)
+    # Equal values (the first hit's Z = +inf on a miss) differ by 0.
+    diff = max((0.0 if x == y else abs(x - y) for x, y in zip(p0, p1)), default=0.0)
+    covered = sum(1 for i in range(c0.index("A"), len(p0), len(c0)) if p0[i] != 0.0)
     if not diff <= tolerance:
         failures.append("%s np=%d: max abs difference %.3e over %g" % (name, np, diff, tolerance))
     elif covered == 0:
@@ -96,7 +103,7 @@ def check_exr(name, scene_path, np):
     ref = os.path.join(a.work, name + ".ref.exr")
     out = os.path.join(a.work, name + ".np%d.exr" % np)
     r = run([a.volref, "render", scene_path, "-o", ref])
-    r2 = mpirun(np, ["render", scene_path, "-o", out])
+    r2 = mpirun(np, ["render", scene_path, "-o", out] + comp)
     if r.returncode != 0 or r2.returncode != 0:
         failures.append("%s: EXR renders failed: %s %s" % (name, r.stderr.strip(), r2.stderr.strip()))
         return
@@ -126,6 +133,8 @@ def base_scene(projection, camera, shaded=False, order="front-to-back"):
     render = {"projection": projection, "step": 0.37}
     if projection == "composite":
         render["order"] = order
+    if projection == "first-hit":
+        render["isovalue"] = 0.5
     return {"volume": vol, "camera": cams[camera], "image": {"width": 33, "height": 27}, "render": render}
 
 
@@ -135,8 +144,19 @@ if a.mode == "equal":
         cases.append(("composite-ftb-" + cam, base_scene("composite", cam)))
         cases.append(("composite-btf-" + cam, base_scene("composite", cam, order="back-to-front")))
         cases.append(("shaded-ftb-" + cam, base_scene("composite", cam, shaded=True)))
-        for p in ("mip", "minip", "average", "xray"):
+        for p in ("mip", "minip", "average", "xray", "first-hit"):
             cases.append((p + "-" + cam, base_scene(p, cam)))
+        cases.append(("shaded-first-hit-" + cam, base_scene("first-hit", cam, shaded=True)))
+    # First hit by bisection (tricubic: no exact cell-cubic search) and with a step of 2.6 voxels (the
+    # ghost layer reaches half a step beyond the brick).
+    s = base_scene("first-hit", "persp", shaded=True)
+    s["volume"]["interpolation"] = "tricubic-bspline"
+    cases.append(("first-hit-tricubic-persp", s))
+    s = base_scene("first-hit", "ortho")
+    s["render"]["step"] = 2.6
+    s["volume"]["crop"] = {"planes": [0, 8, 4, 14, 3, 12], "regions": 134217727 ^ (1 << 13)}
+    s["volume"]["clip_planes"] = [{"point": [7, 11, 10], "normal": [1, 1, 0]}]
+    cases.append(("first-hit-step-crop-clip-ortho", s))
     s = base_scene("composite", "persp", shaded=True, order="back-to-front")
     s["volume"]["interpolation"] = "tricubic-catmull-rom"
     cases.append(("shaded-btf-tricubic-persp", s))
@@ -160,6 +180,9 @@ if a.mode == "equal":
         "xray": lambda ch: 32.0 * 0.125 if ch < 3 else 1.0,
         "average": lambda ch: 1.0,
     }
+    # First hit on f = z (world), seen from above along -z: the hit is z = 10.3 exactly in the lowest
+    # bricks (the first ones the ray meets hold no crossing), Z = 100 - 10.3, colour (1, 0.5, 0.25), A = 1.
+    closed["first-hit"] = lambda ch: [1.0, 0.5, 0.25, 1.0, 100.0 - 10.3][ch]
     for projection, expect in closed.items():
         name = "constant-" + projection
         scene = {"volume": {"source": {"field": "constant", "value": 1.0, "dims": [9, 9, 33]},
@@ -168,18 +191,28 @@ if a.mode == "equal":
                  "camera": {"type": "orthographic", "eye": [4, 4, 100], "target": [4, 4, 16], "up": [0, 1, 0], "height": 4},
                  "image": {"width": 16, "height": 12},
                  "render": {"projection": projection, "step": 0.37, "gain": 0.125}}
+        if projection == "first-hit":
+            scene["volume"]["source"] = {"field": "linear", "coefficients": [0, 0, 1, 0], "dims": [9, 9, 33]}
+            scene["volume"]["transfer"]["color"] = [[0.0, 1.0, 0.5, 0.25], [40.0, 1.0, 0.5, 0.25]]
+            scene["volume"]["transfer"]["opacity"] = [[0.0, 0.5], [40.0, 0.5]]
+            scene["render"]["isovalue"] = 10.3
         path = write_scene(name, scene)
         out = os.path.join(a.work, name + ".np%d.img" % a.np)
-        r = mpirun(a.np, ["render", path, "-o", out, "--threads", "1"])
+        r = mpirun(a.np, ["render", path, "-o", out, "--threads", "1"] + comp)
         if r.returncode != 0:
             failures.append("%s: volref-mpi failed: %s" % (name, r.stderr.strip()))
             continue
-        _, _, _, px = read_img(out)
-        worst = max(abs(px[i] - expect(i % 4)) for i in range(len(px)))
+        _, _, chans, px = read_img(out)
+        worst = max(abs(px[i] - expect(i % len(chans))) for i in range(len(px)))
         if not worst <= 1e-12:
             failures.append("%s np=%d: %.3e from the closed form" % (name, a.np, worst))
         else:
             print("ok %s np=%d: closed form within %.3e" % (name, a.np, worst))
+        # Binary swap asked for with a rank count that is not a power of two: direct send, said once.
+        if a.compositing == "swap" and a.np & (a.np - 1):
+            note = "volref-mpi: note: binary swap needs a power-of-two rank count; %d ranks used direct send" % a.np
+            if r.stderr.strip() != note:
+                failures.append("%s np=%d: expected the note %r on stderr, got %r" % (name, a.np, note, r.stderr))
 
 
 def write_raw(name, dims, fmt, value, truncate_to=None):
@@ -220,6 +253,103 @@ if a.mode == "raw":
         check_equal("raw-shaded", write_scene("raw-shaded", raw_scene(path, shaded=True)), np)
         check_equal("raw-mip", write_scene("raw-mip", raw_scene(path, "mip")), np)
 
+def field_bytes(dims, fmt):
+    """smooth() at every voxel, x fastest, packed with struct format `fmt` ("<f", ">f", "<d", ...)."""
+    nx, ny, nz = dims
+    values = [smooth(i, j, k) for k in range(nz) for j in range(ny) for i in range(nx)]
+    return struct.pack("%s%d%s" % (fmt[0], len(values), fmt[1]), *values)
+
+
+def write_nifti(path, dims, spacing, origin, slope=0.0, inter=0.0, flip_x=False):
+    """NIfTI-1 (.nii), sform_code 1 with an axis-aligned sform, float32 data after vox_offset 352."""
+    nx, ny, nz = dims
+    h = bytearray(348)
+    struct.pack_into("<i", h, 0, 348)
+    struct.pack_into("<8h", h, 40, 3, nx, ny, nz, 1, 1, 1, 1)
+    struct.pack_into("<hh", h, 70, 16, 32)  # DT_FLOAT32, bitpix
+    struct.pack_into("<8f", h, 76, 1.0, spacing[0], spacing[1], spacing[2], 1, 1, 1, 1)
+    struct.pack_into("<fff", h, 108, 352.0, slope, inter)
+    struct.pack_into("<hh", h, 252, 0, 1)  # qform_code 0, sform_code 1
+    sx = -spacing[0] if flip_x else spacing[0]
+    struct.pack_into("<4f", h, 280, sx, 0, 0, origin[0])
+    struct.pack_into("<4f", h, 296, 0, spacing[1], 0, origin[1])
+    struct.pack_into("<4f", h, 312, 0, 0, spacing[2], origin[2])
+    h[344:348] = b"n+1\0"
+    with open(path, "wb") as f:
+        f.write(bytes(h) + b"\0\0\0\0" + field_bytes(dims, "<f"))
+
+
+def one_error(name, scene, expect):
+    out = os.path.join(a.work, name + ".exr")
+    r = mpirun(2, ["render", write_scene(name, scene), "-o", out])
+    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+    if r.returncode == 0 or len(lines) != 1 or expect not in lines[0] or os.path.exists(out):
+        failures.append("%s: expected one error line with %r and no image, got %d %r" % (name, expect, r.returncode, r.stderr))
+    else:
+        print("ok %s: %s" % (name, lines[0]))
+
+
+if a.mode == "formats":
+    # The same field in every format volref-mpi reads as a sub-box; each rendered by 2, 3 and 4 ranks
+    # against `volref render` (which reads the whole file with the same reader).
+    dims = [26, 22, 30]
+    files = {}
+    # NRRD, attached header, raw encoding, big endian, with a byte skip.
+    p = os.path.join(a.work, "field.nrrd")
+    with open(p, "wb") as f:
+        f.write(("NRRD0004\ntype: float\ndimension: 3\nsizes: %d %d %d\nspacings: 1 0.9 1.1\n"
+                 "space origin: (-2,1.5,0.25)\nendian: big\nencoding: raw\nbyte skip: 7\n\n" % tuple(dims)).encode())
+        f.write(b"skipped" + field_bytes(dims, ">f"))
+    files["nrrd"] = p
+    # NRRD, detached header (.nhdr) naming a data file; little endian f64.
+    with open(os.path.join(a.work, "field-data.bin"), "wb") as f:
+        f.write(field_bytes(dims, "<d"))
+    p = os.path.join(a.work, "field.nhdr")
+    with open(p, "w") as f:
+        f.write("NRRD0004\ntype: double\ndimension: 3\nsizes: %d %d %d\nspacings: 1 0.9 1.1\nendian: little\n"
+                "encoding: raw\ndata file: field-data.bin\n" % tuple(dims))
+    files["nhdr"] = p
+    # MetaImage, inline (.mha, ElementDataFile = LOCAL), big endian.
+    p = os.path.join(a.work, "field.mha")
+    with open(p, "wb") as f:
+        f.write(("ObjectType = Image\nNDims = 3\nDimSize = %d %d %d\nElementType = MET_FLOAT\n"
+                 "ElementSpacing = 1 0.9 1.1\nOffset = 3 -1 2\nBinaryDataByteOrderMSB = True\n"
+                 "ElementDataFile = LOCAL\n" % tuple(dims)).encode())
+        f.write(field_bytes(dims, ">f"))
+    files["mha"] = p
+    # MetaImage, detached (.mhd + data file), samples at the end of the file (HeaderSize = -1).
+    with open(os.path.join(a.work, "field-mhd.raw"), "wb") as f:
+        f.write(b"some leading bytes" + field_bytes(dims, "<f"))
+    p = os.path.join(a.work, "field.mhd")
+    with open(p, "w") as f:
+        f.write("NDims = 3\nDimSize = %d %d %d\nElementType = MET_FLOAT\nElementSpacing = 1 0.9 1.1\n"
+                "HeaderSize = -1\nElementDataFile = field-mhd.raw\n" % tuple(dims))
+    files["mhd"] = p
+    # NIfTI-1 (.nii), sform with an origin, scaled by scl_slope / scl_inter.
+    p = os.path.join(a.work, "field.nii")
+    write_nifti(p, dims, [1.0, 0.75, 1.25], [-3.5, 2.0, 0.5], slope=1.5, inter=-0.25)
+    files["nii"] = p
+    for np_ in (2, 3, 4):
+        for name, path in files.items():
+            scene = raw_scene(path)
+            if name == "nii":  # scaled values: 1.5 v - 0.25
+                scene["volume"]["transfer"]["opacity"] = [[0.0, 0.0], [0.65, 0.0], [0.95, 0.5]]
+            check_equal("fmt-" + name, write_scene("fmt-" + name, scene), np_)
+        check_equal("fmt-nrrd-shaded", write_scene("fmt-nrrd-shaded", raw_scene(files["nrrd"], shaded=True)), np_)
+    # Data that cannot be read as a sub-box: one line naming the file, no image.
+    p = os.path.join(a.work, "gz.nrrd")
+    import gzip
+    with open(p, "wb") as f:
+        f.write(("NRRD0004\ntype: float\ndimension: 3\nsizes: %d %d %d\nendian: little\nencoding: gzip\n\n"
+                 % tuple(dims)).encode())
+        f.write(gzip.compress(field_bytes(dims, "<f")))
+    one_error("fmt-gzip", raw_scene(p), "gz.nrrd: volref-mpi reads bricks as sub-boxes of uncompressed samples stored in the volume's axis order; "
+              "this file has gzip encoding")
+    p = os.path.join(a.work, "flipped.nii")
+    write_nifti(p, dims, [1.0, 0.75, 1.25], [20.0, 2.0, 0.5], flip_x=True)
+    one_error("fmt-flipped-nifti", raw_scene(p), "flipped.nii: volref-mpi reads bricks as sub-boxes of uncompressed samples "
+              "stored in the volume's axis order; this file has a flipped or permuted orientation")
+
 if a.mode == "memory":
     # 64^3 f64 = 2 MiB: over a 1.5 MiB limit on one rank; a quarter (+ ghost) fits on each of 4.
     path = write_raw("big", [64, 64, 64], "d", smooth)
@@ -254,13 +384,10 @@ if a.mode == "refusals":
         "render.early_termination": ("render", "early_termination", 0.99),
         "render.integrator": ("render", "integrator", "adaptive"),
         "render.profile": ("render", "profile", "vtk-gpu"),
-        "render.projection": ("render", "projection", "first-hit"),
     }
     for key, (section, k, v) in cases.items():
         s = base_scene("composite", "ortho")
         s[section][k] = v
-        if v == "first-hit":
-            s["render"]["isovalue"] = 0.5
         out = os.path.join(a.work, "refused.exr")
         r = mpirun(2, ["render", write_scene("refused", s), "-o", out])
         lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]

@@ -308,11 +308,7 @@ VolumeLayout metaimage_layout(const std::filesystem::path& path) {
     } else {  // -1: the samples end the file
         const std::uint64_t bytes = std::uint64_t(checked_voxel_count_unlimited(out.dims, path.string(), scalar_type_size(out.type))) *
                                     scalar_type_size(out.type);
-        std::error_code ec;
-        const std::uint64_t size = std::filesystem::file_size(out.data, ec);
-        if (ec) throw Error(out.data_where + ": cannot read the file's size");
-        if (size < base + bytes) throw Error(io::truncated_message(out.data_where, bytes, size - std::min(size, base)));
-        out.offset = size - bytes;
+        out.offset = trailing_samples_offset(out, base, bytes);
     }
     return out;
 }

@@ -679,12 +679,7 @@ VolumeLayout nrrd_layout(const std::filesystem::path& path) {
     if (layout.byte_skip >= 0) {
         out.offset = base + std::uint64_t(layout.byte_skip);
     } else {  // -1: the samples end the file
-        const std::uint64_t bytes = std::uint64_t(layout.count) * scalar_type_size(layout.type);
-        std::error_code ec;
-        const std::uint64_t size = std::filesystem::file_size(out.data, ec);
-        if (ec) throw Error(out.data_where + ": cannot read the file's size");
-        if (size < base + bytes) throw Error(io::truncated_message(out.data_where, bytes, size - std::min(size, base)));
-        out.offset = size - bytes;
+        out.offset = trailing_samples_offset(out, base, std::uint64_t(layout.count) * scalar_type_size(layout.type));
     }
     return out;
 }

@@ -32,6 +32,10 @@ struct VolumeLayout {
     double slope = 1.0, inter = 0.0;
 };
 
+// The offset of samples that end the data file (a header's "skip -1"): file size - bytes, after
+// checking that the file holds `bytes` beyond `base` (else the readers' truncation Error).
+std::uint64_t trailing_samples_offset(const VolumeLayout& layout, std::uint64_t base, std::uint64_t bytes);
+
 VolumeLayout nrrd_layout(const std::filesystem::path& path);
 VolumeLayout metaimage_layout(const std::filesystem::path& path);
 VolumeLayout nifti_layout(const std::filesystem::path& path);

@@ -1,5 +1,6 @@
 #include "core/io/VolumeReader.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/Error.h"
@@ -65,6 +66,14 @@ Volume read_volume(const std::filesystem::path& path, const std::string& format)
     if (chosen == "vtk") return read_vtk_legacy(path);
     if (chosen == "vti") return read_vti(path);
     return read_den(path);
+}
+
+std::uint64_t trailing_samples_offset(const VolumeLayout& layout, std::uint64_t base, std::uint64_t bytes) {
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(layout.data, ec);
+    if (ec) throw Error(layout.data_where + ": cannot read the file's size");
+    if (size < base + bytes) throw Error(io::truncated_message(layout.data_where, bytes, size - std::min(size, base)));
+    return size - bytes;
 }
 
 VolumeLayout volume_layout(const std::filesystem::path& path, const std::string& format) {

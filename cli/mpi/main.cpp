@@ -187,14 +187,15 @@ int run(const Args& args, int rank, int size) {
     if (any_error(err, rank, size)) return 1;
     try {
         VolumeSpec& vs = scene.volume();
-        // The default window of a float volume is the whole volume's data range (TransferFunction.cpp):
-        // the ranks agree on it first.
-        if (!vs.classification && !vs.transfer.window && !scalar_type_is_integer(brick_volume.type)) {
+        // Whatever reads the volume's data range (the transfer function's default window of a float
+        // volume, the shader's zero-gradient tolerance) reads the whole volume's: the ranks agree on it
+        // first (Volume::whole_range).
+        {
             const auto r = brick_volume.value_range();
             double lo = r[0], hi = r[1], glo = 0.0, ghi = 0.0;
             MPI_Allreduce(&lo, &glo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
             MPI_Allreduce(&hi, &ghi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-            vs.transfer.window = std::array<double, 2>{glo, ghi};
+            brick_volume.whole_range = std::array<double, 2>{glo, ghi};
         }
         set_volume_loader_hook([&](const VolumeSpec&) { return std::move(brick_volume); });
         RenderOptions options;

@@ -49,6 +49,7 @@ std::array<double, 2> scalar_type_range(ScalarType t) {
 }
 
 std::array<double, 2> Volume::value_range() const {
+    if (whole_range) return *whole_range;
     if (values.empty()) return {0.0, 0.0};
     // One pass in the storage type (NaN compares false, as std::minmax_element's comparisons do).
     return values.visit([&](const auto* p) -> std::array<double, 2> {

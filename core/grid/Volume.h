@@ -8,6 +8,7 @@
 // (values.type() == type); procedural fields, resampled grids and caches are f64.
 #pragma once
 #include <array>
+#include <optional>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -38,8 +39,12 @@ struct Volume {
     glm::dvec3 domain_max() const {
         return origin + glm::dvec3(double(dims[0] - 1), double(dims[1] - 1), double(dims[2] - 1)) * spacing;
     }
-    // [min, max] of the stored values.
+    // [min, max] of the stored values, or `whole_range` when set.
     std::array<double, 2> value_range() const;
+    // The data range of the whole volume this one is a part of (volref-mpi's bricks, cli/mpi/): what
+    // value_range() reports, so that the transfer function's default window and the shader's
+    // zero-gradient tolerance (conventions §8) are the whole volume's on every rank. Unset otherwise.
+    std::optional<std::array<double, 2>> whole_range;
     // A volume on the same grid (dims, origin, spacing), type f64, every value 0.
     Volume same_grid() const {
         Volume v;

@@ -252,6 +252,23 @@ if a.mode == "raw":
         check_equal("raw-composite", write_scene("raw-composite", raw_scene(path)), np)
         check_equal("raw-shaded", write_scene("raw-shaded", raw_scene(path, shaded=True)), np)
         check_equal("raw-mip", write_scene("raw-mip", raw_scene(path, "mip")), np)
+    # The shader's zero-gradient tolerance (conventions §8: 1e-9 max |v| / voxel) is the whole volume's on
+    # every rank (Volume::whole_range): a ramp of 1e-8 per voxel in x < 20 beside values of 1000 in
+    # x >= 24 has |grad f| = 1e-8 below the whole volume's tolerance 1e-6, so the single-process render
+    # leaves those samples unlit (colour 0.5), while a brick holding only the ramp (its own tolerance
+    # ~2e-16) would light them (0.2 0.5 + 0.7 0.5 + 0.3 = 0.75 under the headlight along +x). At 3 and 4
+    # ranks some bricks hold only the ramp: with each brick's own range they were 0.12 and 0.10 off.
+    ramp = write_raw("zero-gradient", [40, 6, 6], "d",
+                     lambda i, j, k: 1e-8 * i if i < 20 else (1000.0 if i >= 24 else 1e-8 * 19 + (i - 19) * 200.0))
+    zg = raw_scene(ramp, shaded=True)
+    zg["volume"]["transfer"] = {"color": [[0.0, 0.5, 0.5, 0.5], [2000.0, 0.5, 0.5, 0.5]],
+                                "opacity": [[0.0, 0.05], [2000.0, 0.05]]}
+    zg["volume"]["shading"] = {"model": "blinn-phong", "ka": 0.2, "kd": 0.7, "ks": 0.3, "n": 10}
+    zg["camera"] = {"type": "orthographic", "eye": [-30, 2.7, 2.75], "target": [20, 2.7, 2.75], "up": [0, 0, 1],
+                    "height": 6}
+    zg_path = write_scene("zero-gradient", zg)
+    for np in (2, 3, 4):
+        check_equal("zero-gradient", zg_path, np)
 
 def field_bytes(dims, fmt):
     """smooth() at every voxel, x fastest, packed with struct format `fmt` ("<f", ">f", "<d", ...)."""

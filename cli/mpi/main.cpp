@@ -328,42 +328,13 @@ int run(const Args& args, int rank, int size) {
                                 p[0] = kNone;
                                 const double iso = *render.isovalue;
                                 auto g = [&](double t) { return pipeline.value(ray, t) - iso; };
-                                auto sign = [](double v) { return (v > 0.0) - (v < 0.0); };
                                 std::optional<double> hit;
                                 for (std::size_t m = 0; m < owned.size() && !hit; ++m) {
                                     const Interval& iv = intervals[std::size_t(owned_at[m][0])];
                                     const std::int64_t k = owned_at[m][1];
                                     const double ta = owned[m].t0, tb = owned[m].t1, ga = g(ta);
-                                    if (k == 0 && ga == 0.0) {
-                                        hit = ta;
-                                    } else {
-                                        const double gb = g(tb);
-                                        if (!std::isfinite(ga) || !std::isfinite(gb)) {
-                                            if (trilinear) hit = first_crossing_exact(*trilinear, ray, ta, tb, iso);
-                                        } else if (gb == 0.0) {
-                                            hit = tb;
-                                        } else if (sign(gb) != sign(ga)) {
-                                            if (trilinear) hit = first_crossing_exact(*trilinear, ray, ta, tb, iso);
-                                            if (!hit) {
-                                                double lo = ta, hi = tb, glo = ga;
-                                                const double tol = conventions::kFirstHitRelativeTolerance * iv.length();
-                                                for (int it = 0; it < 200 && hi - lo > tol; ++it) {
-                                                    const double mid = 0.5 * (lo + hi), gm = g(mid);
-                                                    if (gm == 0.0) {
-                                                        lo = hi = mid;
-                                                        break;
-                                                    }
-                                                    if (sign(gm) == sign(glo)) {
-                                                        lo = mid;
-                                                        glo = gm;
-                                                    } else {
-                                                        hi = mid;
-                                                    }
-                                                }
-                                                hit = 0.5 * (lo + hi);
-                                            }
-                                        }
-                                    }
+                                    if (k == 0 && ga == 0.0) hit = ta;
+                                    else hit = bracket_crossing(g, trilinear, ray, ta, ga, tb, g(tb), iso, iv.length());
                                     if (hit) {
                                         p[0] = owned[m].midpoint();
                                         const glm::dvec3 c =

@@ -81,39 +81,7 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
         }
         for (std::int64_t k = 0; k < n && !hit; ++k) {
             const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
-            if (!std::isfinite(ga) || !std::isfinite(gb)) {  // non-finite values never cross
-                // Trilinear: the bracket's finite cells are searched exactly (a NaN end must not hide
-                // a crossing in the finite cell beside it).
-                if (trilinear_) hit = first_crossing_exact(*trilinear_, ray, ta, tb, iso);
-                ta = tb;
-                ga = gb;
-                continue;
-            }
-            if (gb == 0.0) {
-                hit = tb;
-            } else if (sign(gb) != sign(ga)) {
-                // Trilinear: the first root of the cell cubics inside the bracket, to rounding.
-                if (trilinear_) hit = first_crossing_exact(*trilinear_, ray, ta, tb, iso);
-                if (!hit) {
-                    // Bisection on [ta, tb]; ga keeps the sign at ta.
-                    double lo = ta, hi = tb, glo = ga;
-                    const double tol = conventions::kFirstHitRelativeTolerance * iv.length();
-                    for (int it = 0; it < 200 && hi - lo > tol; ++it) {
-                        const double m = 0.5 * (lo + hi), gm = g(m);
-                        if (gm == 0.0) {
-                            lo = hi = m;
-                            break;
-                        }
-                        if (sign(gm) == sign(glo)) {
-                            lo = m;
-                            glo = gm;
-                        } else {
-                            hi = m;
-                        }
-                    }
-                    hit = 0.5 * (lo + hi);
-                }
-            }
+            hit = bracket_crossing(g, trilinear_, ray, ta, ga, tb, gb, iso, iv.length());
             ta = tb;
             ga = gb;
         }

@@ -14,8 +14,10 @@
 // "adaptive" the whole interval is searched that way (no step: no crossing is missed, however close
 // two are), and the "error" channel holds the rounding bound; other grids are an error there.
 #pragma once
+#include <cmath>
 #include <optional>
 
+#include "core/Conventions.h"
 #include "core/integrate/Integrator.h"
 
 namespace volref {
@@ -41,5 +43,42 @@ private:
 // bisection narrows until no double lies between the bracket's ends. None: no crossing.
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
                                            double iso);
+
+// One bracket [ta, tb] of the fixed-step search, g = f - iso with ga = g(ta), gb = g(tb): the crossing
+// in it, or none. A non-finite end never crosses (trilinear: the bracket's finite cells are searched
+// exactly, so a NaN end does not hide a crossing beside it); gb = 0: tb; a sign change: the first root
+// of the cell cubics (trilinear, `trilinear` non-null), else bisection keeping the sign change until
+// the bracket is at most kFirstHitRelativeTolerance * interval_length wide, the hit its midpoint.
+// ga = 0 is the caller's to test (only at an interval's first end: inside, ga is the last bracket's gb).
+// FirstHitIntegrator and volref-mpi's ranks (cli/mpi/) search with it.
+template <class G>
+std::optional<double> bracket_crossing(const G& g, const VolumeSampler* trilinear, const Ray& ray, double ta, double ga,
+                                       double tb, double gb, double iso, double interval_length) {
+    auto sign = [](double x) { return (x > 0.0) - (x < 0.0); };
+    if (!std::isfinite(ga) || !std::isfinite(gb)) {
+        if (trilinear) return first_crossing_exact(*trilinear, ray, ta, tb, iso);
+        return std::nullopt;
+    }
+    if (gb == 0.0) return tb;
+    if (sign(gb) == sign(ga)) return std::nullopt;
+    if (trilinear)
+        if (const std::optional<double> hit = first_crossing_exact(*trilinear, ray, ta, tb, iso)) return hit;
+    double lo = ta, hi = tb, glo = ga;
+    const double tol = conventions::kFirstHitRelativeTolerance * interval_length;
+    for (int it = 0; it < 200 && hi - lo > tol; ++it) {
+        const double m = 0.5 * (lo + hi), gm = g(m);
+        if (gm == 0.0) {
+            lo = hi = m;
+            break;
+        }
+        if (sign(gm) == sign(glo)) {
+            lo = m;
+            glo = gm;
+        } else {
+            hi = m;
+        }
+    }
+    return 0.5 * (lo + hi);
+}
 
 }  // namespace volref

@@ -5,6 +5,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/NiftiReader.h"
 
 namespace volref::mpi {
 
@@ -49,16 +50,7 @@ Volume read_brick(const VolumeLayout& h, const std::array<std::int64_t, 3>& lo, 
         }
     std::fclose(file);
     io::to_native_order(v.values, h.endian);
-    if (h.scaled) {  // as read_nifti: value = slope * stored + inter, in f64
-        const std::size_t count = v.values.size();
-        VoxelArray scaled(ScalarType::F64, count);
-        double* values = scaled.data<double>();
-        v.values.visit([&](const auto* p) {
-            for (std::size_t i = 0; i < count; ++i) values[i] = h.slope * double(p[i]) + h.inter;
-        });
-        v.values = std::move(scaled);
-        v.type = ScalarType::F64;
-    }
+    if (h.scaled) scale_samples(v, h.slope, h.inter);  // as read_nifti (the memory was checked above)
     return v;
 }
 

@@ -272,6 +272,17 @@ VolumeLayout nifti_layout(const std::filesystem::path& path) {
     return out;
 }
 
+void scale_samples(Volume& volume, double slope, double inter) {
+    const std::size_t count = volume.values.size();
+    VoxelArray scaled(ScalarType::F64, count);
+    double* out = scaled.data<double>();
+    volume.values.visit([&](const auto* p) {
+        for (std::size_t i = 0; i < count; ++i) out[i] = slope * double(p[i]) + inter;
+    });
+    volume.values = std::move(scaled);
+    volume.type = ScalarType::F64;
+}
+
 Volume read_nifti(const std::filesystem::path& path) {
     const std::string where = path.string();
     const ParsedNifti p = parse_nifti(path, true);
@@ -316,13 +327,7 @@ Volume read_nifti(const std::filesystem::path& path) {
     const double slope = p.slope, inter = p.inter;
     if (scales(slope, inter)) {
         checked_voxel_count(file_dims, where + ": scaled by scl_slope", sizeof(double));
-        VoxelArray scaled(ScalarType::F64, count);
-        double* out = scaled.data<double>();
-        stored.values.visit([&](const auto* p) {
-            for (std::size_t i = 0; i < count; ++i) out[i] = slope * double(p[i]) + inter;
-        });
-        stored.values = std::move(scaled);
-        stored.type = ScalarType::F64;
+        scale_samples(stored, slope, inter);
     }
 
     // Reorder so that volume axis a is world axis a, increasing.

@@ -19,4 +19,9 @@ namespace volref {
 
 Volume read_nifti(const std::filesystem::path& path);
 
+// NIfTI's scaling of stored samples: every value becomes slope * stored + inter, as f64 (the volume's
+// type becomes F64). read_nifti and volref-mpi's brick reader (VolumeLayout::scaled) apply it; the
+// caller checks the memory for the f64 copy first.
+void scale_samples(Volume& volume, double slope, double inter);
+
 }  // namespace volref

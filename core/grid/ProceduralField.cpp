@@ -53,44 +53,26 @@ Volume make_procedural_volume(const FieldSpec& field, const glm::dvec3& origin, 
     return v;
 }
 
-Volume make_procedural_volume(const FieldSpec& field,
-                              const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position) {
-    Volume v;
-    v.dims = field.dims;
-    v.type = ScalarType::F64;
-    const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims");
-    if (field.kind == FieldSpec::Kind::Cells && field.values.size() != count)
-        throw Error("volume.source.values: expected " + std::to_string(count) + " values (dims product), got " +
+namespace {
+
+// A `cells` field lists one value per voxel of the whole grid (field.dims, `whole_count` voxels).
+void check_cell_values(const FieldSpec& field, std::size_t whole_count) {
+    if (field.kind == FieldSpec::Kind::Cells && field.values.size() != whole_count)
+        throw Error("volume.source.values: expected " + std::to_string(whole_count) + " values (dims product), got " +
                     std::to_string(field.values.size()));
-    v.values.allocate(ScalarType::F64, count, false);  // every voxel is written below
-    double* out = v.values.data<double>();
-    // Each voxel depends on its indices alone, so the slices are filled in parallel (TBB, in the
-    // caller's arena: render_scene's --threads) and the volume is the same bits for any thread count.
-    const Volume& grid = v;
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
-        for (std::int64_t k = r.begin(); k != r.end(); ++k)
-            for (std::int64_t j = 0; j < grid.dims[1]; ++j)
-                for (std::int64_t i = 0; i < grid.dims[0]; ++i)
-                    out[grid.index(i, j, k)] = field_value(field, grid, position(i, j, k), i, j, k);
-    });
-    return v;
 }
 
-Volume make_procedural_brick(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing,
-                             const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& dims) {
-    Volume whole;  // the whole grid's dims (indices of marschner-lobb and cells); no values
+// Fills v (its dims set, `count` = their checked product) with the field at the whole grid's voxels
+// lo + (i, j, k), placed at position(gi, gj, gk). Each voxel depends on its indices alone, so the slices are filled in parallel
+// (TBB, in the caller's arena: render_scene's --threads) and the volume is the same bits for any
+// thread count.
+void fill_field(const FieldSpec& field, Volume& v, const std::array<std::int64_t, 3>& lo,
+                const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position,
+                std::size_t count) {
+    Volume whole;  // the whole grid's dims (the indices of marschner-lobb and cells); no values
     whole.dims = field.dims;
-    if (field.kind == FieldSpec::Kind::Cells &&
-        field.values.size() != std::size_t(whole.dims[0]) * std::size_t(whole.dims[1]) * std::size_t(whole.dims[2]))
-        throw Error("volume.source.values: expected " + std::to_string(whole.dims[0] * whole.dims[1] * whole.dims[2]) +
-                    " values (dims product), got " + std::to_string(field.values.size()));
-    Volume v;
-    v.dims = dims;
     v.type = ScalarType::F64;
-    v.origin = origin + glm::dvec3(double(lo[0]), double(lo[1]), double(lo[2])) * spacing;
-    v.spacing = spacing;
-    const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims (this rank's brick)");
-    v.values.allocate(ScalarType::F64, count, false);
+    v.values.allocate(ScalarType::F64, count, false);  // every voxel is written below
     double* out = v.values.data<double>();
     const Volume& grid = v;
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
@@ -98,10 +80,33 @@ Volume make_procedural_brick(const FieldSpec& field, const glm::dvec3& origin, c
             for (std::int64_t j = 0; j < grid.dims[1]; ++j)
                 for (std::int64_t i = 0; i < grid.dims[0]; ++i) {
                     const std::int64_t gi = i + lo[0], gj = j + lo[1], gk = k + lo[2];
-                    const glm::dvec3 p = origin + glm::dvec3(double(gi), double(gj), double(gk)) * spacing;
-                    out[grid.index(i, j, k)] = field_value(field, whole, p, gi, gj, gk);
+                    out[grid.index(i, j, k)] = field_value(field, whole, position(gi, gj, gk), gi, gj, gk);
                 }
     });
+}
+
+}  // namespace
+
+Volume make_procedural_volume(const FieldSpec& field,
+                              const std::function<glm::dvec3(std::int64_t, std::int64_t, std::int64_t)>& position) {
+    Volume v;
+    v.dims = field.dims;
+    const std::size_t count = checked_voxel_count(v.dims, "volume.source.dims");
+    check_cell_values(field, count);
+    fill_field(field, v, {0, 0, 0}, position, count);
+    return v;
+}
+
+Volume make_procedural_brick(const FieldSpec& field, const glm::dvec3& origin, const glm::dvec3& spacing,
+                             const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& dims) {
+    check_cell_values(field, std::size_t(field.dims[0]) * std::size_t(field.dims[1]) * std::size_t(field.dims[2]));
+    Volume v;
+    v.dims = dims;
+    v.origin = origin + glm::dvec3(double(lo[0]), double(lo[1]), double(lo[2])) * spacing;
+    v.spacing = spacing;
+    fill_field(field, v, lo, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+        return origin + glm::dvec3(double(i), double(j), double(k)) * spacing;
+    }, checked_voxel_count(v.dims, "volume.source.dims (this rank's brick)"));
     return v;
 }
 

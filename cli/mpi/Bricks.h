@@ -1,7 +1,8 @@
-// volref-mpi's bricks (docs/architecture.md, "volref-mpi"; docs/conventions.md §14): the volume's
-// cells split into N boxes by a k-d tree (each split on the box's longest axis, in cells, at the
-// point that balances the cell counts of the two halves in proportion to their ranks), the voxels a
-// brick's rank holds (its cells' corners plus a ghost layer), and which brick owns a point.
+// volref-mpi's bricks (docs/architecture.md, "volref-mpi"; docs/conventions.md §14): space split into
+// N boxes by a k-d tree over the cells of the first volume's grid (extended to cover every volume:
+// Lattice; each split on the box's longest axis, in cells, at the point that balances the cell counts
+// of the two halves in proportion to their ranks), the voxels of each volume a brick's rank holds
+// (the cells meeting its box plus a ghost layer), and which brick owns a point.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -14,20 +15,35 @@
 namespace volref::mpi {
 
 struct Brick {
-    // The cells [lo, hi) on each axis (voxel indices; a cell a spans voxels a and a + 1). An axis of
-    // one voxel has the one "cell" [0, 0).
+    // The cells [lo, hi) on each axis (indices of the first volume's lattice; a cell a spans its
+    // planes a and a + 1). An axis of one voxel has the one "cell" [0, 0).
     std::array<std::int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
-    // The voxels this rank holds: [vlo, vhi] (inclusive), the cells' corners widened by the ghost
-    // layer and clamped to the volume.
-    std::array<std::int64_t, 3> vlo{0, 0, 0}, vhi{0, 0, 0};
-    std::array<std::int64_t, 3> voxel_dims() const {
-        return {vhi[0] - vlo[0] + 1, vhi[1] - vlo[1] + 1, vhi[2] - vlo[2] + 1};
-    }
 };
 
-// `count` >= 1 bricks of a grid of `dims` voxels, each with `ghost` voxels of ghost layer. Throws
-// volref::Error when the grid has fewer cells than bricks.
-std::vector<Brick> split_bricks(const std::array<std::int64_t, 3>& dims, int count, int ghost);
+// The cells [lo, hi) of the lattice of the first volume's grid, extended beyond that
+// volume to cover every volume's domain (Lattice, from union_lattice), split by the same k-d rule;
+// voxels_for gives each volume's voxels. Throws volref::Error
+// when the lattice has fewer cells than bricks.
+struct Lattice {
+    std::array<std::int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+};
+std::vector<Brick> split_lattice(const Lattice& cells, int count);
+
+// A grid: `dims` voxels at origin + i * spacing.
+struct GridBox {
+    std::array<std::int64_t, 3> dims{1, 1, 1};
+    glm::dvec3 origin{0.0}, spacing{1.0};
+};
+// The lattice of grids[0] (cells between its voxel planes, extended) covering every grid's domain:
+// grids[0] itself exactly ([0, dims - 1)), the others' corners mapped into grids[0]'s index space
+// u = (x - origin_0) / spacing_0, floor and ceil.
+Lattice union_lattice(const std::vector<GridBox>& grids);
+// The voxels [vlo, vhi] (inclusive) of `grid` that the rank of brick `b` (cells of `lattice` in
+// `first`'s index space) needs: the grid's cells meeting the brick's box, plus `ghost` voxels, clamped to
+// the grid; on the lattice's outer faces (which own every point beyond them) up to the grid's face.
+// When the brick does not meet the grid, a range of 1 or 2 voxels at the nearest face (never sampled).
+void voxels_for(const Brick& b, const Lattice& lattice, const GridBox& first, const GridBox& grid, int ghost,
+                std::array<std::int64_t, 3>& vlo, std::array<std::int64_t, 3>& vhi);
 
 // The ghost layer a volume's reconstruction needs (conventions §14): 1 voxel for nearest and
 // trilinear (a midpoint owned by the brick may round to the neighbouring cell), +1 for tricubic taps
@@ -35,8 +51,9 @@ std::vector<Brick> split_bricks(const std::array<std::int64_t, 3>& dims, int cou
 int ghost_voxels(const VolumeSpec& vs, const RenderSpec& render);
 
 // Whether the point with continuous grid index u (u_a = (x_a - origin_a) / spacing_a of the whole
-// volume) belongs to `b`: lo_a <= u_a < hi_a on every axis, open-ended at the volume's faces, so
-// every point belongs to exactly one brick of a k-d split (the same test on every rank).
-bool owns(const Brick& b, const std::array<std::int64_t, 3>& dims, const glm::dvec3& u);
+// volume, or of the first volume's lattice) belongs to `b`: lo_a <= u_a < hi_a on every axis,
+// open-ended at the lattice's outer faces ([0, dims - 1] for one volume), so every point belongs to
+// exactly one brick of a k-d split (the same test on every rank).
+bool owns(const Brick& b, const Lattice& lattice, const glm::dvec3& u);
 
 }  // namespace volref::mpi

@@ -1,12 +1,14 @@
 // volref-mpi render SCENE -o OUT [--threads T] [--max-memory M] [--set PATH=VALUE ...]
 //
-// One volume split into bricks over the MPI ranks (cli/mpi/Bricks.h); each rank holds its brick plus a
-// ghost layer (read as a sub-box of the file, or generated), integrates the part of every ray inside
-// its brick on the single-process render's sample lattice (segment k of an interval at the same t on
-// every rank; a segment belongs to the brick holding its midpoint), and rank 0 combines the parts in
-// ray order (MPI_Gather, direct send) and writes the image. Errors of any rank reach rank 0, which
-// prints the one line `volref render` prints (the lowest rank's); every rank exits 1; no file is
-// written. docs/conventions.md §14, docs/architecture.md "volref-mpi", docs/performance.md.
+// Space split into bricks over the MPI ranks (cli/mpi/Bricks.h: a k-d split of the first volume's
+// lattice, extended over every volume); each rank holds its brick of every volume plus a ghost layer
+// (read as a sub-box of the file, or generated), integrates the part of every ray inside its brick on
+// the single-process render's sample lattice (segment k of an interval, or of a piece of several
+// volumes' mix, at the same t on every rank; a segment belongs to the brick holding its midpoint),
+// and the parts are combined in ray order (binary swap, or MPI_Gather to rank 0), which writes the
+// image. Errors of any rank reach rank 0, which prints the one line `volref render` prints (the lowest
+// rank's); every rank exits 1; no file is written. docs/conventions.md §14, docs/architecture.md
+// "volref-mpi", docs/performance.md.
 #include <mpi.h>
 
 #include <algorithm>
@@ -36,6 +38,7 @@
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/mix/MultiVolumeIntegrator.h"
 #include "core/render/PreparedVolume.h"
 #include "core/render/VolumeLoaderHook.h"
 #include "core/sample/VolumeSampler.h"
@@ -82,21 +85,34 @@ bool any_error(const std::string& mine, int rank, int size) {
     return true;
 }
 
+// The key of volume k ("volume" for a scene of one, "volumes[k]" otherwise).
+std::string volume_key(const Scene& scene, std::size_t k) {
+    return scene.volumes.size() == 1 ? std::string("volume") : "volumes[" + std::to_string(k) + "]";
+}
+
 // The first version's scope (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
-    if (scene.volumes.size() != 1) throw Error("volumes: volref-mpi renders one volume (several volumes are not supported yet)");
-    const VolumeSpec& vs = scene.volume();
     const RenderSpec& r = scene.render;
     if (r.integrator != IntegrationMethod::Fixed)
         throw Error("render.integrator: volref-mpi supports \"fixed\" only (the adaptive integrator is not supported yet)");
     if (r.profile != ProfileId::Reference)
         throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
     if (r.early_termination) throw Error("render.early_termination: not supported by volref-mpi yet");
-    if (vs.bounds.type != BoundsSpec::Type::Box)
-        throw Error("volume.bounds: volref-mpi supports box bounds only (meshes and shells are not supported yet)");
-    if (vs.transform) throw Error("volume.transform: not supported by volref-mpi yet");
-    if (vs.gradient.cache || vs.gradient.cache_auto) throw Error("volume.gradient.cache: not supported by volref-mpi yet");
-    if (vs.classify == VolumeSpec::Classify::Pre) throw Error("volume.classify: \"pre\" is not supported by volref-mpi yet");
+    for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
+        const VolumeSpec& vs = scene.volumes[k];
+        const std::string key = volume_key(scene, k);
+        if (vs.bounds.type != BoundsSpec::Type::Box)
+            throw Error(key + ".bounds: volref-mpi supports box bounds only (meshes and shells are not supported yet)");
+        if (vs.transform) throw Error(key + ".transform: not supported by volref-mpi yet");
+        if (vs.gradient.cache || vs.gradient.cache_auto) throw Error(key + ".gradient.cache: not supported by volref-mpi yet");
+        if (vs.classify == VolumeSpec::Classify::Pre) throw Error(key + ".classify: \"pre\" is not supported by volref-mpi yet");
+    }
+}
+
+// The parts each pixel carries: one for a single volume and for the mix of several (composite); one
+// per volume for the other projections (each volume's own projection, combined after the ranks').
+std::size_t slot_count(const Scene& scene) {
+    return scene.volumes.size() > 1 && scene.render.projection != Projection::Composite ? scene.volumes.size() : 1;
 }
 
 // OUT ending in ".img": the pixels as doubles in tests/identity/image_dump.cpp's format (a text line
@@ -130,6 +146,17 @@ struct Args {
 
 double now() { return MPI_Wtime(); }
 
+// One volume of the scene on this rank: its whole grid, the voxels of its brick, its pipeline on them.
+struct Member {
+    mpi::GridBox grid;
+    VolumeLayout header;  // file sources
+    int ghost = 1;
+    std::array<std::int64_t, 3> vlo{0, 0, 0}, vhi{0, 0, 0};
+    Volume brick;
+    std::unique_ptr<PreparedVolume> prepared;
+    int geometry_id = 0;
+};
+
 int run(const Args& args, int rank, int size) {
     std::string err;
     // Binary swap needs a power-of-two rank count; others use direct send (said on stderr after a
@@ -137,48 +164,58 @@ int run(const Args& args, int rank, int size) {
     const bool power_of_two = (size & (size - 1)) == 0;
     const bool swap = args.compositing == "swap" && power_of_two && size > 1;
     const double t_start = now();
-    // ---- set-up: scene, bricks, this rank's brick, its pipeline ----
+    // ---- set-up: scene, bricks, this rank's bricks of the volumes, their pipelines ----
     Scene scene;
-    std::array<std::int64_t, 3> dims{1, 1, 1};
-    glm::dvec3 origin(0.0), spacing(1.0);
+    std::vector<Member> members;
+    mpi::Lattice lattice;
     std::vector<mpi::Brick> bricks;
-    std::unique_ptr<PreparedVolume> prepared;
     std::unique_ptr<Camera> camera;
     BoundingGeometry geometry;
-    int geometry_id = 0;
-    Volume brick_volume;
+    std::unique_ptr<MultiVolumeIntegrator> multi;
     try {
         if (!args.max_memory.empty()) set_memory_limit(parse_memory_size(args.max_memory, "--max-memory"));
         if (rank == 0 && !dump_output(args.output)) check_output_path(args.output);
         scene = load_scene(args.scene, args.overrides);
         check_supported(scene);
-        VolumeSpec& vs = scene.volume();
-        VolumeLayout header;
-        if (vs.source.field) {
-            dims = vs.source.field->dims;
-            origin = vs.origin.value_or(glm::dvec3(0.0));
-            spacing = vs.spacing.value_or(glm::dvec3(1.0));
-        } else {
-            header = mpi::read_volume_header(*vs.source.file, vs.source.format);
-            dims = header.dims;
-            origin = vs.origin.value_or(header.origin);
-            spacing = vs.spacing.value_or(header.spacing);
-            header.origin = origin;
-            header.spacing = spacing;
+        members.resize(scene.volumes.size());
+        std::vector<mpi::GridBox> grids;
+        for (std::size_t k = 0; k < members.size(); ++k) {
+            const VolumeSpec& vs = scene.volumes[k];
+            Member& m = members[k];
+            if (vs.source.field) {
+                m.grid = {vs.source.field->dims, vs.origin.value_or(glm::dvec3(0.0)), vs.spacing.value_or(glm::dvec3(1.0))};
+            } else {
+                m.header = mpi::read_volume_header(*vs.source.file, vs.source.format);
+                m.header.origin = vs.origin.value_or(m.header.origin);
+                m.header.spacing = vs.spacing.value_or(m.header.spacing);
+                m.grid = {m.header.dims, m.header.origin, m.header.spacing};
+            }
+            m.ghost = mpi::ghost_voxels(vs, scene.render);
+            if (scene.render.projection == Projection::FirstHit) {
+                // The sign test reads both ends of an owned segment (its midpoint +- h / 2) and the
+                // search runs between them: the ghost layer reaches h / 2 further (h in voxels of the
+                // finest axis).
+                const glm::dvec3& sp = m.grid.spacing;
+                const double finest = std::min({sp.x, sp.y, sp.z});
+                const double h = scene.render.step_units == StepUnits::World ? scene.render.step / finest : scene.render.step;
+                if (!(h > 0.0) || !(h < 1e6)) throw Error("render.step: too large for volref-mpi's ghost layer");
+                m.ghost += int(std::ceil(0.5 * h));
+            }
+            grids.push_back(m.grid);
         }
-        int ghost = mpi::ghost_voxels(vs, scene.render);
-        if (scene.render.projection == Projection::FirstHit) {
-            // The sign test reads both ends of an owned segment (its midpoint +- h / 2) and the search
-            // runs between them: the ghost layer reaches h / 2 further (h in voxels of the finest axis).
-            const double finest = std::min({spacing.x, spacing.y, spacing.z});
-            const double h = scene.render.step_units == StepUnits::World ? scene.render.step / finest : scene.render.step;
-            if (!(h > 0.0) || !(h < 1e6)) throw Error("render.step: too large for volref-mpi's ghost layer");
-            ghost += int(std::ceil(0.5 * h));
+        lattice = mpi::union_lattice(grids);
+        bricks = mpi::split_lattice(lattice, size);
+        std::size_t held = 0;  // the bricks read before this one (--max-memory counts them all)
+        for (std::size_t k = 0; k < members.size(); ++k) {
+            const VolumeSpec& vs = scene.volumes[k];
+            Member& m = members[k];
+            mpi::voxels_for(bricks[std::size_t(rank)], lattice, grids[0], m.grid, m.ghost, m.vlo, m.vhi);
+            const std::array<std::int64_t, 3> n{m.vhi[0] - m.vlo[0] + 1, m.vhi[1] - m.vlo[1] + 1, m.vhi[2] - m.vlo[2] + 1};
+            const HeldMemory earlier(held);
+            if (vs.source.field) m.brick = make_procedural_brick(*vs.source.field, m.grid.origin, m.grid.spacing, m.vlo, n);
+            else m.brick = mpi::read_brick(m.header, m.vlo, n);
+            held += m.brick.values.bytes();
         }
-        bricks = mpi::split_bricks(dims, size, ghost);
-        const mpi::Brick& b = bricks[std::size_t(rank)];
-        if (vs.source.field) brick_volume = make_procedural_brick(*vs.source.field, origin, spacing, b.vlo, b.voxel_dims());
-        else brick_volume = mpi::read_brick(header, b.vlo, b.voxel_dims());
     } catch (const std::bad_alloc&) {
         err = "out of memory";
     } catch (const std::exception& e) {
@@ -186,44 +223,64 @@ int run(const Args& args, int rank, int size) {
     }
     if (any_error(err, rank, size)) return 1;
     try {
-        VolumeSpec& vs = scene.volume();
-        // Whatever reads the volume's data range (the transfer function's default window of a float
+        // Whatever reads a volume's data range (the transfer function's default window of a float
         // volume, the shader's zero-gradient tolerance) reads the whole volume's: the ranks agree on it
         // first (Volume::whole_range).
-        {
-            const auto r = brick_volume.value_range();
+        for (Member& m : members) {
+            const auto r = m.brick.value_range();
             double lo = r[0], hi = r[1], glo = 0.0, ghi = 0.0;
             MPI_Allreduce(&lo, &glo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
             MPI_Allreduce(&hi, &ghi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-            brick_volume.whole_range = std::array<double, 2>{glo, ghi};
+            m.brick.whole_range = std::array<double, 2>{glo, ghi};
         }
-        set_volume_loader_hook([&](const VolumeSpec&) { return std::move(brick_volume); });
         RenderOptions options;
         options.threads = args.threads;
-        prepared = std::make_unique<PreparedVolume>(scene, 0, options, 0);
-        set_volume_loader_hook({});
-        // The whole volume's box (bounds AND domain): the intervals and the default camera of the
-        // single-process render.
-        const glm::dvec3 domain_lo = origin;
-        const glm::dvec3 domain_hi = origin + glm::dvec3(double(dims[0] - 1), double(dims[1] - 1), double(dims[2] - 1)) * spacing;
-        const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
-        if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
-            throw Error("volume.bounds: min must not exceed max");
-        geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+        std::size_t held = 0;
+        glm::dvec3 view_lo(std::numeric_limits<double>::infinity()), view_hi(-std::numeric_limits<double>::infinity());
+        for (std::size_t k = 0; k < members.size(); ++k) {
+            Member& m = members[k];
+            set_volume_loader_hook([&](const VolumeSpec&) { return std::move(m.brick); });
+            m.prepared = std::make_unique<PreparedVolume>(scene, k, options, held);
+            set_volume_loader_hook({});
+            held += m.prepared->bytes;
+            // The whole volume's box (bounds AND domain): the intervals and the default camera of the
+            // single-process render.
+            const VolumeSpec& vs = scene.volumes[k];
+            const glm::dvec3 domain_lo = m.grid.origin;
+            const glm::dvec3 domain_hi =
+                m.grid.origin + glm::dvec3(double(m.grid.dims[0] - 1), double(m.grid.dims[1] - 1), double(m.grid.dims[2] - 1)) * m.grid.spacing;
+            const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
+            if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
+                throw Error(volume_key(scene, k) + ".bounds: min must not exceed max");
+            m.geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+            view_lo = glm::min(view_lo, glm::max(box_lo, domain_lo));
+            view_hi = glm::max(view_hi, glm::min(box_hi, domain_hi));
+        }
         geometry.commit();
-        camera = std::make_unique<Camera>(scene.camera, scene.image.width, scene.image.height, glm::max(box_lo, domain_lo),
-                                          glm::min(box_hi, domain_hi));
-        const std::size_t parts = std::size_t(scene.image.width) * std::size_t(scene.image.height) * kPart * sizeof(double);
+        if (members.size() > 1) {  // the single-process render's mix (composite) and combination (others)
+            std::vector<MultiVolumeIntegrator::Member> list;
+            double step = std::numeric_limits<double>::infinity();
+            for (const Member& m : members) {
+                list.push_back({m.prepared->pipeline.get(), m.prepared->integrator.get(), m.prepared->context.get()});
+                step = std::min(step, m.prepared->step);
+            }
+            multi = std::make_unique<MultiVolumeIntegrator>(std::move(list), scene.render, step);
+        }
+        camera = std::make_unique<Camera>(scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
+        const std::size_t slots = slot_count(scene);
+        const std::size_t parts =
+            std::size_t(scene.image.width) * std::size_t(scene.image.height) * slots * kPart * sizeof(double);
         if (parts / sizeof(double) > std::size_t(std::numeric_limits<int>::max()))
             throw Error("image: " + std::to_string(scene.image.width) + " x " + std::to_string(scene.image.height) +
-                        " is too large for volref-mpi (its messages hold at most 2^31 - 1 doubles: 8 per pixel)");
+                        " is too large for volref-mpi (its messages hold at most 2^31 - 1 doubles: " +
+                        std::to_string(slots * kPart) + " per pixel)");
         // Direct send: rank 0 holds every rank's parts and its own; binary swap: a rank holds its parts
         // and half of them received; rank 0 also holds the image (up to 5 doubles a pixel).
-        const std::size_t image_bytes = parts / kPart * 5;
-        const std::size_t held = swap ? parts + parts / 2 + (rank == 0 ? image_bytes : 0)
-                                      : parts * (rank == 0 ? std::size_t(size) + 1 : 1) + (rank == 0 ? image_bytes : 0);
-        check_memory(prepared->bytes + held, "this rank's brick with the image parts (" + std::to_string(size) + " ranks, " +
-                                                 (swap ? "binary swap" : "direct send") + ")");
+        const std::size_t image_bytes = parts / (kPart * slots) * 5;
+        const std::size_t held_parts = swap ? parts + parts / 2 + (rank == 0 ? image_bytes : 0)
+                                            : parts * (rank == 0 ? std::size_t(size) + 1 : 1) + (rank == 0 ? image_bytes : 0);
+        check_memory(held + held_parts, "this rank's bricks with the image parts (" + std::to_string(size) + " ranks, " +
+                                            (swap ? "binary swap" : "direct send") + ")");
     } catch (const std::bad_alloc&) {
         err = "out of memory";
     } catch (const std::exception& e) {
@@ -236,141 +293,202 @@ int run(const Args& args, int rank, int size) {
     // ---- this rank's part of every ray ----
     const int W = scene.image.width, H = scene.image.height;
     const RenderSpec& render = scene.render;
-    const VolumeSpec& vs = scene.volume();
+    const std::size_t V = members.size(), slots = slot_count(scene);
     const mpi::Brick& brick = bricks[std::size_t(rank)];
-    const SamplePipeline& pipeline = *prepared->pipeline;
-    const double step = prepared->step, unit = pipeline.classifier().unit_distance();
+    const mpi::GridBox& lattice_grid = members[0].grid;
     const bool first_hit = render.projection == Projection::FirstHit;
-    // FirstHitIntegrator's exact search (Cartesian trilinear grids), on this rank's brick.
-    const VolumeSampler* trilinear = pipeline.cartesian_sampler();
-    if (trilinear && trilinear->interpolation() != Interpolation::Trilinear) trilinear = nullptr;
-    std::vector<double> part(std::size_t(W) * std::size_t(H) * kPart, 0.0);
+    const bool mixed = V > 1 && render.projection == Projection::Composite;
+    std::vector<double> part(std::size_t(W) * std::size_t(H) * slots * kPart, 0.0);
     // The brick's world box, padded: the segments worth testing (the test itself is exact).
     glm::dvec3 blo, bhi;
     for (int a = 0; a < 3; ++a) {
-        blo[a] = origin[a] + double(brick.lo[a] > 0 ? brick.lo[a] : 0) * spacing[a];
-        bhi[a] = origin[a] + double(brick.hi[a] < dims[a] - 1 ? brick.hi[a] : dims[a] - 1) * spacing[a];
-        const double pad = 1e-6 * (std::fabs(blo[a]) + std::fabs(bhi[a]) + spacing[a]);
+        blo[a] = lattice_grid.origin[a] + double(brick.lo[a]) * lattice_grid.spacing[a];
+        bhi[a] = lattice_grid.origin[a] + double(brick.hi[a]) * lattice_grid.spacing[a];
+        const double pad = 1e-6 * (std::fabs(blo[a]) + std::fabs(bhi[a]) + lattice_grid.spacing[a]);
         blo[a] -= pad;
         bhi[a] += pad;
     }
+    // Whether this rank owns the point at t: the brick holding it in the lattice (conventions §14).
+    auto owned_point = [&](const Ray& ray, double t) {
+        return mpi::owns(brick, lattice, (ray.at(t) - lattice_grid.origin) / lattice_grid.spacing);
+    };
+    // Pixel (x, y)'s ray and every volume's intervals (bounds AND domain, crop, clip planes: §4).
+    auto pixel_intervals = [&](int x, int y, Ray& ray, std::vector<Interval>* intervals) {
+        ray = camera->pixel_ray(x, y);
+        for (std::size_t k = 0; k < V; ++k) {
+            const VolumeSpec& vs = scene.volumes[k];
+            Ray local = ray;
+            intervals[k].clear();
+            geometry.intervals(&ray, 1, members[k].geometry_id, &intervals[k]);
+            if (vs.crop) crop_intervals(local, *vs.crop, intervals[k]);
+            if (!vs.clip_planes.empty()) clip_intervals(ray, vs.clip_planes, intervals[k]);
+        }
+    };
+    // The segments k of an interval (n of them at `step`) whose midpoints this rank owns, front to
+    // back (contiguous: the brick is convex), given the ray's range in the padded brick box.
+    auto owned_segments = [&](const Ray& ray, const Interval& iv, double step, const Interval& range, auto&& use) {
+        if (iv.t1 < range.t0 || iv.t0 > range.t1) return;
+        const std::int64_t n = segment_count(iv, step);
+        std::int64_t k0 = std::int64_t(std::floor((range.t0 - iv.t0) / step)) - 1;
+        std::int64_t k1 = std::int64_t(std::ceil((range.t1 - iv.t0) / step)) + 1;
+        k0 = std::clamp<std::int64_t>(k0, 0, n - 1);
+        k1 = std::clamp<std::int64_t>(k1, 0, n - 1);
+        for (std::int64_t k = k0; k <= k1; ++k) {
+            const Segment s = segment(iv, step, k, n);
+            if (owned_point(ray, s.midpoint())) use(s, k, n);
+        }
+    };
+    // Composite: one part (C, tau, opaque) from owned segments' (opaque, tau, alpha, colour), in ray
+    // order, by FrontToBack or BackToFront over this rank's segments.
+    struct Composited {
+        bool opaque;
+        double tau, alpha;
+        glm::dvec3 color;
+    };
+    auto composite_part = [&](const std::vector<Composited>& owned, double* p) {
+        CompensatedSum tau;
+        bool opaque = false;
+        auto add = [&](auto& acc, const Composited& o) {
+            const double c[3] = {o.color.r, o.color.g, o.color.b};
+            acc.add(true, o.opaque, o.tau, o.alpha, c);
+            if (o.opaque) opaque = true;
+            else tau.add(o.tau);
+        };
+        if (render.order == CompositeOrder::FrontToBack) {
+            FrontToBack<Scalar> acc;
+            for (const Composited& o : owned) {
+                add(acc, o);
+                if (opaque) break;
+            }
+            for (int i = 0; i < 3; ++i) p[1 + i] = acc.color(i);
+        } else {
+            BackToFront<Scalar> acc;
+            for (auto it = owned.rbegin(); it != owned.rend(); ++it) add(acc, *it);
+            for (int i = 0; i < 3; ++i) p[1 + i] = acc.color(i);
+        }
+        p[4] = tau.value();
+        p[5] = opaque ? 1.0 : 0.0;
+    };
+    // Volume k's part of the ray (its own step and projection), as a single-volume render's.
+    auto volume_part = [&](std::size_t vk, const Ray& ray, const std::vector<Interval>& intervals, const Interval& range,
+                           double* p) {
+        const PreparedVolume& pv = *members[vk].prepared;
+        const SamplePipeline& pipeline = *pv.pipeline;
+        const double step = pv.step, unit = pipeline.classifier().unit_distance();
+        // FirstHitIntegrator's exact search (Cartesian trilinear grids), on this rank's brick.
+        const VolumeSampler* trilinear = pipeline.cartesian_sampler();
+        if (trilinear && trilinear->interpolation() != Interpolation::Trilinear) trilinear = nullptr;
+        std::vector<Segment> owned;
+        std::vector<std::array<std::int64_t, 3>> owned_at;  // first hit: interval, k, n
+        for (std::size_t i = 0; i < intervals.size(); ++i)
+            owned_segments(ray, intervals[i], step, range, [&](const Segment& s, std::int64_t k, std::int64_t n) {
+                owned.push_back(s);
+                if (first_hit) owned_at.push_back({std::int64_t(i), k, n});
+            });
+        if (owned.empty()) return;
+        p[0] = owned.front().midpoint();
+        switch (render.projection) {
+            case Projection::Composite: {
+                std::vector<Composited> samples;
+                for (const Segment& s : owned) {
+                    const PipelineSample q = pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+                    if (!(q.opacity > 0.0)) continue;
+                    const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, q.opacity, s.length(), unit);
+                    samples.push_back({o.solid, o.tau, o.alpha, q.color});
+                }
+                composite_part(samples, p);
+                break;
+            }
+            case Projection::FirstHit: {
+                // FirstHitIntegrator's search over this rank's segments (each one's ends read here: a
+                // segment's g(t0) is its predecessor's g(t1), the same t); the key is the hit
+                // segment's midpoint (ray order).
+                p[0] = kNone;
+                const double iso = *render.isovalue;
+                auto g = [&](double t) { return pipeline.value(ray, t) - iso; };
+                std::optional<double> hit;
+                for (std::size_t m = 0; m < owned.size() && !hit; ++m) {
+                    const Interval& iv = intervals[std::size_t(owned_at[m][0])];
+                    const std::int64_t k = owned_at[m][1];
+                    const double ta = owned[m].t0, tb = owned[m].t1, ga = g(ta);
+                    if (k == 0 && ga == 0.0) hit = ta;
+                    else hit = bracket_crossing(g, trilinear, ray, ta, ga, tb, g(tb), iso, iv.length());
+                    if (hit) {
+                        p[0] = owned[m].midpoint();
+                        const glm::dvec3 c = pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color;
+                        for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
+                        p[4] = 1.0;
+                        p[5] = *hit;
+                    }
+                }
+                break;
+            }
+            case Projection::Mip:
+            case Projection::Minip: {
+                Extremum<Scalar> acc(render.projection == Projection::Mip);
+                for (const Segment& s : owned) acc.add(true, pipeline.value(ray, s.midpoint()), s.midpoint());
+                if (!acc.any()) {
+                    p[0] = kNone;
+                    break;
+                }
+                p[0] = acc.where();
+                const PipelineSample q = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
+                for (int i = 0; i < 3; ++i) p[1 + i] = q.opacity * q.color[i];
+                p[4] = q.opacity;
+                p[5] = acc.value();
+                break;
+            }
+            default: {  // average, xray
+                LineIntegral<CompensatedSum> acc;
+                for (const Segment& s : owned) {
+                    const double c = pipeline.classifier().coordinate(pipeline.value(ray, s.midpoint()));
+                    acc.add(std::isfinite(c) ? c * s.length() : 0.0, s.length());
+                }
+                p[6] = acc.integral();
+                p[7] = acc.length();
+                break;
+            }
+        }
+    };
+    // Several volumes, composite: the mix of the volumes present (MultiVolumeIntegrator::mix) at each
+    // owned segment of the pieces (segments restart at every piece, step = the smallest volume step).
+    auto mixed_part = [&](const std::vector<Ray>& rays, const std::vector<Interval>* intervals, const Interval& range,
+                          double* p, MultiVolumeIntegrator::MixScratch& scratch) {
+        std::vector<Composited> samples;
+        bool any = false;
+        for (const MultiVolumeIntegrator::Piece& piece : MultiVolumeIntegrator::pieces(intervals, V))
+            owned_segments(rays[0], piece.span, multi->step(), range, [&](const Segment& s, std::int64_t, std::int64_t) {
+                if (!any) p[0] = s.midpoint();
+                any = true;
+                const MultiVolumeIntegrator::MixedSegment m = multi->mix(rays.data(), piece.present, s, scratch);
+                if (!m.opaque && !(m.tau > 0.0)) return;
+                samples.push_back({m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), m.color});
+            });
+        if (any) composite_part(samples, p);
+    };
     try {
         tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
-                std::vector<Interval> intervals;
+                std::vector<std::vector<Interval>> intervals(V);
+                std::vector<Ray> rays(V);
+                MultiVolumeIntegrator::MixScratch scratch;
                 for (int y = rows.begin(); y != rows.end(); ++y)
                     for (int x = 0; x < W; ++x) {
-                        const Ray ray = camera->pixel_ray(x, y);
-                        Ray local = ray;
-                        intervals.clear();
-                        geometry.intervals(&ray, 1, geometry_id, &intervals);
-                        if (vs.crop) crop_intervals(local, *vs.crop, intervals);
-                        if (!vs.clip_planes.empty()) clip_intervals(ray, vs.clip_planes, intervals);
-                        double* p = &part[(std::size_t(y) * std::size_t(W) + std::size_t(x)) * kPart];
-                        p[0] = kNone;
+                        Ray ray;
+                        pixel_intervals(x, y, ray, intervals.data());
+                        double* p = &part[(std::size_t(y) * std::size_t(W) + std::size_t(x)) * slots * kPart];
+                        for (std::size_t s = 0; s < slots; ++s) p[s * kPart] = kNone;
                         Interval range;
-                        if (intervals.empty() || !intersect_box(ray, blo, bhi, range)) continue;
-                        // The owned segments, front to back (contiguous: the brick is convex).
-                        std::vector<Segment> owned;
-                        std::vector<std::array<std::int64_t, 3>> owned_at;  // first hit: interval, k, n
-                        for (std::size_t i = 0; i < intervals.size(); ++i) {
-                            const Interval& iv = intervals[i];
-                            if (iv.t1 < range.t0 || iv.t0 > range.t1) continue;
-                            const std::int64_t n = segment_count(iv, step);
-                            std::int64_t k0 = std::int64_t(std::floor((range.t0 - iv.t0) / step)) - 1;
-                            std::int64_t k1 = std::int64_t(std::ceil((range.t1 - iv.t0) / step)) + 1;
-                            k0 = std::clamp<std::int64_t>(k0, 0, n - 1);
-                            k1 = std::clamp<std::int64_t>(k1, 0, n - 1);
-                            for (std::int64_t k = k0; k <= k1; ++k) {
-                                const Segment s = segment(iv, step, k, n);
-                                const glm::dvec3 u = (ray.at(s.midpoint()) - origin) / spacing;
-                                if (!mpi::owns(brick, dims, u)) continue;
-                                owned.push_back(s);
-                                if (first_hit) owned_at.push_back({std::int64_t(i), k, n});
-                            }
-                        }
-                        if (owned.empty()) continue;
-                        p[0] = owned.front().midpoint();
-                        switch (render.projection) {
-                            case Projection::Composite: {
-                                CompensatedSum tau;
-                                bool opaque = false;
-                                auto add = [&](auto& acc, const Segment& s) {
-                                    const PipelineSample q = pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
-                                    if (!(q.opacity > 0.0)) return;
-                                    const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, q.opacity, s.length(), unit);
-                                    const double c[3] = {q.color.r, q.color.g, q.color.b};
-                                    acc.add(true, o.solid, o.tau, o.alpha, c);
-                                    if (o.solid) opaque = true;
-                                    else tau.add(o.tau);
-                                };
-                                if (render.order == CompositeOrder::FrontToBack) {
-                                    FrontToBack<Scalar> acc;
-                                    for (const Segment& s : owned) {
-                                        add(acc, s);
-                                        if (opaque) break;
-                                    }
-                                    for (int i = 0; i < 3; ++i) p[1 + i] = acc.color(i);
-                                } else {
-                                    BackToFront<Scalar> acc;
-                                    for (auto it = owned.rbegin(); it != owned.rend(); ++it) add(acc, *it);
-                                    for (int i = 0; i < 3; ++i) p[1 + i] = acc.color(i);
-                                }
-                                p[4] = tau.value();
-                                p[5] = opaque ? 1.0 : 0.0;
-                                break;
-                            }
-                            case Projection::FirstHit: {
-                                // FirstHitIntegrator's search over this rank's segments (each one's
-                                // ends read here: a segment's g(t0) is its predecessor's g(t1), the
-                                // same t); the key is the hit segment's midpoint (ray order).
-                                p[0] = kNone;
-                                const double iso = *render.isovalue;
-                                auto g = [&](double t) { return pipeline.value(ray, t) - iso; };
-                                std::optional<double> hit;
-                                for (std::size_t m = 0; m < owned.size() && !hit; ++m) {
-                                    const Interval& iv = intervals[std::size_t(owned_at[m][0])];
-                                    const std::int64_t k = owned_at[m][1];
-                                    const double ta = owned[m].t0, tb = owned[m].t1, ga = g(ta);
-                                    if (k == 0 && ga == 0.0) hit = ta;
-                                    else hit = bracket_crossing(g, trilinear, ray, ta, ga, tb, g(tb), iso, iv.length());
-                                    if (hit) {
-                                        p[0] = owned[m].midpoint();
-                                        const glm::dvec3 c =
-                                            pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color;
-                                        for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
-                                        p[4] = 1.0;
-                                        p[5] = *hit;
-                                    }
-                                }
-                                break;
-                            }
-                            case Projection::Mip:
-                            case Projection::Minip: {
-                                Extremum<Scalar> acc(render.projection == Projection::Mip);
-                                for (const Segment& s : owned) acc.add(true, pipeline.value(ray, s.midpoint()), s.midpoint());
-                                if (!acc.any()) {
-                                    p[0] = kNone;
-                                    break;
-                                }
-                                p[0] = acc.where();
-                                const PipelineSample q = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
-                                for (int i = 0; i < 3; ++i) p[1 + i] = q.opacity * q.color[i];
-                                p[4] = q.opacity;
-                                p[5] = acc.value();
-                                break;
-                            }
-                            default: {  // average, xray
-                                LineIntegral<CompensatedSum> acc;
-                                for (const Segment& s : owned) {
-                                    const double c = pipeline.classifier().coordinate(pipeline.value(ray, s.midpoint()));
-                                    acc.add(std::isfinite(c) ? c * s.length() : 0.0, s.length());
-                                }
-                                p[6] = acc.integral();
-                                p[7] = acc.length();
-                                break;
-                            }
+                        bool none = true;
+                        for (const auto& iv : intervals) none = none && iv.empty();
+                        if (none || !intersect_box(ray, blo, bhi, range)) continue;
+                        if (mixed) {
+                            std::fill(rays.begin(), rays.end(), ray);  // no transforms: every volume's ray is the world ray
+                            mixed_part(rays, intervals.data(), range, p, scratch);
+                        } else {
+                            for (std::size_t k = 0; k < V; ++k)
+                                if (!intervals[k].empty()) volume_part(k, ray, intervals[k], range, p + k * kPart);
                         }
                     }
             });
@@ -386,10 +504,10 @@ int run(const Args& args, int rank, int size) {
     MPI_Barrier(MPI_COMM_WORLD);  // (timing: the compositing below starts when the slowest rank is done)
     const double t_ready = now();
 
-    // One pixel from its parts in ray order (sorted by key; parts with no segment, key +inf, last):
-    // out = R G B A (and Z for first hit).
+    // One slot's pixel from its parts in ray order (sorted by key; parts with no segment, key +inf,
+    // last): R G B A (and Z for first hit).
     const int nc = first_hit ? 5 : 4;
-    auto pixel_of = [&](const double* const* order, int count, double* out) {
+    auto pixel_of = [&](const double* const* order, int count) {
         glm::dvec4 rgba(0.0);
         double depth = kNone;
         if (first_hit) {  // the nearest rank's hit
@@ -438,8 +556,23 @@ int run(const Args& args, int rank, int size) {
                 rgba = glm::dvec4(g, g, g, 1.0);
             }
         }
-        for (int c = 0; c < 4; ++c) out[c] = rgba[c];
-        if (first_hit) out[4] = depth;
+        PixelValue v;
+        v.rgba = rgba;
+        v.depth = depth;
+        return v;
+    };
+    // Pixel px from its slots' values: one slot as it is; several volumes (other than composite)
+    // combined by the single-process rule (MultiVolumeIntegrator::combine, which reads the pixel's
+    // intervals: recomputed here). out = R G B A (and Z).
+    auto finish = [&](std::size_t px, const PixelValue* values, double* out, std::vector<std::vector<Interval>>& intervals) {
+        PixelValue v = values[0];
+        if (slots > 1) {
+            Ray ray;
+            pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), ray, intervals.data());
+            v = multi->combine(values, intervals.data());
+        }
+        for (int c = 0; c < 4; ++c) out[c] = v.rgba[c];
+        if (first_hit) out[4] = v.depth;
     };
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
@@ -460,11 +593,17 @@ int run(const Args& args, int rank, int size) {
         if (rank == 0) {
             const std::size_t stride = part.size();
             std::vector<const double*> order(static_cast<std::size_t>(size));
+            std::vector<PixelValue> values(slots);
+            std::vector<std::vector<Interval>> intervals(V);
             for (std::size_t px = 0; px < pixels; ++px) {
-                for (int r = 0; r < size; ++r) order[std::size_t(r)] = &all[std::size_t(r) * stride + px * kPart];
-                // Ray order: the key, then the rank (ties of the extremum: the first sample wins).
-                std::stable_sort(order.begin(), order.end(), [](const double* a, const double* b) { return a[0] < b[0]; });
-                pixel_of(order.data(), size, &image->pixels[px * std::size_t(nc)]);
+                for (std::size_t sl = 0; sl < slots; ++sl) {
+                    for (int r = 0; r < size; ++r)
+                        order[std::size_t(r)] = &all[std::size_t(r) * stride + (px * slots + sl) * kPart];
+                    // Ray order: the key, then the rank (ties of the extremum: the first sample wins).
+                    std::stable_sort(order.begin(), order.end(), [](const double* a, const double* b) { return a[0] < b[0]; });
+                    values[sl] = pixel_of(order.data(), size);
+                }
+                finish(px, values.data(), &image->pixels[px * std::size_t(nc)], intervals);
             }
         }
     } else {
@@ -518,20 +657,27 @@ int run(const Args& args, int rank, int size) {
             const bool upper = (rank & bit) != 0;
             const std::size_t keep_lo = upper ? mid : lo, keep_hi = upper ? hi : mid;
             const std::size_t send_lo = upper ? lo : mid, send_hi = upper ? mid : hi;
-            incoming.resize((keep_hi - keep_lo) * kPart);
-            MPI_Sendrecv(&part[send_lo * kPart], int((send_hi - send_lo) * kPart), MPI_DOUBLE, partner, bit,
+            const std::size_t stride = slots * kPart;  // one pixel's slots
+            incoming.resize((keep_hi - keep_lo) * stride);
+            MPI_Sendrecv(&part[send_lo * stride], int((send_hi - send_lo) * stride), MPI_DOUBLE, partner, bit,
                          incoming.data(), int(incoming.size()), MPI_DOUBLE, partner, bit, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-            bytes_sent += (send_hi - send_lo) * kPart * sizeof(double);
+            bytes_sent += (send_hi - send_lo) * stride * sizeof(double);
             bytes_received += incoming.size() * sizeof(double);
             for (std::size_t px = keep_lo; px < keep_hi; ++px)
-                merge(&part[px * kPart], &incoming[(px - keep_lo) * kPart], upper);
+                for (std::size_t sl = 0; sl < slots; ++sl)
+                    merge(&part[px * stride + sl * kPart], &incoming[(px - keep_lo) * stride + sl * kPart], upper);
             lo = keep_lo;
             hi = keep_hi;
         }
         std::vector<double> finished((hi - lo) * std::size_t(nc));
+        std::vector<PixelValue> values(slots);
+        std::vector<std::vector<Interval>> intervals(V);
         for (std::size_t px = lo; px < hi; ++px) {
-            const double* q = &part[px * kPart];
-            pixel_of(&q, 1, &finished[(px - lo) * std::size_t(nc)]);
+            for (std::size_t sl = 0; sl < slots; ++sl) {
+                const double* q = &part[(px * slots + sl) * kPart];
+                values[sl] = pixel_of(&q, 1);
+            }
+            finish(px, values.data(), &finished[(px - lo) * std::size_t(nc)], intervals);
         }
         std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
         for (int r = 0; r < size; ++r) {

@@ -13,6 +13,9 @@ failed       : a truncated raw file whose last brick cannot be read: exit status
                `volref: error:` line naming the file, no image.
 formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.nii, scaled) read as bricks
                by 2, 3 and 4 ranks equal `volref render`; gzip data and a flipped NIfTI are one-line errors.
+volumes      : several volumes (different grids, overlapping, one cropped and clipped) on every
+               projection and order, orthographic and perspective, shaded and unshaded, by 2, 3 and
+               4 ranks equal `volref render`; a constant medium beside a second one has a closed form.
 refusals     : scenes outside the first version's scope are refused in one line naming the key.
 """
 import argparse, json, os, shutil, struct, subprocess, sys, math
@@ -396,6 +399,72 @@ if a.mode == "failed":
     else:
         print("ok failed brick: " + lines[0])
 
+def two_volumes(projection, camera, shaded=False, order="front-to-back"):
+    """base_scene's volume and a second one on another grid (coarser, shifted, partly overlapping it),
+    the second cropped and clipped, tricubic; a third, small constant one in front of both."""
+    s = base_scene(projection, camera, shaded=shaded, order=order)
+    v0 = s.pop("volume")
+    v1 = {"source": {"field": "marschner-lobb", "dims": [13, 15, 11], "alpha": 0.5, "fm": 3},
+          "spacing": [1.7, 1.1, 2.05], "origin": [4.2, -2.5, 3.3],
+          "interpolation": "tricubic-catmull-rom",
+          "transfer": {"color": [[0.0, 0.9, 0.2, 0.1], [1.0, 0.2, 0.9, 0.3]],
+                       "opacity": [[0.0, 0.0], [0.4, 0.05], [0.7, 0.4], [1.0, 0.1]]},
+          "crop": {"planes": [5, 20, -1, 12, 4, 22], "regions": 134217727 ^ (1 << 13)},
+          "clip_planes": [{"point": [10, 5, 12], "normal": [1, -1, 0.5]}]}
+    v2 = {"source": {"field": "constant", "value": 0.5, "dims": [4, 5, 3]},
+          "spacing": [2.0, 1.5, 2.5], "origin": [8.0, 6.0, 6.0],
+          "transfer": {"color": [[0.0, 0.3, 0.3, 1.0], [1.0, 0.3, 0.3, 1.0]], "opacity": [[0.0, 0.2], [1.0, 0.2]]}}
+    if shaded:
+        v1["shading"] = {"model": "phong"}
+    s["volumes"] = [v0, v1, v2]
+    if projection == "first-hit":
+        s["render"]["step"] = 0.45  # and volume 2 (constant 0.5 = the isovalue) hits at its face
+    return s
+
+
+if a.mode == "volumes":
+    cases = []
+    for cam in ("ortho", "persp", "inside"):
+        cases.append(("vols-composite-ftb-" + cam, two_volumes("composite", cam)))
+        cases.append(("vols-composite-btf-" + cam, two_volumes("composite", cam, order="back-to-front")))
+        for p in ("mip", "minip", "average", "xray", "first-hit"):
+            cases.append(("vols-" + p + "-" + cam, two_volumes(p, cam)))
+    cases.append(("vols-shaded-ftb-persp", two_volumes("composite", "persp", shaded=True)))
+    cases.append(("vols-shaded-first-hit-persp", two_volumes("first-hit", "persp", shaded=True)))
+    for name, scene in cases:
+        path = write_scene(name, scene)
+        for np_ in (2, 3, 4):
+            check_equal(name, path, np_)
+    # Closed form: two constant media along z, one above the other (z in [0, 16] and [16, 32]), with
+    # opacities 0.5 and 0.25 per unit and colours c0, c1, seen from above along -z: the upper medium
+    # first, C = c1 (1 - 0.75^16) + 0.75^16 c0 (1 - 0.5^16), A = 1 - 0.75^16 0.5^16; where they overlap
+    # (z in [14, 18] here: the second spans [14, 32]) the extinctions add (conventions §6a), so the
+    # scene below keeps them apart: the second starts at z = 16.
+    c0, c1 = [1.0, 0.5, 0.25], [0.2, 0.4, 0.8]
+    t1, t0 = 0.75 ** 16, 0.5 ** 16
+    expect = [c1[i] * (1 - t1) + t1 * c0[i] * (1 - t0) for i in range(3)] + [1 - t1 * t0]
+    scene = {"volumes": [
+        {"source": {"field": "constant", "value": 1.0, "dims": [9, 9, 17]},
+         "transfer": {"color": [[0.0] + c0, [2.0] + c0], "opacity": [[0.0, 0.5], [2.0, 0.5]]}},
+        {"source": {"field": "constant", "value": 1.0, "dims": [5, 5, 9]}, "spacing": [2.0, 2.0, 2.0],
+         "origin": [0.0, 0.0, 16.0],
+         "transfer": {"color": [[0.0] + c1, [2.0] + c1], "opacity": [[0.0, 0.25], [2.0, 0.25]]}}],
+        "camera": {"type": "orthographic", "eye": [4, 4, 100], "target": [4, 4, 16], "up": [0, 1, 0], "height": 4},
+        "image": {"width": 16, "height": 12}, "render": {"projection": "composite", "step": 0.37}}
+    path = write_scene("vols-constant", scene)
+    for np_ in (2, 3, 4):
+        out = os.path.join(a.work, "vols-constant.np%d.img" % np_)
+        r = mpirun(np_, ["render", path, "-o", out, "--threads", "1"] + comp)
+        if r.returncode != 0:
+            failures.append("vols-constant np=%d: volref-mpi failed: %s" % (np_, r.stderr.strip()))
+            continue
+        _, _, chans, px = read_img(out)
+        worst = max(abs(px[i] - expect[i % 4]) for i in range(len(px)))
+        if not worst <= 1e-12:
+            failures.append("vols-constant np=%d: %.3e from the closed form" % (np_, worst))
+        else:
+            print("ok vols-constant np=%d: closed form within %.3e" % (np_, worst))
+
 if a.mode == "refusals":
     cases = {
         "render.early_termination": ("render", "early_termination", 0.99),
@@ -412,6 +481,16 @@ if a.mode == "refusals":
             failures.append("%s: expected one error line naming it, got %d %r" % (key, r.returncode, r.stderr))
         else:
             print("ok " + lines[0])
+    # Several volumes: the key names the volume at fault.
+    s = two_volumes("composite", "ortho")
+    s["volumes"][1]["transform"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 2, 0, 0, 0, 1]
+    out = os.path.join(a.work, "refused.exr")
+    r = mpirun(2, ["render", write_scene("refused", s), "-o", out])
+    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+    if r.returncode == 0 or len(lines) != 1 or not lines[0].startswith("volref: error: volumes[1].transform") or os.path.exists(out):
+        failures.append("volumes[1].transform: expected one error line naming it, got %d %r" % (r.returncode, r.stderr))
+    else:
+        print("ok " + lines[0])
 
 for f in failures:
     print("FAIL " + f)

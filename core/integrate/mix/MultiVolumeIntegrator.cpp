@@ -17,14 +17,16 @@ namespace volref {
 
 namespace {
 
-// A piece of the ray on which the same volumes are present.
-struct Piece {
-    Interval span;
-    std::vector<int> present;
-};
+using Piece = MultiVolumeIntegrator::Piece;
+using Term = MultiVolumeIntegrator::MixTerm;
 
-// The pieces of the union of the volumes' intervals, front to back.
-std::vector<Piece> pieces(const std::vector<Interval>* intervals, std::size_t n) {
+}  // namespace
+
+bool MultiVolumeIntegrator::MixTerm::operator<(const MixTerm& o) const {
+    return std::tie(tau, c.r, c.g, c.b) < std::tie(o.tau, o.c.r, o.c.g, o.c.b);
+}
+
+std::vector<Piece> MultiVolumeIntegrator::pieces(const std::vector<Interval>* intervals, std::size_t n) {
     std::vector<double> cuts;
     for (std::size_t k = 0; k < n; ++k)
         for (const Interval& iv : intervals[k]) {
@@ -48,22 +50,41 @@ std::vector<Piece> pieces(const std::vector<Interval>* intervals, std::size_t n)
     return out;
 }
 
-// One segment of the mix: its optical depth and emitted colour, or opaque.
-struct Mixed {
-    double tau = 0.0;
-    glm::dvec3 color{0.0};
-    bool opaque = false;
-};
-
-struct Term {
-    double tau;
-    glm::dvec3 c;
-    bool operator<(const Term& o) const {
-        return std::tie(tau, c.r, c.g, c.b) < std::tie(o.tau, o.c.r, o.c.g, o.c.b);
+MultiVolumeIntegrator::MixedSegment MultiVolumeIntegrator::mix(const Ray* rays, const std::vector<int>& present,
+                                                               const Segment& s, MixScratch& scratch) const {
+    std::vector<Term>& terms = scratch.terms;
+    std::vector<Term>& opaque_terms = scratch.opaque_terms;
+    terms.clear();
+    opaque_terms.clear();
+    for (int k : present) {
+        const SamplePipeline& pipeline = *volumes_[std::size_t(k)].pipeline;
+        const PipelineSample p = pipeline.sample(rays[k], s.midpoint(), SamplePipeline::Use::Composite);
+        if (p.opacity <= 0.0) continue;
+        if (p.opacity >= 1.0)
+            opaque_terms.push_back({0.0, p.color});
+        else
+            terms.push_back({optical_depth(p.opacity, s.length(), pipeline.classifier().unit_distance()), p.color});
     }
-};
-
-}  // namespace
+    MixedSegment m;
+    if (!opaque_terms.empty()) {
+        std::sort(opaque_terms.begin(), opaque_terms.end());
+        for (const Term& t : opaque_terms) m.color += t.c;
+        m.color /= double(opaque_terms.size());
+        m.opaque = true;
+    } else if (terms.size() == 1) {
+        m.tau = terms[0].tau;
+        m.color = terms[0].c;
+    } else if (!terms.empty()) {
+        std::sort(terms.begin(), terms.end());
+        glm::dvec3 weighted(0.0);
+        for (const Term& t : terms) {
+            m.tau += t.tau;
+            weighted += t.tau * t.c;
+        }
+        if (m.tau > 0.0) m.color = weighted / m.tau;
+    }
+    return m;
+}
 
 MultiVolumeIntegrator::MultiVolumeIntegrator(std::vector<Member> volumes, const RenderSpec& render, double step)
     : volumes_(std::move(volumes)), render_(render), step_(step) {
@@ -156,44 +177,12 @@ PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std:
 PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<Interval>* intervals) const {
     if (!adaptive_.empty()) return adaptive_composite(rays, intervals);
     const std::vector<Piece> ps = pieces(intervals, volumes_.size());
-    std::vector<Term> terms, opaque_terms;
-    // The mix at segment s of the volumes `present`.
-    auto mix = [&](const std::vector<int>& present, const Segment& s) {
-        terms.clear();
-        opaque_terms.clear();
-        for (int k : present) {
-            const SamplePipeline& pipeline = *volumes_[std::size_t(k)].pipeline;
-            const PipelineSample p = pipeline.sample(rays[k], s.midpoint(), SamplePipeline::Use::Composite);
-            if (p.opacity <= 0.0) continue;
-            if (p.opacity >= 1.0)
-                opaque_terms.push_back({0.0, p.color});
-            else
-                terms.push_back({optical_depth(p.opacity, s.length(), pipeline.classifier().unit_distance()), p.color});
-        }
-        Mixed m;
-        if (!opaque_terms.empty()) {
-            std::sort(opaque_terms.begin(), opaque_terms.end());
-            for (const Term& t : opaque_terms) m.color += t.c;
-            m.color /= double(opaque_terms.size());
-            m.opaque = true;
-        } else if (terms.size() == 1) {
-            m.tau = terms[0].tau;
-            m.color = terms[0].c;
-        } else if (!terms.empty()) {
-            std::sort(terms.begin(), terms.end());
-            glm::dvec3 weighted(0.0);
-            for (const Term& t : terms) {
-                m.tau += t.tau;
-                weighted += t.tau * t.c;
-            }
-            if (m.tau > 0.0) m.color = weighted / m.tau;
-        }
-        return m;
-    };
+    MixScratch scratch;
+    auto mix = [&](const std::vector<int>& present, const Segment& s) { return this->mix(rays, present, s, scratch); };
 
     // The mixed segments composite as one medium's (march/Accumulators.h): opaque, or optical depth
     // m.tau with alpha = -expm1(-m.tau).
-    auto add = [](auto& acc, const Mixed& m) {
+    auto add = [](auto& acc, const MixedSegment& m) {
         const double c[3] = {m.color.r, m.color.g, m.color.b};
         acc.add(true, m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), c);
     };
@@ -205,7 +194,7 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         for (const Piece& p : ps) {
             const std::int64_t n = segment_count(p.span, step_);
             for (std::int64_t k = 0; k < n && !done; ++k) {
-                const Mixed m = mix(p.present, segment(p.span, step_, k, n));
+                const MixedSegment m = mix(p.present, segment(p.span, step_, k, n));
                 if (!m.opaque && !(m.tau > 0.0)) continue;
                 add(acc, m);
                 done = m.opaque || acc.stops(true, stop);
@@ -218,7 +207,7 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
             const std::int64_t n = segment_count(it->span, step_);
             for (std::int64_t k = n - 1; k >= 0; --k) {
-                const Mixed m = mix(it->present, segment(it->span, step_, k, n));
+                const MixedSegment m = mix(it->present, segment(it->span, step_, k, n));
                 if (m.opaque || m.tau > 0.0) add(acc, m);
             }
         }

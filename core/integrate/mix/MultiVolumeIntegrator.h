@@ -34,6 +34,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/integrate/Integrator.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/scene/Scene.h"
 #include "geometry/RayIntervals.h"
 
@@ -57,6 +58,32 @@ public:
     PixelValue composite(const Ray* rays, const std::vector<Interval>* intervals) const;
     // Other projections: the volumes' own pixels values[k] (from their integrators) combined.
     PixelValue combine(const PixelValue* values, const std::vector<Interval>* intervals) const;
+
+    // The pieces of the union of the volumes' intervals (intervals[k], k < n), front to back: the
+    // union's end points cut the ray, and each piece lists the volumes present on all of it.
+    struct Piece {
+        Interval span;
+        std::vector<int> present;
+    };
+    static std::vector<Piece> pieces(const std::vector<Interval>* intervals, std::size_t n);
+
+    // The mix of the volumes `present` at segment s (composite; fixed step): its optical depth and
+    // extinction-weighted colour, or opaque with the mean colour of the opaque samples. composite()
+    // adds these front to back; volref-mpi adds the segments a rank owns (cli/mpi/).
+    struct MixedSegment {
+        double tau = 0.0;
+        glm::dvec3 color{0.0};
+        bool opaque = false;
+    };
+    struct MixTerm {
+        double tau;
+        glm::dvec3 c;
+        bool operator<(const MixTerm& o) const;
+    };
+    struct MixScratch {
+        std::vector<MixTerm> terms, opaque_terms;
+    };
+    MixedSegment mix(const Ray* rays, const std::vector<int>& present, const Segment& s, MixScratch& scratch) const;
 
     std::size_t size() const { return volumes_.size(); }
     const Member& member(std::size_t k) const { return volumes_[k]; }

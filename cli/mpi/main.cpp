@@ -34,6 +34,7 @@
 #include "core/camera/Camera.h"
 #include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
+#include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/fixed/FirstHitIntegrator.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/CompensatedSum.h"
@@ -93,8 +94,9 @@ std::string volume_key(const Scene& scene, std::size_t k) {
 // The first version's scope (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    if (r.integrator != IntegrationMethod::Fixed)
-        throw Error("render.integrator: volref-mpi supports \"fixed\" only (the adaptive integrator is not supported yet)");
+    if (r.integrator != IntegrationMethod::Fixed && (r.projection != Projection::Composite || scene.volumes.size() != 1))
+        throw Error("render.integrator: volref-mpi supports \"adaptive\" for the composite of one volume only (other "
+                    "projections and several volumes are not supported yet)");
     if (r.profile != ProfileId::Reference)
         throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
     if (r.early_termination) throw Error("render.early_termination: not supported by volref-mpi yet");
@@ -466,7 +468,131 @@ int run(const Args& args, int rank, int size) {
             });
         if (any) composite_part(samples, p);
     };
-    try {
+    // ---- render.integrator "adaptive", composite: the ray's state handed from rank to rank ----
+    // The adaptive integrator's refinement of a piece depends on the transmittance in front of it,
+    // the largest colour seen and the rules left (AdaptiveComposite.h), so a rank's pieces cannot be
+    // integrated before those of the ranks in front: every rank lists the pieces it owns (cut as the
+    // single process cuts them; a piece belongs to the brick holding its midpoint) and its key (the
+    // first one's midpoint); the keys are all-gathered, giving each pixel's ranks in ray order; in
+    // round j the j-th rank of each pixel continues that pixel's state (kStateSize doubles) over its
+    // pieces, and an MPI_Allreduce hands the states on. The error's sums run back to front the same way
+    // (what is emitted behind each leaf). Pixels' R G B A error in `chained` on every rank.
+    const bool chain = render.integrator == IntegrationMethod::Adaptive;
+    std::vector<double> chained;
+    if (chain) {
+        using Composite = AdaptiveIntegrator::Composite;
+        const auto* adaptive = dynamic_cast<const AdaptiveIntegrator*>(members[0].prepared->integrator.get());
+        const std::size_t P = std::size_t(W) * std::size_t(H), S = std::size_t(Composite::kStateSize);
+        std::vector<std::vector<std::array<double, 2>>> pieces(P);
+        std::vector<double> key(P, kNone), total(P, 0.0);
+        std::vector<int> position(P, -1), count(P, 0);
+        tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
+        auto each_pixel = [&](auto&& f) {
+            arena.execute([&] {
+                tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P), [&](const tbb::blocked_range<std::size_t>& r) {
+                    for (std::size_t px = r.begin(); px != r.end(); ++px) f(px);
+                });
+            });
+        };
+        try {
+            if (!adaptive) throw Error("render.integrator: internal: volref-mpi found no adaptive integrator");
+            each_pixel([&](std::size_t px) {
+                std::vector<Interval> intervals;
+                std::vector<double> cut;
+                Ray ray;
+                pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), ray, &intervals);
+                for (const Interval& iv : intervals) total[px] += iv.length();
+                for (const Interval& iv : intervals) {
+                    adaptive->cuts(ray, iv, cut);
+                    for (std::size_t p = 0; p + 1 < cut.size(); ++p)
+                        if (owned_point(ray, 0.5 * (cut[p] + cut[p + 1]))) pieces[px].push_back({cut[p], cut[p + 1]});
+                }
+                if (!pieces[px].empty()) key[px] = 0.5 * (pieces[px][0][0] + pieces[px][0][1]);
+            });
+        } catch (const std::bad_alloc&) {
+            err = "out of memory";
+        } catch (const std::exception& e) {
+            err = e.what();
+        }
+        if (any_error(err, rank, size)) return 1;
+        std::vector<double> keys(P * std::size_t(size));
+        MPI_Allgather(key.data(), int(P), MPI_DOUBLE, keys.data(), int(P), MPI_DOUBLE, MPI_COMM_WORLD);
+        for (std::size_t px = 0; px < P; ++px)
+            for (int r = 0; r < size; ++r) {
+                const double k = keys[std::size_t(r) * P + px];
+                if (k == kNone) continue;
+                ++count[px];
+                if (key[px] != kNone && (k < key[px] || (k == key[px] && r < rank))) ++position[px];
+            }
+        for (std::size_t px = 0; px < P; ++px)
+            if (key[px] != kNone) ++position[px];  // from -1: the ranks in front of this one
+        const double tolerance = render.tolerance, safety = adaptive->safety();
+        std::vector<double> state(P * S), delta(P * S), next(P * S);
+        {
+            const AdaptiveIntegrator::OneVolume none{adaptive, nullptr};
+            const Composite fresh(none, tolerance, safety, 1.0);
+            for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
+        }
+        std::vector<std::vector<Composite::LeafRecord>> leaves(P);
+        for (int j = 0; j < size; ++j) {
+            std::fill(delta.begin(), delta.end(), 0.0);
+            try {
+                each_pixel([&](std::size_t px) {
+                    if (position[px] != j) return;
+                    const Ray ray = camera->pixel_ray(int(px % std::size_t(W)), int(px / std::size_t(W)));
+                    const AdaptiveIntegrator::OneVolume one{adaptive, &ray};
+                    Composite st(one, tolerance, safety, total[px]);
+                    st.load(&state[px * S]);
+                    for (const auto& piece : pieces[px]) {
+                        if (st.is_opaque()) break;
+                        adaptive->composite_piece(ray, piece[0], piece[1], st);
+                    }
+                    st.save(&delta[px * S]);
+                    leaves[px] = st.leaves();
+                });
+            } catch (const std::bad_alloc&) {
+                err = "out of memory";
+            } catch (const std::exception& e) {
+                err = e.what();
+            }
+            if (any_error(err, rank, size)) return 1;
+            // One rank wrote each pixel of this round, the others 0: the sum is its state.
+            MPI_Allreduce(delta.data(), next.data(), int(P * S), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+            for (std::size_t px = 0; px < P; ++px)
+                if (count[px] > j) std::copy(&next[px * S], &next[px * S] + S, &state[px * S]);
+        }
+        // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c.
+        constexpr std::size_t E = 5;
+        std::vector<double> sums(P * E, 0.0), dsums(P * E), nsums(P * E);
+        for (std::size_t px = 0; px < P; ++px)
+            for (int i = 0; i < 3; ++i) sums[px * E + std::size_t(i)] = state[px * S + 12 + std::size_t(i)];
+        for (int j = size - 1; j >= 0; --j) {
+            std::fill(dsums.begin(), dsums.end(), 0.0);
+            for (std::size_t px = 0; px < P; ++px) {
+                if (position[px] != j) continue;
+                double* q = &sums[px * E];
+                glm::dvec3 behind(q[0], q[1], q[2]);
+                double colour_err = q[3], tau_err = q[4];
+                Composite::error_sums(leaves[px], behind, colour_err, tau_err);
+                double* d = &dsums[px * E];
+                d[0] = behind.r, d[1] = behind.g, d[2] = behind.b, d[3] = colour_err, d[4] = tau_err;
+            }
+            MPI_Allreduce(dsums.data(), nsums.data(), int(P * E), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+            for (std::size_t px = 0; px < P; ++px)
+                if (count[px] > j) std::copy(&nsums[px * E], &nsums[px * E] + E, &sums[px * E]);
+        }
+        chained.assign(P * 5, 0.0);
+        const AdaptiveIntegrator::OneVolume none{adaptive, nullptr};
+        for (std::size_t px = 0; px < P; ++px) {
+            if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as AdaptiveIntegrator)
+            Composite st(none, tolerance, safety, total[px]);
+            st.load(&state[px * S]);
+            const PixelValue v = st.result_from(sums[px * E + 3], sums[px * E + 4]);
+            for (int c = 0; c < 4; ++c) chained[px * 5 + std::size_t(c)] = v.rgba[c];
+            chained[px * 5 + 4] = v.error;
+        }
+    }
+    if (!chain) try {
         tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
@@ -506,7 +632,7 @@ int run(const Args& args, int rank, int size) {
 
     // One slot's pixel from its parts in ray order (sorted by key; parts with no segment, key +inf,
     // last): R G B A (and Z for first hit).
-    const int nc = first_hit ? 5 : 4;
+    const int nc = first_hit || chain ? 5 : 4;
     auto pixel_of = [&](const double* const* order, int count) {
         glm::dvec4 rgba(0.0);
         double depth = kNone;
@@ -577,12 +703,16 @@ int run(const Args& args, int rank, int size) {
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
     if (first_hit) channels.push_back("Z");  // as volref render writes it
+    if (chain) channels.push_back("error");  // the adaptive integrator's estimate, as volref render writes it
     std::unique_ptr<Image> image;
     if (rank == 0) image = std::make_unique<Image>(W, H, channels);
     const std::size_t pixels = std::size_t(W) * std::size_t(H);
     std::size_t bytes_sent = 0, bytes_received = 0;  // by this rank, this frame
     double t_gather = 0.0;  // rank 0: the parts (direct) or the finished pixels (swap) are in
-    if (!swap) {
+    if (chain) {  // every rank holds the pixels
+        t_gather = now();
+        if (rank == 0) std::copy(chained.begin(), chained.end(), image->pixels.begin());
+    } else if (!swap) {
         // ---- direct send: every rank's parts to rank 0, combined there in ray order ----
         std::vector<double> all;
         if (rank == 0) all.resize(part.size() * std::size_t(size));

@@ -465,15 +465,43 @@ if a.mode == "volumes":
         else:
             print("ok vols-constant np=%d: closed form within %.3e" % (np_, worst))
 
+if a.mode == "adaptive":
+    # render.integrator "adaptive", composite: each pixel's state passed from rank to rank in ray order.
+    cases = []
+    for cam in ("ortho", "persp", "inside"):
+        s = base_scene("composite", cam)
+        s["render"]["integrator"] = "adaptive"
+        s["render"]["tolerance"] = 1e-4
+        cases.append(("adaptive-" + cam, s))
+    s = base_scene("composite", "persp", shaded=True)
+    s["render"].update({"integrator": "adaptive", "tolerance": 1e-3})
+    cases.append(("adaptive-shaded-persp", s))
+    s = base_scene("composite", "ortho")
+    s["render"].update({"integrator": "adaptive", "tolerance": 1e-4})
+    s["volume"]["interpolation"] = "tricubic-bspline"
+    s["volume"]["crop"] = {"planes": [0, 8, 4, 14, 3, 12], "regions": 134217727 ^ (1 << 13)}
+    s["volume"]["clip_planes"] = [{"point": [7, 11, 10], "normal": [1, 1, 0]}]
+    cases.append(("adaptive-tricubic-crop-clip-ortho", s))
+    # Opacity 1 above f = 0.7: rays end inside some brick (the opaque piece), the ranks behind add nothing.
+    s = base_scene("composite", "persp")
+    s["render"].update({"integrator": "adaptive", "tolerance": 1e-4})
+    s["volume"]["transfer"]["opacity"] = [[0.0, 0.0], [0.45, 0.0], [0.5, 0.3], [0.7, 1.0], [1.0, 1.0]]
+    cases.append(("adaptive-opaque-persp", s))
+    for name, scene in cases:
+        path = write_scene(name, scene)
+        for np_ in (2, 3, 4):
+            check_equal(name, path, np_)
+
 if a.mode == "refusals":
     cases = {
         "render.early_termination": ("render", "early_termination", 0.99),
-        "render.integrator": ("render", "integrator", "adaptive"),
+        "render.integrator": ("render", "integrator", "adaptive", "projection", "mip"),
         "render.profile": ("render", "profile", "vtk-gpu"),
     }
-    for key, (section, k, v) in cases.items():
+    for key, (section, *kv) in cases.items():
         s = base_scene("composite", "ortho")
-        s[section][k] = v
+        for k, v in zip(kv[::2], kv[1::2]):
+            s[section][k] = v
         out = os.path.join(a.work, "refused.exr")
         r = mpirun(2, ["render", write_scene("refused", s), "-o", out])
         lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]

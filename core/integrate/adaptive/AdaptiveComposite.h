@@ -57,31 +57,69 @@ public:
 
     // The pixel and its error (AdaptiveIntegrator.h, "Error").
     PixelValue result() const {
-        using adaptive_detail::max_abs;
-        PixelValue out;
-        const double T_end = opaque_ ? 0.0 : acc_.transmittance();
-        out.rgba = glm::dvec4(acc_.color(0), acc_.color(1), acc_.color(2), acc_.alpha());
-        // Posterior error: leaf i's tau error scales everything emitted behind it.
         glm::dvec3 behind = opaque_colour_;
         double colour_err = 0.0, tau_err = 0.0;
-        for (auto it = leaves_.rbegin(); it != leaves_.rend(); ++it) {
+        error_sums(leaves_, behind, colour_err, tau_err);
+        return result_from(colour_err, tau_err);
+    }
+
+    struct LeafRecord {
+        glm::dvec3 contribution;  // T(a) E
+        double e_emission;        // T(a) e_E
+        double e_tau;
+    };
+    // Posterior error: leaf i's tau error scales everything emitted behind it. Adds the leaves' terms,
+    // back to front, to colour_err and tau_err; `behind` is what is emitted behind the last leaf (the
+    // opaque piece's T c, or 0), and on return behind the first.
+    static void error_sums(const std::vector<LeafRecord>& leaves, glm::dvec3& behind, double& colour_err, double& tau_err) {
+        using adaptive_detail::max_abs;
+        for (auto it = leaves.rbegin(); it != leaves.rend(); ++it) {
             colour_err += it->e_emission + it->e_tau * max_abs(behind);
             tau_err += it->e_tau;
             behind += it->contribution;
         }
+    }
+    // The pixel, given the error sums over every leaf of the ray.
+    PixelValue result_from(double colour_err, double tau_err) const {
+        PixelValue out;
+        const double T_end = opaque_ ? 0.0 : acc_.transmittance();
+        out.rgba = glm::dvec4(acc_.color(0), acc_.color(1), acc_.color(2), acc_.alpha());
         // A piece accepted unresolved (the ray's rules spent) may be wrong by anything it and the pieces
         // behind it contribute: at most T K in each channel (T in front of it, K >= 1 the largest colour).
         out.error = std::max(colour_err, T_end * tau_err) + adaptive_detail::rounding_bound(out.rgba) +
                     unresolved_T_ * colour_bound_;
         return out;
     }
+    const std::vector<LeafRecord>& leaves() const { return leaves_; }
+    const glm::dvec3& opaque_contribution() const { return opaque_colour_; }
+
+    // volref-mpi (cli/mpi/): the state a ray carries from one rank's pieces to the next's, kStateSize
+    // doubles: the accumulator, K, the rules left, the transmittance of the first unresolved piece,
+    // opaque, and the opaque piece's T c. load() starts a new list of leaves (each rank keeps its own).
+    static constexpr int kStateSize = 8 + 7;
+    void save(double* s) const {
+        bool opaque_lanes = false;
+        acc_.save(s, opaque_lanes);
+        s[8] = colour_bound_;
+        s[9] = double(rules_left_);
+        s[10] = unresolved_T_;
+        s[11] = opaque_ ? 1.0 : 0.0;
+        s[12] = opaque_colour_.r;
+        s[13] = opaque_colour_.g;
+        s[14] = opaque_colour_.b;
+        (void)opaque_lanes;
+    }
+    void load(const double* s) {
+        opaque_ = s[11] != 0.0;
+        acc_.load(s, opaque_);
+        colour_bound_ = s[8];
+        rules_left_ = long(s[9]);
+        unresolved_T_ = s[10];
+        opaque_colour_ = glm::dvec3(s[12], s[13], s[14]);
+        leaves_.clear();
+    }
 
 private:
-    struct LeafRecord {
-        glm::dvec3 contribution;  // T(a) E
-        double e_emission;        // T(a) e_E
-        double e_tau;
-    };
     // One G7/K15 evaluation of [a, b]: the emission E (relative to T(a)) and Delta tau by both rules.
     struct Rule {
         glm::dvec3 ek{0.0}, eg{0.0};

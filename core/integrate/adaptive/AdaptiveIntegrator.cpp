@@ -295,29 +295,26 @@ PixelValue AdaptiveIntegrator::composite(const Ray& ray, const std::vector<Inter
     double total = 0.0;
     for (const Interval& iv : intervals) total += iv.length();
     if (!(total > 0.0)) return PixelValue{};
-    struct OneVolume {
-        const AdaptiveIntegrator* self;
-        const Ray* ray;
-        void sample(double t, double& sigma, glm::dvec3& c) const { self->medium(*ray, t, sigma, c); }
-    } one{this, &ray};
-    AdaptiveComposite<OneVolume> st(one, ctx_.render.tolerance, safety(), total);
+    const OneVolume one{this, &ray};
+    Composite st(one, ctx_.render.tolerance, safety(), total);
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
         cuts(ray, iv, cut);
-        for (std::size_t p = 0; p + 1 < cut.size() && !st.is_opaque(); ++p) {
-            const double a = cut[p], b = cut[p + 1];
-            if (!(b > a) || empty_piece(ray, a, b)) continue;
-            const double ts = opaque_from(ray, a, b);
-            if (ts < b) {  // the ray ends at ts
-                if (ts > a) st.integrate(a, ts);
-                st.opaque(opaque_colour(ray, ts, b));
-            } else {
-                st.integrate(a, b);
-            }
-        }
+        for (std::size_t p = 0; p + 1 < cut.size() && !st.is_opaque(); ++p) composite_piece(ray, cut[p], cut[p + 1], st);
         if (st.is_opaque()) break;
     }
     return st.result();
+}
+
+void AdaptiveIntegrator::composite_piece(const Ray& ray, double a, double b, Composite& st) const {
+    if (!(b > a) || empty_piece(ray, a, b)) return;
+    const double ts = opaque_from(ray, a, b);
+    if (ts < b) {  // the ray ends at ts
+        if (ts > a) st.integrate(a, ts);
+        st.opaque(opaque_colour(ray, ts, b));
+    } else {
+        st.integrate(a, b);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

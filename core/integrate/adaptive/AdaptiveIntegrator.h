@@ -53,6 +53,7 @@
 #pragma once
 #include <vector>
 
+#include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/CellCubic.h"
 #include "core/integrate/Integrator.h"
 
@@ -86,6 +87,17 @@ public:
     bool empty_piece(const Ray& ray, double a, double b) const;
     // 1, or kAdaptiveWeakSafety where kinks of the integrand lie inside pieces.
     double safety() const;
+
+    // The composite of one volume: its medium, and one piece [a, b] between two cuts added to `st`
+    // (skipped when empty; cut where it becomes opaque). composite() calls it for every piece front to
+    // back; volref-mpi for the pieces a rank owns, continuing the state of the ranks in front.
+    struct OneVolume {
+        const AdaptiveIntegrator* self;
+        const Ray* ray;
+        void sample(double t, double& sigma, glm::dvec3& c) const { self->medium(*ray, t, sigma, c); }
+    };
+    using Composite = AdaptiveComposite<OneVolume>;
+    void composite_piece(const Ray& ray, double a, double b, Composite& st) const;
 
 private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;

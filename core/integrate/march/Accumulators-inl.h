@@ -100,6 +100,23 @@ public:
         opaque_ = L::all_lanes();
     }
 
+    // The whole state: 8 values (optical depth or transmittance and its compensation, colour and its
+    // compensation) and the opaque lanes. volref-mpi hands a ray's accumulator from rank to rank
+    // (the adaptive integrator's pieces, cli/mpi/); load(save()) changes no bit.
+    static constexpr int kStateValues = 8;
+    void save(V* out, M& opaque) const {
+        out[0] = s_;
+        out[1] = c_;
+        for (int i = 0; i < 3; ++i) out[2 + i] = color_[i], out[5 + i] = color_c_[i];
+        opaque = opaque_;
+    }
+    void load(const V* in, M opaque) {
+        s_ = in[0];
+        c_ = in[1];
+        for (int i = 0; i < 3; ++i) color_[i] = in[2 + i], color_c_[i] = in[5 + i];
+        opaque_ = opaque;
+    }
+
     // The lanes among `partial` (lanes that took a partially transparent sample) that stop here.
     M stops(M partial, const ::volref::Termination& t) const {
         M stop = L::no_lanes();

@@ -392,17 +392,26 @@ PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<I
     const double tol = ctx_.render.tolerance;
     // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
     const double per_length = mean ? tol : (L > 0.0 ? tol / (ctx_.render.gain * L) : 0.0);
-    LineState st{&ctx_.pipeline, &ray, per_length, cubic_ ? 1.0 : conventions::kAdaptiveWeakSafety, {}, 0.0};
+    LineSums st;
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
         cuts(ray, iv, cut);
-        for (std::size_t p = 0; p + 1 < cut.size(); ++p)
-            if (cut[p + 1] > cut[p]) st.integrate(cut[p], cut[p + 1]);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p) line_piece(ray, cut[p], cut[p + 1], per_length, st);
     }
     const double g = mean ? (L > 0.0 ? st.integral.value() / L : 0.0) : ctx_.render.gain * st.integral.value();
     out.rgba = glm::dvec4(g, g, g, 1.0);
     out.error = (mean ? (L > 0.0 ? st.error / L : 0.0) : ctx_.render.gain * st.error) + rounding_bound(out.rgba);
     return out;
+}
+
+void AdaptiveIntegrator::line_piece(const Ray& ray, double a, double b, double per_length, LineSums& sums) const {
+    if (!(b > a)) return;
+    LineState st{&ctx_.pipeline, &ray, per_length, cubic_ ? 1.0 : conventions::kAdaptiveWeakSafety, sums.integral,
+                 sums.error, sums.rules_left};
+    st.integrate(a, b);
+    sums.integral = st.integral;
+    sums.error = st.error;
+    sums.rules_left = st.rules_left;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -413,28 +422,10 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
     const bool maximum = ctx_.render.projection == Projection::Mip;
     // The extremum over the candidates (march/Accumulators.h; non-finite values are ignored).
     Extremum<Scalar> acc(maximum);
-    auto consider = [&](double t) { acc.add(true, ctx_.field(ray, t), t); };
-    // A piece's end, read in the piece's own cell (piece_end, CellCubic.h).
-    auto consider_end = [&](double t, double toward) {
-        const auto [at, v] = piece_end([&](double u) { return ctx_.field(ray, u); }, t, toward);
-        acc.add(true, v, at);
-    };
-    const Volume& v = cartesian_->volume();
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
-        grid_cuts(ray, iv.t0, iv.t1, v, cut_offset_, cut);
-        for (std::size_t p = 0; p + 1 < cut.size(); ++p) {
-            const double ta = cut[p], tb = cut[p + 1];
-            if (!cubic_) {  // nearest: constant on the piece
-                consider(0.5 * (ta + tb));
-                continue;
-            }
-            consider_end(ta, tb);
-            consider_end(tb, ta);
-            double ex[2];
-            const int ne = cubic_extrema(cell_cubic(*cartesian_, ray, ta, tb), tb - ta, ex);
-            for (int k = 0; k < ne; ++k) consider(ta + ex[k]);
-        }
+        extremum_cuts(ray, iv, cut);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p) extremum_piece(ray, cut[p], cut[p + 1], acc);
     }
     PixelValue out;
     if (acc.any()) {
@@ -443,6 +434,28 @@ PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interv
     }
     out.error = rounding_bound(out.rgba);
     return out;
+}
+
+void AdaptiveIntegrator::extremum_cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const {
+    grid_cuts(ray, iv.t0, iv.t1, cartesian_->volume(), cut_offset_, out);
+}
+
+void AdaptiveIntegrator::extremum_piece(const Ray& ray, double ta, double tb, Extremum<Scalar>& acc) const {
+    auto consider = [&](double t) { acc.add(true, ctx_.field(ray, t), t); };
+    if (!cubic_) {  // nearest: constant on the piece
+        consider(0.5 * (ta + tb));
+        return;
+    }
+    // A piece's end, read in the piece's own cell (piece_end, CellCubic.h).
+    auto consider_end = [&](double t, double toward) {
+        const auto [at, v] = piece_end([&](double u) { return ctx_.field(ray, u); }, t, toward);
+        acc.add(true, v, at);
+    };
+    consider_end(ta, tb);
+    consider_end(tb, ta);
+    double ex[2];
+    const int ne = cubic_extrema(cell_cubic(*cartesian_, ray, ta, tb), tb - ta, ex);
+    for (int k = 0; k < ne; ++k) consider(ta + ex[k]);
 }
 
 }  // namespace volref

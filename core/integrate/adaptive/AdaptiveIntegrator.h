@@ -55,6 +55,7 @@
 
 #include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/CellCubic.h"
+#include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/Integrator.h"
 
 namespace volref {
@@ -98,6 +99,19 @@ public:
     };
     using Composite = AdaptiveComposite<OneVolume>;
     void composite_piece(const Ray& ray, double a, double b, Composite& st) const;
+
+    // mip / minip: the pieces of an interval (cell faces; nearest: the regions' faces), and one piece's
+    // candidates (its ends in its own cell and the cubic's extrema; nearest: its midpoint) added to acc.
+    void extremum_cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const;
+    void extremum_piece(const Ray& ray, double ta, double tb, Extremum<Scalar>& acc) const;
+    // average / xray: the sums along the ray (the integral, its error estimate, the rules left), and one
+    // piece [a, b] between two cuts added to them with the accepted error `per_length` per unit length.
+    struct LineSums {
+        CompensatedSum integral;
+        double error = 0.0;
+        long rules_left = conventions::kAdaptiveMaxRulesPerRay;
+    };
+    void line_piece(const Ray& ray, double a, double b, double per_length, LineSums& sums) const;
 
 private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;

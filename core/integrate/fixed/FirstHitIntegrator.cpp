@@ -22,34 +22,37 @@ int sign(double x) { return (x > 0.0) - (x < 0.0); }
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
                                            double iso) {
     // Non-finite values (NaN, +-Inf voxels) never cross: parts with a non-finite end are passed over.
-    auto g = [&](double t) { return sampler.trilinear(ray.at(t)) - iso; };
-    if (g(t0) == 0.0) return t0;
+    if (sampler.trilinear(ray.at(t0)) - iso == 0.0) return t0;
     std::vector<double> cuts;
     grid_cuts(ray, t0, t1, sampler.volume(), 0.0, cuts);
-    for (std::size_t p = 0; p + 1 < cuts.size(); ++p) {
-        const double ta = cuts[p], tb = cuts[p + 1];
-        double ex[2];
-        const int ne = cubic_extrema(cell_cubic(sampler, ray, ta, tb), tb - ta, ex);
-        // The monotone parts' ends: ta, ta + extrema, tb.
-        double ts[4];
-        int n = 0;
-        ts[n++] = ta;
-        for (int k = 0; k < ne; ++k)
-            if (ta + ex[k] > ts[n - 1] && ta + ex[k] < tb) ts[n++] = ta + ex[k];
-        ts[n++] = tb;
-        // The piece's own ends, read in its cell (piece_end, CellCubic.h).
-        double ga = piece_end(g, ta, tb).second;
-        for (int m = 0; m + 1 < n; ++m) {
-            const double a = ts[m], b = ts[m + 1], gb = m + 2 == n ? piece_end(g, b, a).second : g(b);
-            if (!std::isfinite(ga) || !std::isfinite(gb)) {
-                ga = gb;
-                continue;
-            }
-            if (ga == 0.0) return a;
-            if (gb == 0.0) return b;
-            if (sign(ga) != sign(gb)) return bisect_to_rounding(g, a, b, sign(ga));
+    for (std::size_t p = 0; p + 1 < cuts.size(); ++p)
+        if (const auto hit = first_crossing_in_cell(sampler, ray, cuts[p], cuts[p + 1], iso)) return hit;
+    return std::nullopt;
+}
+
+std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const Ray& ray, double ta, double tb, double iso) {
+    auto g = [&](double t) { return sampler.trilinear(ray.at(t)) - iso; };
+    double ex[2];
+    const int ne = cubic_extrema(cell_cubic(sampler, ray, ta, tb), tb - ta, ex);
+    // The monotone parts' ends: ta, ta + extrema, tb.
+    double ts[4];
+    int n = 0;
+    ts[n++] = ta;
+    for (int k = 0; k < ne; ++k)
+        if (ta + ex[k] > ts[n - 1] && ta + ex[k] < tb) ts[n++] = ta + ex[k];
+    ts[n++] = tb;
+    // The piece's own ends, read in its cell (piece_end, CellCubic.h).
+    double ga = piece_end(g, ta, tb).second;
+    for (int m = 0; m + 1 < n; ++m) {
+        const double a = ts[m], b = ts[m + 1], gb = m + 2 == n ? piece_end(g, b, a).second : g(b);
+        if (!std::isfinite(ga) || !std::isfinite(gb)) {
             ga = gb;
+            continue;
         }
+        if (ga == 0.0) return a;
+        if (gb == 0.0) return b;
+        if (sign(ga) != sign(gb)) return bisect_to_rounding(g, a, b, sign(ga));
+        ga = gb;
     }
     return std::nullopt;
 }

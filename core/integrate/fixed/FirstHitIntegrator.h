@@ -43,6 +43,9 @@ private:
 // bisection narrows until no double lies between the bracket's ends. None: no crossing.
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
                                            double iso);
+// Its loop body: the first crossing inside one piece [ta, tb] between two grid planes (one cell), or
+// none (volref-mpi searches the pieces a rank owns; first_crossing_exact tests g(t0) = 0 first).
+std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const Ray& ray, double ta, double tb, double iso);
 
 // One bracket [ta, tb] of the fixed-step search, g = f - iso with ga = g(ta), gb = g(tb): the crossing
 // in it, or none. A non-finite end never crosses (trilinear: the bracket's finite cells are searched

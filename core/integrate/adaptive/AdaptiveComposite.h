@@ -31,6 +31,12 @@ inline double max_abs(const glm::dvec4& v) { return std::max(max_abs(glm::dvec3(
 inline double rounding_bound(const glm::dvec4& rgba) {
     return conventions::kRoundingErrorRelative * (1.0 + max_abs(rgba));
 }
+// A leaf accepted by the composite, for its posterior error (AdaptiveComposite::error_sums).
+struct Leaf {
+    glm::dvec3 contribution;  // T(a) E
+    double e_emission;        // T(a) e_E
+    double e_tau;
+};
 }  // namespace adaptive_detail
 
 template <class Medium>
@@ -63,11 +69,7 @@ public:
         return result_from(colour_err, tau_err);
     }
 
-    struct LeafRecord {
-        glm::dvec3 contribution;  // T(a) E
-        double e_emission;        // T(a) e_E
-        double e_tau;
-    };
+    using LeafRecord = adaptive_detail::Leaf;
     // Posterior error: leaf i's tau error scales everything emitted behind it. Adds the leaves' terms,
     // back to front, to colour_err and tau_err; `behind` is what is emitted behind the last leaf (the
     // opaque piece's T c, or 0), and on return behind the first.

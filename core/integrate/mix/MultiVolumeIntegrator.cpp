@@ -94,81 +94,87 @@ MultiVolumeIntegrator::MultiVolumeIntegrator(std::vector<Member> volumes, const 
 
 MultiVolumeIntegrator::~MultiVolumeIntegrator() = default;
 
+void MultiVolumeIntegrator::AdaptiveMix::sample(double t, double& sigma, glm::dvec3& c) const {
+    terms.clear();
+    for (int k : *present) {
+        double s;
+        glm::dvec3 ck;
+        (*parts)[std::size_t(k)]->medium(rays[k], t, s, ck);
+        if (s > 0.0) terms.push_back({s, ck});
+    }
+    sigma = 0.0;
+    c = glm::dvec3(0.0);
+    if (terms.size() == 1) {
+        sigma = terms[0].tau;
+        c = terms[0].c;
+        return;
+    }
+    std::sort(terms.begin(), terms.end());  // canonical order: the volumes' listing changes no bit
+    glm::dvec3 weighted(0.0);
+    for (const Term& term : terms) {
+        sigma += term.tau;
+        weighted += term.tau * term.c;
+    }
+    if (sigma > 0.0) c = weighted / sigma;
+}
+
+double MultiVolumeIntegrator::adaptive_safety() const {
+    double safety = 1.0;
+    for (const auto& part : adaptive_) safety = std::max(safety, part->safety());
+    return safety;
+}
+
+void MultiVolumeIntegrator::adaptive_cuts(const Ray* rays, const Piece& p, std::vector<double>& all, std::vector<double>& cut) const {
+    all.clear();
+    for (int k : p.present) {
+        adaptive_[std::size_t(k)]->cuts(rays[k], p.span, cut);
+        all.insert(all.end(), cut.begin(), cut.end());
+    }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+}
+
+void MultiVolumeIntegrator::adaptive_piece(const Ray* rays, const std::vector<int>& present, double a, double b,
+                                           AdaptiveComposite<AdaptiveMix>& st, std::vector<MixTerm>& opaque) const {
+    if (!(b > a)) return;
+    // Where the first present volume becomes opaque (AdaptiveIntegrator::opaque_from), and which.
+    bool empty = true;
+    double ts = std::numeric_limits<double>::infinity();
+    for (int k : present) {
+        const AdaptiveIntegrator& part = *adaptive_[std::size_t(k)];
+        if (!part.empty_piece(rays[k], a, b)) empty = false;
+        const double from = part.opaque_from(rays[k], a, b);
+        if (from < ts) opaque.clear();
+        if (from <= ts && from < b) {
+            ts = from;
+            opaque.push_back({0.0, part.opaque_colour(rays[k], ts, b)});
+        }
+    }
+    if (ts < b) {  // the mean of the opaque volumes' colours, in canonical order
+        if (ts > a) st.integrate(a, ts);
+        std::sort(opaque.begin(), opaque.end());
+        glm::dvec3 c(0.0);
+        for (const Term& o : opaque) c += o.c;
+        st.opaque(c / double(opaque.size()));
+    } else if (!empty) {
+        st.integrate(a, b);
+    }
+    opaque.clear();
+}
+
 PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std::vector<Interval>* intervals) const {
     const std::vector<Piece> ps = pieces(intervals, volumes_.size());
     double total = 0.0;
     for (const Piece& p : ps) total += p.span.length();
     if (!(total > 0.0)) return PixelValue{};
-    struct Mixed {
-        const std::vector<std::unique_ptr<AdaptiveIntegrator>>* parts;
-        const Ray* rays;
-        const std::vector<int>* present = nullptr;
-        mutable std::vector<Term> terms;
-        void sample(double t, double& sigma, glm::dvec3& c) const {
-            terms.clear();
-            for (int k : *present) {
-                double s;
-                glm::dvec3 ck;
-                (*parts)[std::size_t(k)]->medium(rays[k], t, s, ck);
-                if (s > 0.0) terms.push_back({s, ck});
-            }
-            sigma = 0.0;
-            c = glm::dvec3(0.0);
-            if (terms.size() == 1) {
-                sigma = terms[0].tau;
-                c = terms[0].c;
-                return;
-            }
-            std::sort(terms.begin(), terms.end());  // canonical order: the volumes' listing changes no bit
-            glm::dvec3 weighted(0.0);
-            for (const Term& term : terms) {
-                sigma += term.tau;
-                weighted += term.tau * term.c;
-            }
-            if (sigma > 0.0) c = weighted / sigma;
-        }
-    } mixed{&adaptive_, rays};
-    double safety = 1.0;
-    for (const auto& part : adaptive_) safety = std::max(safety, part->safety());
-    AdaptiveComposite<Mixed> st(mixed, render_.tolerance, safety, total);
+    AdaptiveMix mixed = adaptive_mix(rays);
+    AdaptiveComposite<AdaptiveMix> st(mixed, render_.tolerance, adaptive_safety(), total);
     std::vector<double> cut, all;
     std::vector<Term> opaque;
     for (const Piece& p : ps) {
-        all.clear();
-        for (int k : p.present) {
-            adaptive_[std::size_t(k)]->cuts(rays[k], p.span, cut);
-            all.insert(all.end(), cut.begin(), cut.end());
-        }
-        std::sort(all.begin(), all.end());
-        all.erase(std::unique(all.begin(), all.end()), all.end());
+        adaptive_cuts(rays, p, all, cut);
         mixed.present = &p.present;
-        for (std::size_t i = 0; i + 1 < all.size() && !st.is_opaque(); ++i) {
-            const double a = all[i], b = all[i + 1];
-            if (!(b > a)) continue;
-            // Where the first present volume becomes opaque (AdaptiveIntegrator::opaque_from), and which.
-            bool empty = true;
-            double ts = std::numeric_limits<double>::infinity();
-            for (int k : p.present) {
-                const AdaptiveIntegrator& part = *adaptive_[std::size_t(k)];
-                if (!part.empty_piece(rays[k], a, b)) empty = false;
-                const double from = part.opaque_from(rays[k], a, b);
-                if (from < ts) opaque.clear();
-                if (from <= ts && from < b) {
-                    ts = from;
-                    opaque.push_back({0.0, part.opaque_colour(rays[k], ts, b)});
-                }
-            }
-            if (ts < b) {  // the mean of the opaque volumes' colours, in canonical order
-                if (ts > a) st.integrate(a, ts);
-                std::sort(opaque.begin(), opaque.end());
-                glm::dvec3 c(0.0);
-                for (const Term& o : opaque) c += o.c;
-                st.opaque(c / double(opaque.size()));
-            } else if (!empty) {
-                st.integrate(a, b);
-            }
-            opaque.clear();
-        }
+        for (std::size_t i = 0; i + 1 < all.size() && !st.is_opaque(); ++i) adaptive_piece(rays, p.present, all[i], all[i + 1], st, opaque);
         if (st.is_opaque()) break;
     }
     return st.result();

@@ -41,6 +41,8 @@
 namespace volref {
 
 class AdaptiveIntegrator;
+template <class Medium>
+class AdaptiveComposite;
 
 class MultiVolumeIntegrator {
 public:
@@ -84,6 +86,25 @@ public:
         std::vector<MixTerm> terms, opaque_terms;
     };
     MixedSegment mix(const Ray* rays, const std::vector<int>& present, const Segment& s, MixScratch& scratch) const;
+
+    // render.integrator "adaptive", composite: the mixed medium (sigma = sum sigma_k, emission
+    // sum sigma_k c_k over the volumes `present`, in canonical order), the sub-pieces of a piece (every
+    // present volume's adaptive cuts, merged), and one sub-piece [a, b] added to `st` (skipped when
+    // every present volume is empty there; cut where one becomes opaque). adaptive_composite() calls
+    // these front to back; volref-mpi for the sub-pieces a rank owns (cli/mpi/). Set `present` of the
+    // medium `st` reads to the piece's before adaptive_piece.
+    struct AdaptiveMix {
+        const std::vector<std::unique_ptr<AdaptiveIntegrator>>* parts;
+        const Ray* rays;
+        const std::vector<int>* present = nullptr;
+        mutable std::vector<MixTerm> terms;
+        void sample(double t, double& sigma, glm::dvec3& c) const;
+    };
+    AdaptiveMix adaptive_mix(const Ray* rays) const { return AdaptiveMix{&adaptive_, rays}; }
+    double adaptive_safety() const;
+    void adaptive_cuts(const Ray* rays, const Piece& p, std::vector<double>& all, std::vector<double>& scratch) const;
+    void adaptive_piece(const Ray* rays, const std::vector<int>& present, double a, double b,
+                        AdaptiveComposite<AdaptiveMix>& st, std::vector<MixTerm>& opaque_scratch) const;
 
     std::size_t size() const { return volumes_.size(); }
     const Member& member(std::size_t k) const { return volumes_[k]; }

@@ -34,6 +34,7 @@
 #include "core/camera/Camera.h"
 #include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
+#include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/fixed/FirstHitIntegrator.h"
 #include "core/integrate/march/Accumulators.h"
@@ -94,9 +95,6 @@ std::string volume_key(const Scene& scene, std::size_t k) {
 // The first version's scope (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    if (r.integrator != IntegrationMethod::Fixed && (r.projection != Projection::Composite || scene.volumes.size() != 1))
-        throw Error("render.integrator: volref-mpi supports \"adaptive\" for the composite of one volume only (other "
-                    "projections and several volumes are not supported yet)");
     if (r.profile != ProfileId::Reference)
         throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
     if (r.early_termination) throw Error("render.early_termination: not supported by volref-mpi yet");
@@ -372,8 +370,88 @@ int run(const Args& args, int rank, int size) {
         p[5] = opaque ? 1.0 : 0.0;
     };
     // Volume k's part of the ray (its own step and projection), as a single-volume render's.
+    const bool adaptive = render.integrator == IntegrationMethod::Adaptive;
+    // render.integrator "adaptive", other than composite: volume k's part from the pieces this rank
+    // owns (cut as the single process cuts them; a piece lies in one cell, so in one brick: the one
+    // holding its midpoint), by the adaptive integrator's own piece functions. These combine as
+    // independent parts: mip / minip the extremum, average / xray the sums (p[5] the error sum),
+    // first hit the nearest.
+    auto adaptive_part = [&](std::size_t vk, const Ray& ray, const std::vector<Interval>& intervals, double* p) {
+        const PreparedVolume& pv = *members[vk].prepared;
+        const SamplePipeline& pipeline = *pv.pipeline;
+        const auto* integrator = dynamic_cast<const AdaptiveIntegrator*>(pv.integrator.get());
+        std::vector<double> cut;
+        switch (render.projection) {
+            case Projection::FirstHit: {  // first_crossing_exact, piece by piece
+                const VolumeSampler& sampler = *pipeline.cartesian_sampler();  // trilinear (FirstHitIntegrator checks)
+                const double iso = *render.isovalue;
+                std::optional<double> hit;
+                for (const Interval& iv : intervals) {
+                    grid_cuts(ray, iv.t0, iv.t1, sampler.volume(), 0.0, cut);
+                    for (std::size_t q = 0; q + 1 < cut.size() && !hit; ++q) {
+                        const double ta = cut[q], tb = cut[q + 1];
+                        if (!owned_point(ray, 0.5 * (ta + tb))) continue;
+                        if (q == 0 && sampler.trilinear(ray.at(iv.t0)) - iso == 0.0) hit = iv.t0;
+                        else hit = first_crossing_in_cell(sampler, ray, ta, tb, iso);
+                        if (hit) p[0] = 0.5 * (ta + tb);
+                    }
+                    if (hit) break;
+                }
+                if (hit) {
+                    const glm::dvec3 c = pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color;
+                    for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
+                    p[4] = 1.0;
+                    p[5] = *hit;
+                }
+                return;
+            }
+            case Projection::Mip:
+            case Projection::Minip: {
+                Extremum<Scalar> acc(render.projection == Projection::Mip);
+                for (const Interval& iv : intervals) {
+                    integrator->extremum_cuts(ray, iv, cut);
+                    for (std::size_t q = 0; q + 1 < cut.size(); ++q)
+                        if (owned_point(ray, 0.5 * (cut[q] + cut[q + 1]))) integrator->extremum_piece(ray, cut[q], cut[q + 1], acc);
+                }
+                if (!acc.any()) return;
+                p[0] = acc.where();
+                const PipelineSample s = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
+                for (int i = 0; i < 3; ++i) p[1 + i] = s.opacity * s.color[i];
+                p[4] = s.opacity;
+                p[5] = acc.value();
+                return;
+            }
+            default: {  // average, xray: AdaptiveIntegrator::line_integral's budget, this rank's pieces
+                CompensatedSum length;
+                for (const Interval& iv : intervals) length.add(iv.length());
+                const double L = length.value(), tol = render.tolerance;
+                const double per_length =
+                    render.projection == Projection::Average ? tol : (L > 0.0 ? tol / (render.gain * L) : 0.0);
+                AdaptiveIntegrator::LineSums sums;
+                CompensatedSum owned_length;
+                bool any = false;
+                for (const Interval& iv : intervals) {
+                    integrator->cuts(ray, iv, cut);
+                    for (std::size_t q = 0; q + 1 < cut.size(); ++q) {
+                        const double ta = cut[q], tb = cut[q + 1];
+                        if (!(tb > ta) || !owned_point(ray, 0.5 * (ta + tb))) continue;
+                        if (!any) p[0] = 0.5 * (ta + tb);
+                        any = true;
+                        integrator->line_piece(ray, ta, tb, per_length, sums);
+                        owned_length.add(tb - ta);
+                    }
+                }
+                if (!any) return;
+                p[5] = sums.error;
+                p[6] = sums.integral.value();
+                p[7] = owned_length.value();
+                return;
+            }
+        }
+    };
     auto volume_part = [&](std::size_t vk, const Ray& ray, const std::vector<Interval>& intervals, const Interval& range,
                            double* p) {
+        if (adaptive) return adaptive_part(vk, ray, intervals, p);
         const PreparedVolume& pv = *members[vk].prepared;
         const SamplePipeline& pipeline = *pv.pipeline;
         const double step = pv.step, unit = pipeline.classifier().unit_distance();
@@ -477,35 +555,54 @@ int run(const Args& args, int rank, int size) {
     // round j the j-th rank of each pixel continues that pixel's state (kStateSize doubles) over its
     // pieces, and an MPI_Allreduce hands the states on. The error's sums run back to front the same way
     // (what is emitted behind each leaf). Pixels' R G B A error in `chained` on every rank.
-    const bool chain = render.integrator == IntegrationMethod::Adaptive;
+    const bool chain = adaptive && render.projection == Projection::Composite;
     std::vector<double> chained;
     if (chain) {
         using Composite = AdaptiveIntegrator::Composite;
-        const auto* adaptive = dynamic_cast<const AdaptiveIntegrator*>(members[0].prepared->integrator.get());
+        using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
+        const auto* one = V == 1 ? dynamic_cast<const AdaptiveIntegrator*>(members[0].prepared->integrator.get()) : nullptr;
         const std::size_t P = std::size_t(W) * std::size_t(H), S = std::size_t(Composite::kStateSize);
-        std::vector<std::vector<std::array<double, 2>>> pieces(P);
+        // Each pixel's owned pieces: [a, b] and (several volumes) the index of the union piece holding it.
+        std::vector<std::vector<std::array<double, 3>>> pieces(P);
         std::vector<double> key(P, kNone), total(P, 0.0);
         std::vector<int> position(P, -1), count(P, 0);
         tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
-        auto each_pixel = [&](auto&& f) {
+        // f(px, rays, intervals) for the pixels `round` selects (-1: all), in parallel.
+        auto each_pixel = [&](int round, auto&& f) {
             arena.execute([&] {
                 tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P), [&](const tbb::blocked_range<std::size_t>& r) {
-                    for (std::size_t px = r.begin(); px != r.end(); ++px) f(px);
+                    std::vector<std::vector<Interval>> intervals(V);
+                    std::vector<Ray> rays(V);
+                    for (std::size_t px = r.begin(); px != r.end(); ++px) {
+                        if (round >= 0 && position[px] != round) continue;
+                        pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), rays[0], intervals.data());
+                        std::fill(rays.begin() + 1, rays.end(), rays[0]);  // no transforms: one world ray
+                        f(px, rays, intervals);
+                    }
                 });
             });
         };
         try {
-            if (!adaptive) throw Error("render.integrator: internal: volref-mpi found no adaptive integrator");
-            each_pixel([&](std::size_t px) {
-                std::vector<Interval> intervals;
-                std::vector<double> cut;
-                Ray ray;
-                pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), ray, &intervals);
-                for (const Interval& iv : intervals) total[px] += iv.length();
-                for (const Interval& iv : intervals) {
-                    adaptive->cuts(ray, iv, cut);
-                    for (std::size_t p = 0; p + 1 < cut.size(); ++p)
-                        if (owned_point(ray, 0.5 * (cut[p] + cut[p + 1]))) pieces[px].push_back({cut[p], cut[p + 1]});
+            if (V == 1 && !one) throw Error("render.integrator: internal: volref-mpi found no adaptive integrator");
+            each_pixel(-1, [&](std::size_t px, const std::vector<Ray>& rays, const std::vector<std::vector<Interval>>& intervals) {
+                std::vector<double> cut, all;
+                const Ray& ray = rays[0];
+                auto keep = [&](double a, double b, std::size_t piece) {
+                    if (owned_point(ray, 0.5 * (a + b))) pieces[px].push_back({a, b, double(piece)});
+                };
+                if (V == 1) {  // AdaptiveIntegrator::composite's pieces
+                    for (const Interval& iv : intervals[0]) total[px] += iv.length();
+                    for (const Interval& iv : intervals[0]) {
+                        one->cuts(ray, iv, cut);
+                        for (std::size_t q = 0; q + 1 < cut.size(); ++q) keep(cut[q], cut[q + 1], 0);
+                    }
+                } else {  // MultiVolumeIntegrator::adaptive_composite's
+                    const auto ps = MultiVolumeIntegrator::pieces(intervals.data(), V);
+                    for (const auto& piece : ps) total[px] += piece.span.length();
+                    for (std::size_t i = 0; i < ps.size(); ++i) {
+                        multi->adaptive_cuts(rays.data(), ps[i], all, cut);
+                        for (std::size_t q = 0; q + 1 < all.size(); ++q) keep(all[q], all[q + 1], i);
+                    }
                 }
                 if (!pieces[px].empty()) key[px] = 0.5 * (pieces[px][0][0] + pieces[px][0][1]);
             });
@@ -526,29 +623,44 @@ int run(const Args& args, int rank, int size) {
             }
         for (std::size_t px = 0; px < P; ++px)
             if (key[px] != kNone) ++position[px];  // from -1: the ranks in front of this one
-        const double tolerance = render.tolerance, safety = adaptive->safety();
+        const double tolerance = render.tolerance, safety = V == 1 ? one->safety() : multi->adaptive_safety();
         std::vector<double> state(P * S), delta(P * S), next(P * S);
+        const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
         {
-            const AdaptiveIntegrator::OneVolume none{adaptive, nullptr};
             const Composite fresh(none, tolerance, safety, 1.0);
             for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
         }
-        std::vector<std::vector<Composite::LeafRecord>> leaves(P);
+        std::vector<std::vector<adaptive_detail::Leaf>> leaves(P);
         for (int j = 0; j < size; ++j) {
             std::fill(delta.begin(), delta.end(), 0.0);
             try {
-                each_pixel([&](std::size_t px) {
-                    if (position[px] != j) return;
-                    const Ray ray = camera->pixel_ray(int(px % std::size_t(W)), int(px / std::size_t(W)));
-                    const AdaptiveIntegrator::OneVolume one{adaptive, &ray};
-                    Composite st(one, tolerance, safety, total[px]);
-                    st.load(&state[px * S]);
-                    for (const auto& piece : pieces[px]) {
-                        if (st.is_opaque()) break;
-                        adaptive->composite_piece(ray, piece[0], piece[1], st);
+                each_pixel(j, [&](std::size_t px, const std::vector<Ray>& rays, const std::vector<std::vector<Interval>>& intervals) {
+                    const Ray& ray = rays[0];
+                    if (V == 1) {
+                        const AdaptiveIntegrator::OneVolume medium{one, &ray};
+                        Composite st(medium, tolerance, safety, total[px]);
+                        st.load(&state[px * S]);
+                        for (const auto& piece : pieces[px]) {
+                            if (st.is_opaque()) break;
+                            one->composite_piece(ray, piece[0], piece[1], st);
+                        }
+                        st.save(&delta[px * S]);
+                        leaves[px] = st.leaves();
+                    } else {
+                        const auto ps = MultiVolumeIntegrator::pieces(intervals.data(), V);
+                        MultiVolumeIntegrator::AdaptiveMix medium = multi->adaptive_mix(rays.data());
+                        MixComposite st(medium, tolerance, safety, total[px]);
+                        st.load(&state[px * S]);
+                        std::vector<MultiVolumeIntegrator::MixTerm> opaque;
+                        for (const auto& piece : pieces[px]) {
+                            if (st.is_opaque()) break;
+                            const std::vector<int>& present = ps[std::size_t(piece[2])].present;
+                            medium.present = &present;
+                            multi->adaptive_piece(rays.data(), present, piece[0], piece[1], st, opaque);
+                        }
+                        st.save(&delta[px * S]);
+                        leaves[px] = st.leaves();
                     }
-                    st.save(&delta[px * S]);
-                    leaves[px] = st.leaves();
                 });
             } catch (const std::bad_alloc&) {
                 err = "out of memory";
@@ -582,9 +694,8 @@ int run(const Args& args, int rank, int size) {
                 if (count[px] > j) std::copy(&nsums[px * E], &nsums[px * E] + E, &sums[px * E]);
         }
         chained.assign(P * 5, 0.0);
-        const AdaptiveIntegrator::OneVolume none{adaptive, nullptr};
         for (std::size_t px = 0; px < P; ++px) {
-            if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as AdaptiveIntegrator)
+            if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as the single process)
             Composite st(none, tolerance, safety, total[px]);
             st.load(&state[px * S]);
             const PixelValue v = st.result_from(sums[px * E + 3], sums[px * E + 4]);
@@ -632,9 +743,10 @@ int run(const Args& args, int rank, int size) {
 
     // One slot's pixel from its parts in ray order (sorted by key; parts with no segment, key +inf,
     // last): R G B A (and Z for first hit).
-    const int nc = first_hit || chain ? 5 : 4;
+    const int nc = 4 + (first_hit ? 1 : 0) + (adaptive ? 1 : 0);
     auto pixel_of = [&](const double* const* order, int count) {
         glm::dvec4 rgba(0.0);
+        double line_error = 0.0;
         double depth = kNone;
         if (first_hit) {  // the nearest rank's hit
             if (order[0][0] != kNone) {
@@ -668,23 +780,34 @@ int run(const Args& args, int rank, int size) {
             if (best) rgba = glm::dvec4(best[1], best[2], best[3], best[4]);
         } else {  // average, xray
             bool hit = false;
-            CompensatedSum integral, length;
+            CompensatedSum integral, length, error;
             for (int r = 0; r < count; ++r) {
                 const double* q = order[r];
                 if (q[0] == kNone) break;
                 hit = true;
                 integral.add(q[6]);
                 length.add(q[7]);
+                error.add(q[5]);
             }
             if (hit) {
-                const double g = render.projection == Projection::Average ? integral.value() / length.value()
-                                                                          : render.gain * integral.value();
+                const bool mean = render.projection == Projection::Average;
+                const double g = mean ? integral.value() / length.value() : render.gain * integral.value();
                 rgba = glm::dvec4(g, g, g, 1.0);
+                // The adaptive integrator's estimate (AdaptiveIntegrator::line_integral's form).
+                if (adaptive)
+                    line_error = (mean ? error.value() / length.value() : render.gain * error.value()) +
+                                 adaptive_detail::rounding_bound(rgba);
             }
         }
         PixelValue v;
         v.rgba = rgba;
         v.depth = depth;
+        // The adaptive integrator's error channel: the rounding bound of an exact result (mip, minip,
+        // first hit: AdaptiveIntegrator::extremum, FirstHitIntegrator), the sums' estimate (average, xray).
+        if (adaptive)
+            v.error = render.projection == Projection::Average || render.projection == Projection::Xray
+                          ? line_error
+                          : adaptive_detail::rounding_bound(rgba);
         return v;
     };
     // Pixel px from its slots' values: one slot as it is; several volumes (other than composite)
@@ -699,11 +822,12 @@ int run(const Args& args, int rank, int size) {
         }
         for (int c = 0; c < 4; ++c) out[c] = v.rgba[c];
         if (first_hit) out[4] = v.depth;
+        if (adaptive) out[nc - 1] = v.error;
     };
 
     std::vector<std::string> channels{"R", "G", "B", "A"};
     if (first_hit) channels.push_back("Z");  // as volref render writes it
-    if (chain) channels.push_back("error");  // the adaptive integrator's estimate, as volref render writes it
+    if (adaptive) channels.push_back("error");  // the adaptive integrator's estimate, as volref render writes it
     std::unique_ptr<Image> image;
     if (rank == 0) image = std::make_unique<Image>(W, H, channels);
     const std::size_t pixels = std::size_t(W) * std::size_t(H);
@@ -764,7 +888,8 @@ int run(const Args& args, int rank, int size) {
             } else if (render.projection == Projection::Mip || render.projection == Projection::Minip) {
                 const bool maximum = render.projection == Projection::Mip;
                 if (maximum ? k[5] > f[5] : k[5] < f[5]) std::copy(k, k + kPart, out);  // ties: the front's
-            } else if (!first_hit) {  // average, xray: the sums add
+            } else if (!first_hit) {  // average, xray: the sums add (adaptive: and the error estimates)
+                out[5] = f[5] + k[5];
                 out[6] = f[6] + k[6];
                 out[7] = f[7] + k[7];
             }

@@ -16,6 +16,9 @@ formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.n
 volumes      : several volumes (different grids, overlapping, one cropped and clipped) on every
                projection and order, orthographic and perspective, shaded and unshaded, by 2, 3 and
                4 ranks equal `volref render`; a constant medium beside a second one has a closed form.
+adaptive     : render.integrator "adaptive" on every projection, one volume and three (the composite's
+               state handed from rank to rank, the others' independent parts), by 2, 3 and 4 ranks:
+               every channel, the error channel included, equals `volref render` within 1e-12.
 refusals     : scenes outside the first version's scope are refused in one line naming the key.
 """
 import argparse, json, os, shutil, struct, subprocess, sys, math
@@ -487,6 +490,33 @@ if a.mode == "adaptive":
     s["render"].update({"integrator": "adaptive", "tolerance": 1e-4})
     s["volume"]["transfer"]["opacity"] = [[0.0, 0.0], [0.45, 0.0], [0.5, 0.3], [0.7, 1.0], [1.0, 1.0]]
     cases.append(("adaptive-opaque-persp", s))
+    # Several volumes' adaptive mix (MultiVolumeIntegrator::adaptive_composite), the state handed on
+    # the same way; one orthographic, one perspective with shading, one with an opaque run.
+    for cam, shaded in (("ortho", False), ("persp", True)):
+        s = two_volumes("composite", cam, shaded=shaded)
+        s["render"].update({"integrator": "adaptive", "tolerance": 1e-3})
+        cases.append(("adaptive-vols-composite-%s%s" % (cam, "-shaded" if shaded else ""), s))
+    s = two_volumes("composite", "inside")
+    s["render"].update({"integrator": "adaptive", "tolerance": 1e-3})
+    s["volumes"][0]["transfer"]["opacity"] = [[0.0, 0.0], [0.45, 0.0], [0.5, 0.3], [0.7, 1.0], [1.0, 1.0]]
+    cases.append(("adaptive-vols-composite-opaque-inside", s))
+    # The other projections: each rank's pieces as independent parts (one volume and several).
+    for cam in ("ortho", "persp"):
+        for p in ("mip", "minip", "average", "xray", "first-hit"):
+            s = base_scene(p, cam)
+            s["render"].update({"integrator": "adaptive", "tolerance": 1e-5})
+            cases.append(("adaptive-%s-%s" % (p, cam), s))
+            s = two_volumes(p, cam)
+            s["render"].update({"integrator": "adaptive", "tolerance": 1e-5})
+            s["volumes"][1]["interpolation"] = "trilinear"  # adaptive mip / first hit: trilinear or nearest
+            cases.append(("adaptive-vols-%s-%s" % (p, cam), s))
+    s = base_scene("mip", "inside")
+    s["render"].update({"integrator": "adaptive"})
+    s["volume"]["interpolation"] = "nearest"
+    cases.append(("adaptive-mip-nearest-inside", s))
+    s = base_scene("first-hit", "persp", shaded=True)
+    s["render"].update({"integrator": "adaptive"})
+    cases.append(("adaptive-shaded-first-hit-persp", s))
     for name, scene in cases:
         path = write_scene(name, scene)
         for np_ in (2, 3, 4):
@@ -495,7 +525,6 @@ if a.mode == "adaptive":
 if a.mode == "refusals":
     cases = {
         "render.early_termination": ("render", "early_termination", 0.99),
-        "render.integrator": ("render", "integrator", "adaptive", "projection", "mip"),
         "render.profile": ("render", "profile", "vtk-gpu"),
     }
     for key, (section, *kv) in cases.items():
@@ -512,13 +541,14 @@ if a.mode == "refusals":
     # Several volumes: the key names the volume at fault.
     s = two_volumes("composite", "ortho")
     s["volumes"][1]["transform"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 2, 0, 0, 0, 1]
-    out = os.path.join(a.work, "refused.exr")
-    r = mpirun(2, ["render", write_scene("refused", s), "-o", out])
-    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
-    if r.returncode == 0 or len(lines) != 1 or not lines[0].startswith("volref: error: volumes[1].transform") or os.path.exists(out):
-        failures.append("volumes[1].transform: expected one error line naming it, got %d %r" % (r.returncode, r.stderr))
-    else:
-        print("ok " + lines[0])
+    for key, scene in (("volumes[1].transform", s),):
+        out = os.path.join(a.work, "refused.exr")
+        r = mpirun(2, ["render", write_scene("refused", scene), "-o", out])
+        lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+        if r.returncode == 0 or len(lines) != 1 or not lines[0].startswith("volref: error: " + key) or os.path.exists(out):
+            failures.append("%s: expected one error line naming it, got %d %r" % (key, r.returncode, r.stderr))
+        else:
+            print("ok " + lines[0])
 
 for f in failures:
     print("FAIL " + f)

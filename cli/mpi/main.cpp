@@ -557,6 +557,7 @@ int run(const Args& args, int rank, int size) {
     // (what is emitted behind each leaf). Pixels' R G B A error in `chained` on every rank.
     const bool chain = adaptive && render.projection == Projection::Composite;
     std::vector<double> chained;
+    std::size_t chain_bytes = 0;  // what this rank hands to the collectives (keys, N rounds each way)
     if (chain) {
         using Composite = AdaptiveIntegrator::Composite;
         using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
@@ -614,6 +615,7 @@ int run(const Args& args, int rank, int size) {
         if (any_error(err, rank, size)) return 1;
         std::vector<double> keys(P * std::size_t(size));
         MPI_Allgather(key.data(), int(P), MPI_DOUBLE, keys.data(), int(P), MPI_DOUBLE, MPI_COMM_WORLD);
+        chain_bytes = P * sizeof(double) * (1 + std::size_t(size) * (S + 5));
         for (std::size_t px = 0; px < P; ++px)
             for (int r = 0; r < size; ++r) {
                 const double k = keys[std::size_t(r) * P + px];
@@ -835,6 +837,7 @@ int run(const Args& args, int rank, int size) {
     double t_gather = 0.0;  // rank 0: the parts (direct) or the finished pixels (swap) are in
     if (chain) {  // every rank holds the pixels
         t_gather = now();
+        bytes_sent = chain_bytes;
         if (rank == 0) std::copy(chained.begin(), chained.end(), image->pixels.begin());
     } else if (!swap) {
         // ---- direct send: every rank's parts to rank 0, combined there in ray order ----
@@ -966,7 +969,7 @@ int run(const Args& args, int rank, int size) {
                          "volref: timing {\"ranks\": %d, \"compositing\": \"%s\", \"setup_s\": %.4f, \"render_s\": %.4f, "
                          "\"gather_s\": %.4f, \"combine_write_s\": %.4f, \"bytes_sent_per_rank\": %llu, "
                          "\"bytes_received_rank0\": %llu, \"image_bytes\": %zu}\n",
-                         size, swap ? "swap" : "direct", slowest[0], slowest[1], t_gather - t_ready, t_write - t_gather,
+                         size, chain ? "chain" : swap ? "swap" : "direct", slowest[0], slowest[1], t_gather - t_ready, t_write - t_gather,
                          most, (unsigned long long)bytes_received,
                          pixels * std::size_t(nc) * sizeof(double));
     }

@@ -91,6 +91,15 @@ void box_bounds(const RTCBoundsFunctionArguments* args) {
     set_bounds(args->bounds_o, box->lo, box->hi, padding(box->lo, box->hi));
 }
 
+// The ray's interval in the box AND its domain, in front of the origin (t >= 0), if not empty.
+bool box_interval(const BoxShape& box, const Ray& ray, Interval& out) {
+    Interval shape, domain;
+    if (!intersect_box(ray, box.lo, box.hi, shape)) return false;
+    if (!intersect_box(ray, box.domain_lo, box.domain_hi, domain)) return false;
+    out = Interval{std::max({shape.t0, domain.t0, 0.0}), std::min(shape.t1, domain.t1)};
+    return out.t1 > out.t0;
+}
+
 void box_intersect(const RTCIntersectFunctionNArguments* args) {
     const auto* box = static_cast<const BoxShape*>(args->geometryUserPtr);
     const IntervalQuery* query = query_of(args->context);
@@ -99,12 +108,9 @@ void box_intersect(const RTCIntersectFunctionNArguments* args) {
         if (args->valid[i] == 0) continue;
         const unsigned id = ray_id(args, i);
         if (id >= query->num_rays) continue;
-        const Ray& ray = query->rays[id];
-        Interval shape, domain;
-        if (!intersect_box(ray, box->lo, box->hi, shape)) continue;
-        if (!intersect_box(ray, box->domain_lo, box->domain_hi, domain)) continue;
-        const Interval clipped{std::max({shape.t0, domain.t0, 0.0}), std::min(shape.t1, domain.t1)};
-        if (clipped.t1 > clipped.t0) query->records[id].intervals[std::size_t(box->volume_id)].push_back(clipped);
+        Interval clipped;
+        if (box_interval(*box, query->rays[id], clipped))
+            query->records[id].intervals[std::size_t(box->volume_id)].push_back(clipped);
     }
     // No hit is reported: traversal continues to every shape along the ray.
 }
@@ -190,6 +196,7 @@ struct BoundingGeometry::Impl {
     std::vector<std::unique_ptr<CylinderShape>> cylinders;
     std::vector<std::unique_ptr<SphereShape>> spheres;
     std::vector<const MeshShape*> volume_mesh;  // per volume: its mesh, if it is one
+    std::vector<const BoxShape*> volume_box;    // per volume: its box, if it is one
 
     int next_id() const { return int(volume_mesh.size()); }
 
@@ -229,6 +236,7 @@ int BoundingGeometry::add_box(const glm::dvec3& lo, const glm::dvec3& hi, const 
     impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id}));
     impl_->attach(1, impl_->boxes.back().get(), box_bounds, box_intersect, "adding a box");
     impl_->volume_mesh.push_back(nullptr);
+    impl_->volume_box.push_back(impl_->boxes.back().get());
     return id;
 }
 
@@ -249,6 +257,7 @@ int BoundingGeometry::add_mesh(const TriangleMesh& mesh, const glm::dvec3& domai
     impl_->attach(unsigned(added->mesh.triangles.size()), impl_->meshes.back().get(), mesh_bounds, mesh_intersect,
                   "adding a mesh");
     impl_->volume_mesh.push_back(added);
+    impl_->volume_box.push_back(nullptr);
     return id;
 }
 
@@ -258,6 +267,7 @@ int BoundingGeometry::add_cylindrical_shell(const CylindricalShell& shell) {
     impl_->attach(1, impl_->cylinders.back().get(), shell_bounds_callback<CylinderShape>, shell_intersect<CylinderShape>,
                   "adding a cylindrical shell");
     impl_->volume_mesh.push_back(nullptr);
+    impl_->volume_box.push_back(nullptr);
     return id;
 }
 
@@ -267,6 +277,7 @@ int BoundingGeometry::add_spherical_shell(const SphericalShell& shell) {
     impl_->attach(1, impl_->spheres.back().get(), shell_bounds_callback<SphereShape>, shell_intersect<SphereShape>,
                   "adding a spherical shell");
     impl_->volume_mesh.push_back(nullptr);
+    impl_->volume_box.push_back(nullptr);
     return id;
 }
 
@@ -302,6 +313,7 @@ void finish_intervals(const Ray& ray, RayRecord& record, std::size_t v, const Me
 void BoundingGeometry::intervals(const Ray& ray, int volume_id, std::vector<Interval>& out) const {
     out.clear();
     if (volume_id < 0 || volume_id >= volume_count()) return;
+    if (impl_->volume_box[std::size_t(volume_id)]) return intervals(&ray, 1, volume_id, &out);  // no Embree query
     thread_local RayRecord record;
     record.reset(impl_->volume_mesh.size());
     const RayTriangleFrame frame(ray);
@@ -340,6 +352,15 @@ void BoundingGeometry::intervals(const Ray* rays, int count, int volume_id, std:
     for (int i = 0; i < count; ++i) out[i].clear();
     if (volume_id < 0 || volume_id >= volume_count()) return;
     const std::size_t v = std::size_t(volume_id);
+    // A box needs no Embree query: its one interval is the slab test box_intersect would run (Embree's
+    // float bounds are padded, so it calls box_intersect for every ray the double test can hit).
+    if (const BoxShape* box = impl_->volume_box[v]) {
+        for (int i = 0; i < count; ++i) {
+            Interval iv;
+            if (box_interval(*box, rays[i], iv)) out[i].push_back(iv);
+        }
+        return;
+    }
     thread_local RayRecord records[kPacket];
     for (int first = 0; first < count; first += kPacket) {
         const int n = std::min(kPacket, count - first);

@@ -7,7 +7,9 @@
 // scene is built with RTC_SCENE_FLAG_ROBUST) and records them in the query's context without
 // reporting a hit, so traversal visits every shape the ray meets and a ray may enter and leave a
 // shape several times:
-//   box:   the slab test (geometry/BoxIntersection.h), one interval;
+//   box:   the slab test (geometry/BoxIntersection.h), one interval; intervals() of a box volume runs
+//          the same test directly, with no Embree query (the padded bounds make Embree call it for
+//          every ray the double test can hit, so the result is the same);
 //   mesh:  one primitive per triangle; the watertight double-precision ray/triangle test
 //          (geometry/MeshIntervals.h) records each crossing, and after traversal the crossings become
 //          the intervals where the winding number is > 0. (Embree's own float triangle test is not

@@ -371,6 +371,23 @@ int run(const Args& args, int rank, int size) {
     };
     // Volume k's part of the ray (its own step and projection), as a single-volume render's.
     const bool adaptive = render.integrator == IntegrationMethod::Adaptive;
+    // First hit: the part of a hit at t found in the piece or segment whose midpoint is `key`.
+    auto hit_part = [&](const SamplePipeline& pipeline, const Ray& ray, double t, double key, double* p) {
+        p[0] = key;
+        const glm::dvec3 c = pipeline.sample(ray, t, SamplePipeline::Use::Surface).color;
+        for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
+        p[4] = 1.0;
+        p[5] = t;
+    };
+    // mip / minip: the part of this rank's extremum (none: p[0] stays kNone), classified here.
+    auto extremum_part = [&](const SamplePipeline& pipeline, const Ray& ray, const Extremum<Scalar>& acc, double* p) {
+        if (!acc.any()) return;
+        p[0] = acc.where();
+        const PipelineSample q = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
+        for (int i = 0; i < 3; ++i) p[1 + i] = q.opacity * q.color[i];
+        p[4] = q.opacity;
+        p[5] = acc.value();
+    };
     // render.integrator "adaptive", other than composite: volume k's part from the pieces this rank
     // owns (cut as the single process cuts them; a piece lies in one cell, so in one brick: the one
     // holding its midpoint), by the adaptive integrator's own piece functions. These combine as
@@ -385,23 +402,16 @@ int run(const Args& args, int rank, int size) {
             case Projection::FirstHit: {  // first_crossing_exact, piece by piece
                 const VolumeSampler& sampler = *pipeline.cartesian_sampler();  // trilinear (FirstHitIntegrator checks)
                 const double iso = *render.isovalue;
-                std::optional<double> hit;
                 for (const Interval& iv : intervals) {
                     grid_cuts(ray, iv.t0, iv.t1, sampler.volume(), 0.0, cut);
-                    for (std::size_t q = 0; q + 1 < cut.size() && !hit; ++q) {
+                    for (std::size_t q = 0; q + 1 < cut.size(); ++q) {
                         const double ta = cut[q], tb = cut[q + 1];
                         if (!owned_point(ray, 0.5 * (ta + tb))) continue;
-                        if (q == 0 && sampler.trilinear(ray.at(iv.t0)) - iso == 0.0) hit = iv.t0;
-                        else hit = first_crossing_in_cell(sampler, ray, ta, tb, iso);
-                        if (hit) p[0] = 0.5 * (ta + tb);
+                        const std::optional<double> hit = q == 0 && sampler.trilinear(ray.at(iv.t0)) - iso == 0.0
+                                                              ? std::optional<double>(iv.t0)
+                                                              : first_crossing_in_cell(sampler, ray, ta, tb, iso);
+                        if (hit) return hit_part(pipeline, ray, *hit, 0.5 * (ta + tb), p);
                     }
-                    if (hit) break;
-                }
-                if (hit) {
-                    const glm::dvec3 c = pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color;
-                    for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
-                    p[4] = 1.0;
-                    p[5] = *hit;
                 }
                 return;
             }
@@ -413,13 +423,7 @@ int run(const Args& args, int rank, int size) {
                     for (std::size_t q = 0; q + 1 < cut.size(); ++q)
                         if (owned_point(ray, 0.5 * (cut[q] + cut[q + 1]))) integrator->extremum_piece(ray, cut[q], cut[q + 1], acc);
                 }
-                if (!acc.any()) return;
-                p[0] = acc.where();
-                const PipelineSample s = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
-                for (int i = 0; i < 3; ++i) p[1 + i] = s.opacity * s.color[i];
-                p[4] = s.opacity;
-                p[5] = acc.value();
-                return;
+                return extremum_part(pipeline, ray, acc, p);
             }
             default: {  // average, xray: AdaptiveIntegrator::line_integral's budget, this rank's pieces
                 CompensatedSum length;
@@ -493,13 +497,7 @@ int run(const Args& args, int rank, int size) {
                     const double ta = owned[m].t0, tb = owned[m].t1, ga = g(ta);
                     if (k == 0 && ga == 0.0) hit = ta;
                     else hit = bracket_crossing(g, trilinear, ray, ta, ga, tb, g(tb), iso, iv.length());
-                    if (hit) {
-                        p[0] = owned[m].midpoint();
-                        const glm::dvec3 c = pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color;
-                        for (int i = 0; i < 3; ++i) p[1 + i] = c[i];
-                        p[4] = 1.0;
-                        p[5] = *hit;
-                    }
+                    if (hit) hit_part(pipeline, ray, *hit, owned[m].midpoint(), p);
                 }
                 break;
             }
@@ -507,15 +505,8 @@ int run(const Args& args, int rank, int size) {
             case Projection::Minip: {
                 Extremum<Scalar> acc(render.projection == Projection::Mip);
                 for (const Segment& s : owned) acc.add(true, pipeline.value(ray, s.midpoint()), s.midpoint());
-                if (!acc.any()) {
-                    p[0] = kNone;
-                    break;
-                }
-                p[0] = acc.where();
-                const PipelineSample q = pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
-                for (int i = 0; i < 3; ++i) p[1 + i] = q.opacity * q.color[i];
-                p[4] = q.opacity;
-                p[5] = acc.value();
+                p[0] = kNone;
+                extremum_part(pipeline, ray, acc, p);
                 break;
             }
             default: {  // average, xray

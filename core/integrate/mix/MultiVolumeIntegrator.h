@@ -100,7 +100,7 @@ public:
         mutable std::vector<MixTerm> terms;
         void sample(double t, double& sigma, glm::dvec3& c) const;
     };
-    AdaptiveMix adaptive_mix(const Ray* rays) const { return AdaptiveMix{&adaptive_, rays}; }
+    AdaptiveMix adaptive_mix(const Ray* rays) const { return AdaptiveMix{&adaptive_, rays, nullptr, {}}; }
     double adaptive_safety() const;
     void adaptive_cuts(const Ray* rays, const Piece& p, std::vector<double>& all, std::vector<double>& scratch) const;
     void adaptive_piece(const Ray* rays, const std::vector<int>& present, double a, double b,

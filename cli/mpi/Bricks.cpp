@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/Error.h"
@@ -48,20 +49,48 @@ std::vector<Brick> split_lattice(const Lattice& cells_box, int count) {
     return out;
 }
 
+namespace {
+
+// A point of `from`'s index space (u = (x_local - origin) / spacing) in `to`'s, through world space.
+glm::dvec3 map_index(const GridBox& from, const GridBox& to, const glm::dvec3& u) {
+    glm::dvec3 x = from.origin + u * from.spacing;  // from's own space
+    if (from.to_world) x = from.to_world->to_world(x);
+    if (to.to_world) x = to.to_world->to_local(x);
+    return (x - to.origin) / to.spacing;
+}
+
+// The box [lo, hi] of `from`'s index space mapped into `to`'s: the bounds of its 8 mapped corners.
+void map_box(const GridBox& from, const GridBox& to, const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3& out_lo,
+             glm::dvec3& out_hi) {
+    out_lo = glm::dvec3(std::numeric_limits<double>::infinity());
+    out_hi = -out_lo;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 u = map_index(from, to, glm::dvec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z));
+        out_lo = glm::min(out_lo, u);
+        out_hi = glm::max(out_hi, u);
+    }
+}
+
+// The same lattice: no mapping (exact integer voxel ranges).
+bool same_grid(const GridBox& a, const GridBox& b) {
+    return a.origin == b.origin && a.spacing == b.spacing && a.to_world == b.to_world;
+}
+
+}  // namespace
+
 Lattice union_lattice(const std::vector<GridBox>& grids) {
     Lattice out;
     const GridBox& g0 = grids.front();
     for (int a = 0; a < 3; ++a) out.hi[a] = std::max<std::int64_t>(g0.dims[a] - 1, 0);
     for (std::size_t k = 1; k < grids.size(); ++k) {
         const GridBox& g = grids[k];
+        glm::dvec3 lo, hi;
+        map_box(g, g0, glm::dvec3(0.0), glm::dvec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1)), lo, hi);
         for (int a = 0; a < 3; ++a) {
-            const double x0 = g.origin[a], x1 = g.origin[a] + double(g.dims[a] - 1) * g.spacing[a];
-            const double u0 = (std::min(x0, x1) - g0.origin[a]) / g0.spacing[a];
-            const double u1 = (std::max(x0, x1) - g0.origin[a]) / g0.spacing[a];
-            if (!(std::fabs(u0) < 1e15 && std::fabs(u1) < 1e15))
+            if (!(std::fabs(lo[a]) < 1e15 && std::fabs(hi[a]) < 1e15))
                 throw Error("volumes: volref-mpi needs every volume within 1e15 voxels of the first volume's grid");
-            out.lo[a] = std::min(out.lo[a], std::int64_t(std::floor(u0)));
-            out.hi[a] = std::max(out.hi[a], std::int64_t(std::ceil(u1)));
+            out.lo[a] = std::min(out.lo[a], std::int64_t(std::floor(lo[a])));
+            out.hi[a] = std::max(out.hi[a], std::int64_t(std::ceil(hi[a])));
         }
     }
     return out;
@@ -69,25 +98,29 @@ Lattice union_lattice(const std::vector<GridBox>& grids) {
 
 void voxels_for(const Brick& b, const Lattice& lattice, const GridBox& first, const GridBox& grid, int ghost,
                 std::array<std::int64_t, 3>& vlo, std::array<std::int64_t, 3>& vhi) {
+    glm::dvec3 lo(0.0), hi(0.0);
+    const bool same = same_grid(first, grid);
+    if (!same)
+        map_box(first, grid, glm::dvec3(double(b.lo[0]), double(b.lo[1]), double(b.lo[2])),
+                glm::dvec3(double(b.hi[0]), double(b.hi[1]), double(b.hi[2])), lo, hi);
+    const bool axis_aligned = !first.to_world && !grid.to_world;  // else an outer face bounds no single axis
     for (int a = 0; a < 3; ++a) {
         const std::int64_t last = grid.dims[a] - 1;
-        std::int64_t lo = 0, hi = last;
-        if (grid.origin[a] == first.origin[a] && grid.spacing[a] == first.spacing[a]) {  // the lattice's own grid
-            if (b.lo[a] > lattice.lo[a]) lo = b.lo[a] - ghost;
-            if (b.hi[a] < lattice.hi[a]) hi = b.hi[a] + ghost;
-        } else if (b.lo[a] > lattice.lo[a]) {
-            const double u = (first.origin[a] + double(b.lo[a]) * first.spacing[a] - grid.origin[a]) / grid.spacing[a];
-            lo = std::int64_t(std::floor(std::clamp(u, -1e15, 1e15))) - ghost;
+        std::int64_t l = 0, h = last;
+        if (same) {  // the lattice's own grid
+            if (b.lo[a] > lattice.lo[a]) l = b.lo[a] - ghost;
+            if (b.hi[a] < lattice.hi[a]) h = b.hi[a] + ghost;
+        } else {
+            // On the lattice's outer faces the brick owns everything beyond: up to the grid's face
+            // (axis-aligned grids); a rotated grid takes the mapped box, which the union covers.
+            if (!(axis_aligned && b.lo[a] == lattice.lo[a])) l = std::int64_t(std::floor(std::clamp(lo[a], -1e15, 1e15))) - ghost;
+            if (!(axis_aligned && b.hi[a] == lattice.hi[a])) h = std::int64_t(std::ceil(std::clamp(hi[a], -1e15, 1e15))) + ghost;
         }
-        if (!(grid.origin[a] == first.origin[a] && grid.spacing[a] == first.spacing[a]) && b.hi[a] < lattice.hi[a]) {
-            const double u = (first.origin[a] + double(b.hi[a]) * first.spacing[a] - grid.origin[a]) / grid.spacing[a];
-            hi = std::int64_t(std::ceil(std::clamp(u, -1e15, 1e15))) + ghost;
-        }
-        lo = std::clamp<std::int64_t>(lo, 0, last);
-        hi = std::clamp<std::int64_t>(hi, 0, last);
-        if (lo > hi) std::swap(lo, hi);  // the brick misses the grid on this axis: a sliver at the face
-        vlo[a] = lo;
-        vhi[a] = hi;
+        l = std::clamp<std::int64_t>(l, 0, last);
+        h = std::clamp<std::int64_t>(h, 0, last);
+        if (l > h) std::swap(l, h);  // the brick misses the grid on this axis: a sliver at the face
+        vlo[a] = l;
+        vhi[a] = h;
     }
 }
 

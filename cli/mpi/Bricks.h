@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/scene/Scene.h"
+#include "geometry/VolumeTransform.h"
 
 namespace volref::mpi {
 
@@ -29,18 +30,21 @@ struct Lattice {
 };
 std::vector<Brick> split_lattice(const Lattice& cells, int count);
 
-// A grid: `dims` voxels at origin + i * spacing.
+// A grid: `dims` voxels at origin + i * spacing in its own space, placed in the world by `to_world`
+// (null: its space is world space).
 struct GridBox {
     std::array<std::int64_t, 3> dims{1, 1, 1};
     glm::dvec3 origin{0.0}, spacing{1.0};
+    const VolumeTransform* to_world = nullptr;
 };
 // The lattice of grids[0] (cells between its voxel planes, extended) covering every grid's domain:
-// grids[0] itself exactly ([0, dims - 1)), the others' corners mapped into grids[0]'s index space
-// u = (x - origin_0) / spacing_0, floor and ceil.
+// grids[0] itself exactly ([0, dims - 1)), the others' 8 corners mapped through world space into
+// grids[0]'s index space u = (x_local0 - origin_0) / spacing_0, floor and ceil.
 Lattice union_lattice(const std::vector<GridBox>& grids);
 // The voxels [vlo, vhi] (inclusive) of `grid` that the rank of brick `b` (cells of `lattice` in
-// `first`'s index space) needs: the grid's cells meeting the brick's box, plus `ghost` voxels, clamped to
-// the grid; on the lattice's outer faces (which own every point beyond them) up to the grid's face.
+// `first`'s index space) needs: the grid's cells meeting the brick's box (its 8 corners mapped into
+// the grid's index space, floor and ceil), plus `ghost` voxels, clamped to the grid; on the lattice's
+// outer faces (which own every point beyond them) up to the grid's face.
 // When the brick does not meet the grid, a range of 1 or 2 voxels at the nearest face (never sampled).
 void voxels_for(const Brick& b, const Lattice& lattice, const GridBox& first, const GridBox& grid, int ghost,
                 std::array<std::int64_t, 3>& vlo, std::array<std::int64_t, 3>& vhi);

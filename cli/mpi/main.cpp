@@ -49,6 +49,7 @@
 #include "geometry/BoxIntersection.h"
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
+#include "geometry/VolumeTransform.h"
 #include "cli/mpi/BrickReader.h"
 #include "cli/mpi/Bricks.h"
 
@@ -103,7 +104,6 @@ void check_supported(const Scene& scene) {
         const std::string key = volume_key(scene, k);
         if (vs.bounds.type != BoundsSpec::Type::Box)
             throw Error(key + ".bounds: volref-mpi supports box bounds only (meshes and shells are not supported yet)");
-        if (vs.transform) throw Error(key + ".transform: not supported by volref-mpi yet");
         if (vs.gradient.cache || vs.gradient.cache_auto) throw Error(key + ".gradient.cache: not supported by volref-mpi yet");
         if (vs.classify == VolumeSpec::Classify::Pre) throw Error(key + ".classify: \"pre\" is not supported by volref-mpi yet");
     }
@@ -155,6 +155,7 @@ struct Member {
     Volume brick;
     std::unique_ptr<PreparedVolume> prepared;
     int geometry_id = 0;
+    std::optional<VolumeTransform> transform;  // its own space to world (`transform`), if any
 };
 
 int run(const Args& args, int rank, int size) {
@@ -182,13 +183,15 @@ int run(const Args& args, int rank, int size) {
         for (std::size_t k = 0; k < members.size(); ++k) {
             const VolumeSpec& vs = scene.volumes[k];
             Member& m = members[k];
+            if (vs.transform) m.transform.emplace(*vs.transform);
+            const VolumeTransform* to_world = m.transform ? &*m.transform : nullptr;  // (members is not resized again)
             if (vs.source.field) {
-                m.grid = {vs.source.field->dims, vs.origin.value_or(glm::dvec3(0.0)), vs.spacing.value_or(glm::dvec3(1.0))};
+                m.grid = {vs.source.field->dims, vs.origin.value_or(glm::dvec3(0.0)), vs.spacing.value_or(glm::dvec3(1.0)), to_world};
             } else {
                 m.header = mpi::read_volume_header(*vs.source.file, vs.source.format);
                 m.header.origin = vs.origin.value_or(m.header.origin);
                 m.header.spacing = vs.spacing.value_or(m.header.spacing);
-                m.grid = {m.header.dims, m.header.origin, m.header.spacing};
+                m.grid = {m.header.dims, m.header.origin, m.header.spacing, to_world};
             }
             m.ghost = mpi::ghost_voxels(vs, scene.render);
             if (scene.render.projection == Projection::FirstHit) {
@@ -253,8 +256,14 @@ int run(const Args& args, int rank, int size) {
             if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
                 throw Error(volume_key(scene, k) + ".bounds: min must not exceed max");
             m.geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
-            view_lo = glm::min(view_lo, glm::max(box_lo, domain_lo));
-            view_hi = glm::max(view_hi, glm::min(box_hi, domain_hi));
+            // The world box of the shape AND domain (its transformed corners): PreparedVolume::view_lo.
+            const glm::dvec3 lo = glm::max(box_lo, domain_lo), hi = glm::min(box_hi, domain_hi);
+            for (int c = 0; c < 8; ++c) {
+                glm::dvec3 x(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+                if (m.transform) x = m.transform->to_world(x);
+                view_lo = glm::min(view_lo, x);
+                view_hi = glm::max(view_hi, x);
+            }
         }
         geometry.commit();
         if (members.size() > 1) {  // the single-process render's mix (composite) and combination (others)
@@ -299,7 +308,8 @@ int run(const Args& args, int rank, int size) {
     const bool first_hit = render.projection == Projection::FirstHit;
     const bool mixed = V > 1 && render.projection == Projection::Composite;
     std::vector<double> part(std::size_t(W) * std::size_t(H) * slots * kPart, 0.0);
-    // The brick's world box, padded: the segments worth testing (the test itself is exact).
+    // The brick's box in the first volume's space, padded: the segments worth testing (the test
+    // itself is exact).
     glm::dvec3 blo, bhi;
     for (int a = 0; a < 3; ++a) {
         blo[a] = lattice_grid.origin[a] + double(brick.lo[a]) * lattice_grid.spacing[a];
@@ -308,25 +318,28 @@ int run(const Args& args, int rank, int size) {
         blo[a] -= pad;
         bhi[a] += pad;
     }
-    // Whether this rank owns the point at t: the brick holding it in the lattice (conventions §14).
-    auto owned_point = [&](const Ray& ray, double t) {
-        return mpi::owns(brick, lattice, (ray.at(t) - lattice_grid.origin) / lattice_grid.spacing);
+    // Whether this rank owns the point at t of `lattice_ray` (the first volume's ray, in its own
+    // space): the brick holding it in the lattice (conventions §14).
+    auto owned_point = [&](const Ray& lattice_ray, double t) {
+        return mpi::owns(brick, lattice, (lattice_ray.at(t) - lattice_grid.origin) / lattice_grid.spacing);
     };
-    // Pixel (x, y)'s ray and every volume's intervals (bounds AND domain, crop, clip planes: §4).
-    auto pixel_intervals = [&](int x, int y, Ray& ray, std::vector<Interval>* intervals) {
-        ray = camera->pixel_ray(x, y);
+    // Pixel (x, y)'s ray in every volume's own space (rays[k], the same t) and every volume's
+    // intervals (bounds AND domain and crop on the volume's ray, clip planes on the world ray: §4).
+    auto pixel_intervals = [&](int x, int y, Ray* rays, std::vector<Interval>* intervals) {
+        const Ray world = camera->pixel_ray(x, y);
         for (std::size_t k = 0; k < V; ++k) {
             const VolumeSpec& vs = scene.volumes[k];
-            Ray local = ray;
+            rays[k] = members[k].transform ? members[k].transform->local_ray(world) : world;
+            Ray local = rays[k];
             intervals[k].clear();
-            geometry.intervals(&ray, 1, members[k].geometry_id, &intervals[k]);
+            geometry.intervals(&rays[k], 1, members[k].geometry_id, &intervals[k]);
             if (vs.crop) crop_intervals(local, *vs.crop, intervals[k]);
-            if (!vs.clip_planes.empty()) clip_intervals(ray, vs.clip_planes, intervals[k]);
+            if (!vs.clip_planes.empty()) clip_intervals(world, vs.clip_planes, intervals[k]);
         }
     };
     // The segments k of an interval (n of them at `step`) whose midpoints this rank owns, front to
     // back (contiguous: the brick is convex), given the ray's range in the padded brick box.
-    auto owned_segments = [&](const Ray& ray, const Interval& iv, double step, const Interval& range, auto&& use) {
+    auto owned_segments = [&](const Ray& lattice_ray, const Interval& iv, double step, const Interval& range, auto&& use) {
         if (iv.t1 < range.t0 || iv.t0 > range.t1) return;
         const std::int64_t n = segment_count(iv, step);
         std::int64_t k0 = std::int64_t(std::floor((range.t0 - iv.t0) / step)) - 1;
@@ -335,7 +348,7 @@ int run(const Args& args, int rank, int size) {
         k1 = std::clamp<std::int64_t>(k1, 0, n - 1);
         for (std::int64_t k = k0; k <= k1; ++k) {
             const Segment s = segment(iv, step, k, n);
-            if (owned_point(ray, s.midpoint())) use(s, k, n);
+            if (owned_point(lattice_ray, s.midpoint())) use(s, k, n);
         }
     };
     // Composite: one part (C, tau, opaque) from owned segments' (opaque, tau, alpha, colour), in ray
@@ -393,7 +406,8 @@ int run(const Args& args, int rank, int size) {
     // holding its midpoint), by the adaptive integrator's own piece functions. These combine as
     // independent parts: mip / minip the extremum, average / xray the sums (p[5] the error sum),
     // first hit the nearest.
-    auto adaptive_part = [&](std::size_t vk, const Ray& ray, const std::vector<Interval>& intervals, double* p) {
+    auto adaptive_part = [&](std::size_t vk, const Ray* rays, const std::vector<Interval>& intervals, double* p) {
+        const Ray& ray = rays[vk];
         const PreparedVolume& pv = *members[vk].prepared;
         const SamplePipeline& pipeline = *pv.pipeline;
         const auto* integrator = dynamic_cast<const AdaptiveIntegrator*>(pv.integrator.get());
@@ -406,7 +420,7 @@ int run(const Args& args, int rank, int size) {
                     grid_cuts(ray, iv.t0, iv.t1, sampler.volume(), 0.0, cut);
                     for (std::size_t q = 0; q + 1 < cut.size(); ++q) {
                         const double ta = cut[q], tb = cut[q + 1];
-                        if (!owned_point(ray, 0.5 * (ta + tb))) continue;
+                        if (!owned_point(rays[0], 0.5 * (ta + tb))) continue;
                         const std::optional<double> hit = q == 0 && sampler.trilinear(ray.at(iv.t0)) - iso == 0.0
                                                               ? std::optional<double>(iv.t0)
                                                               : first_crossing_in_cell(sampler, ray, ta, tb, iso);
@@ -421,7 +435,8 @@ int run(const Args& args, int rank, int size) {
                 for (const Interval& iv : intervals) {
                     integrator->extremum_cuts(ray, iv, cut);
                     for (std::size_t q = 0; q + 1 < cut.size(); ++q)
-                        if (owned_point(ray, 0.5 * (cut[q] + cut[q + 1]))) integrator->extremum_piece(ray, cut[q], cut[q + 1], acc);
+                        if (owned_point(rays[0], 0.5 * (cut[q] + cut[q + 1])))
+                            integrator->extremum_piece(ray, cut[q], cut[q + 1], acc);
                 }
                 return extremum_part(pipeline, ray, acc, p);
             }
@@ -438,7 +453,7 @@ int run(const Args& args, int rank, int size) {
                     integrator->cuts(ray, iv, cut);
                     for (std::size_t q = 0; q + 1 < cut.size(); ++q) {
                         const double ta = cut[q], tb = cut[q + 1];
-                        if (!(tb > ta) || !owned_point(ray, 0.5 * (ta + tb))) continue;
+                        if (!(tb > ta) || !owned_point(rays[0], 0.5 * (ta + tb))) continue;
                         if (!any) p[0] = 0.5 * (ta + tb);
                         any = true;
                         integrator->line_piece(ray, ta, tb, per_length, sums);
@@ -453,9 +468,10 @@ int run(const Args& args, int rank, int size) {
             }
         }
     };
-    auto volume_part = [&](std::size_t vk, const Ray& ray, const std::vector<Interval>& intervals, const Interval& range,
+    auto volume_part = [&](std::size_t vk, const Ray* rays, const std::vector<Interval>& intervals, const Interval& range,
                            double* p) {
-        if (adaptive) return adaptive_part(vk, ray, intervals, p);
+        if (adaptive) return adaptive_part(vk, rays, intervals, p);
+        const Ray& ray = rays[vk];
         const PreparedVolume& pv = *members[vk].prepared;
         const SamplePipeline& pipeline = *pv.pipeline;
         const double step = pv.step, unit = pipeline.classifier().unit_distance();
@@ -465,7 +481,7 @@ int run(const Args& args, int rank, int size) {
         std::vector<Segment> owned;
         std::vector<std::array<std::int64_t, 3>> owned_at;  // first hit: interval, k, n
         for (std::size_t i = 0; i < intervals.size(); ++i)
-            owned_segments(ray, intervals[i], step, range, [&](const Segment& s, std::int64_t k, std::int64_t n) {
+            owned_segments(rays[0], intervals[i], step, range, [&](const Segment& s, std::int64_t k, std::int64_t n) {
                 owned.push_back(s);
                 if (first_hit) owned_at.push_back({std::int64_t(i), k, n});
             });
@@ -567,8 +583,7 @@ int run(const Args& args, int rank, int size) {
                     std::vector<Ray> rays(V);
                     for (std::size_t px = r.begin(); px != r.end(); ++px) {
                         if (round >= 0 && position[px] != round) continue;
-                        pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), rays[0], intervals.data());
-                        std::fill(rays.begin() + 1, rays.end(), rays[0]);  // no transforms: one world ray
+                        pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), rays.data(), intervals.data());
                         f(px, rays, intervals);
                     }
                 });
@@ -705,20 +720,18 @@ int run(const Args& args, int rank, int size) {
                 MultiVolumeIntegrator::MixScratch scratch;
                 for (int y = rows.begin(); y != rows.end(); ++y)
                     for (int x = 0; x < W; ++x) {
-                        Ray ray;
-                        pixel_intervals(x, y, ray, intervals.data());
+                        pixel_intervals(x, y, rays.data(), intervals.data());
                         double* p = &part[(std::size_t(y) * std::size_t(W) + std::size_t(x)) * slots * kPart];
                         for (std::size_t s = 0; s < slots; ++s) p[s * kPart] = kNone;
-                        Interval range;
+                        Interval range;  // the ray in the brick's box (in the first volume's space)
                         bool none = true;
                         for (const auto& iv : intervals) none = none && iv.empty();
-                        if (none || !intersect_box(ray, blo, bhi, range)) continue;
+                        if (none || !intersect_box(rays[0], blo, bhi, range)) continue;
                         if (mixed) {
-                            std::fill(rays.begin(), rays.end(), ray);  // no transforms: every volume's ray is the world ray
                             mixed_part(rays, intervals.data(), range, p, scratch);
                         } else {
                             for (std::size_t k = 0; k < V; ++k)
-                                if (!intervals[k].empty()) volume_part(k, ray, intervals[k], range, p + k * kPart);
+                                if (!intervals[k].empty()) volume_part(k, rays.data(), intervals[k], range, p + k * kPart);
                         }
                     }
             });
@@ -806,11 +819,11 @@ int run(const Args& args, int rank, int size) {
     // Pixel px from its slots' values: one slot as it is; several volumes (other than composite)
     // combined by the single-process rule (MultiVolumeIntegrator::combine, which reads the pixel's
     // intervals: recomputed here). out = R G B A (and Z).
-    auto finish = [&](std::size_t px, const PixelValue* values, double* out, std::vector<std::vector<Interval>>& intervals) {
+    auto finish = [&](std::size_t px, const PixelValue* values, double* out, std::vector<std::vector<Interval>>& intervals,
+                      std::vector<Ray>& rays) {
         PixelValue v = values[0];
         if (slots > 1) {
-            Ray ray;
-            pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), ray, intervals.data());
+            pixel_intervals(int(px % std::size_t(W)), int(px / std::size_t(W)), rays.data(), intervals.data());
             v = multi->combine(values, intervals.data());
         }
         for (int c = 0; c < 4; ++c) out[c] = v.rgba[c];
@@ -843,6 +856,7 @@ int run(const Args& args, int rank, int size) {
             std::vector<const double*> order(static_cast<std::size_t>(size));
             std::vector<PixelValue> values(slots);
             std::vector<std::vector<Interval>> intervals(V);
+            std::vector<Ray> rays(V);
             for (std::size_t px = 0; px < pixels; ++px) {
                 for (std::size_t sl = 0; sl < slots; ++sl) {
                     for (int r = 0; r < size; ++r)
@@ -851,7 +865,7 @@ int run(const Args& args, int rank, int size) {
                     std::stable_sort(order.begin(), order.end(), [](const double* a, const double* b) { return a[0] < b[0]; });
                     values[sl] = pixel_of(order.data(), size);
                 }
-                finish(px, values.data(), &image->pixels[px * std::size_t(nc)], intervals);
+                finish(px, values.data(), &image->pixels[px * std::size_t(nc)], intervals, rays);
             }
         }
     } else {
@@ -921,12 +935,13 @@ int run(const Args& args, int rank, int size) {
         std::vector<double> finished((hi - lo) * std::size_t(nc));
         std::vector<PixelValue> values(slots);
         std::vector<std::vector<Interval>> intervals(V);
+        std::vector<Ray> rays(V);
         for (std::size_t px = lo; px < hi; ++px) {
             for (std::size_t sl = 0; sl < slots; ++sl) {
                 const double* q = &part[(px * slots + sl) * kPart];
                 values[sl] = pixel_of(&q, 1);
             }
-            finish(px, values.data(), &finished[(px - lo) * std::size_t(nc)], intervals);
+            finish(px, values.data(), &finished[(px - lo) * std::size_t(nc)], intervals, rays);
         }
         std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
         for (int r = 0; r < size; ++r) {

@@ -13,7 +13,7 @@ failed       : a truncated raw file whose last brick cannot be read: exit status
                `volref: error:` line naming the file, no image.
 formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.nii, scaled) read as bricks
                by 2, 3 and 4 ranks equal `volref render`; gzip data and a flipped NIfTI are one-line errors.
-volumes      : several volumes (different grids, overlapping, one cropped and clipped) on every
+volumes      : several volumes (different grids, overlapping, one cropped and clipped, transformed) on every
                projection and order, orthographic and perspective, shaded and unshaded, by 2, 3 and
                4 ranks equal `volref render`; a constant medium beside a second one has a closed form.
 adaptive     : render.integrator "adaptive" on every projection, one volume and three (the composite's
@@ -434,6 +434,23 @@ if a.mode == "volumes":
             cases.append(("vols-" + p + "-" + cam, two_volumes(p, cam)))
     cases.append(("vols-shaded-ftb-persp", two_volumes("composite", "persp", shaded=True)))
     cases.append(("vols-shaded-first-hit-persp", two_volumes("first-hit", "persp", shaded=True)))
+    # Transforms: the second volume rotated, scaled and moved; the first (whose lattice is split) turned
+    # too; and the reference scene of two volumes (a shaded shell cut by a clip plane, a transformed
+    # Gaussian), made small.
+    for cam in ("ortho", "persp"):
+        for p in ("composite", "mip", "first-hit"):
+            s = two_volumes(p, cam, shaded=p != "mip")
+            s["volumes"][1]["transform"] = {"scale": [1.3, 0.8, 1], "rotate": {"axis": [1, 1, 0], "degrees": 35},
+                                            "translate": [2, -1, 3]}
+            s["volumes"][0]["transform"] = {"rotate": {"axis": [0, 0, 1], "degrees": 20}, "translate": [1, 0, 0]}
+            cases.append(("vols-transform-%s-%s" % (p, cam), s))
+    s = base_scene("composite", "persp", shaded=True)
+    s["volume"]["transform"] = {"scale": [1, 1.5, 0.7], "rotate": {"axis": [1, 0, 1], "degrees": 50}, "translate": [3, 0, -2]}
+    cases.append(("one-volume-transform-shaded-persp", s))
+    s = json.load(open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "reference_scenes",
+                                    "two-volumes-clipped.json")))
+    s["image"] = {"width": 40, "height": 32}
+    cases.append(("vols-two-volumes-clipped", s))
     for name, scene in cases:
         path = write_scene(name, scene)
         for np_ in (2, 3, 4):
@@ -542,8 +559,9 @@ if a.mode == "refusals":
         expect_refusal(key, s)
     # Several volumes: the key names the volume at fault.
     s = two_volumes("composite", "ortho")
-    s["volumes"][1]["transform"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 2, 0, 0, 0, 1]
-    expect_refusal("volumes[1].transform", s)
+    s["volumes"][1]["gradient"] = {"cache": True}
+    s["volumes"][1]["shading"] = {"model": "phong"}
+    expect_refusal("volumes[1].gradient.cache", s)
 
 for f in failures:
     print("FAIL " + f)

@@ -1,0 +1,107 @@
+// volref-mpi's bricks (cli/mpi/Bricks.h; conventions §14): the k-d split by hand, the lattice over
+// several (transformed) grids by hand, each grid's voxels for a brick by hand, and ownership as a
+// partition (every point in exactly one brick). Bricks.cpp needs no MPI, so these run in every
+// build, the sanitizers' included.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <glm/mat4x4.hpp>
+
+#include "cli/mpi/Bricks.h"
+#include "core/Error.h"
+
+namespace {
+
+using namespace volref;
+using namespace volref::mpi;
+
+TEST(MpiBricks, KdSplitByHand) {
+    // 10 x 4 x 6 cells, 3 ranks: x (longest) cut at 0 + (10 * 1 + 3 / 2) / 3 = 3 for 1 : 2 ranks;
+    // then [3, 10) (7 cells, longer than z's 6) cut at 3 + (7 * 1 + 1) / 2 = 7.
+    Lattice cells;
+    cells.hi = {10, 4, 6};
+    const std::vector<Brick> b = split_lattice(cells, 3);
+    ASSERT_EQ(b.size(), 3u);
+    EXPECT_EQ(b[0].lo, (std::array<std::int64_t, 3>{0, 0, 0}));
+    EXPECT_EQ(b[0].hi, (std::array<std::int64_t, 3>{3, 4, 6}));
+    EXPECT_EQ(b[1].lo, (std::array<std::int64_t, 3>{3, 0, 0}));
+    EXPECT_EQ(b[1].hi, (std::array<std::int64_t, 3>{7, 4, 6}));
+    EXPECT_EQ(b[2].lo, (std::array<std::int64_t, 3>{7, 0, 0}));
+    EXPECT_EQ(b[2].hi, (std::array<std::int64_t, 3>{10, 4, 6}));
+    EXPECT_THROW(split_lattice(cells, 11), Error);  // more ranks than the longest axis' cells
+}
+
+TEST(MpiBricks, EveryPointBelongsToExactlyOneBrick) {
+    Lattice cells;
+    cells.lo = {-3, 0, 2};
+    cells.hi = {9, 5, 13};
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-6.0, 16.0);  // beyond the outer faces too
+    for (int n = 1; n <= 7; ++n) {
+        const std::vector<Brick> bricks = split_lattice(cells, n);
+        for (int i = 0; i < 2000; ++i) {
+            glm::dvec3 p(u(rng), u(rng), u(rng));
+            if (i % 10 == 0) p.x = double(bricks[std::size_t(i) % bricks.size()].lo[0]);  // on a cut plane
+            int owners = 0;
+            for (const Brick& b : bricks) owners += owns(b, cells, p) ? 1 : 0;
+            ASSERT_EQ(owners, 1) << n << " bricks, point " << p.x << " " << p.y << " " << p.z;
+        }
+    }
+}
+
+TEST(MpiBricks, UnionLatticeByHand) {
+    GridBox g0;
+    g0.dims = {11, 5, 7};  // cells [0, 10) x [0, 4) x [0, 6)
+    GridBox shifted;       // x from -2.5 to -0.5, y from 1 to 3, z from 0 to 9 (beyond g0's 6)
+    shifted.dims = {5, 3, 10};
+    shifted.origin = {-2.5, 1.0, 0.0};
+    shifted.spacing = {0.5, 1.0, 1.0};
+    Lattice l = union_lattice({g0, shifted});
+    EXPECT_EQ(l.lo, (std::array<std::int64_t, 3>{-3, 0, 0}));  // floor(-2.5)
+    EXPECT_EQ(l.hi, (std::array<std::int64_t, 3>{10, 4, 9}));
+    // Turned 90 degrees about z (local (x, y, z) -> world (-y, x, z)): its box [0, 2] x [0, 4] x [0, 1]
+    // lies at x in [-4, 0], y in [0, 2] in the world.
+    glm::dmat4 m(1.0);
+    m[0] = glm::dvec4(0, 1, 0, 0);
+    m[1] = glm::dvec4(-1, 0, 0, 0);
+    const VolumeTransform turn(m);
+    GridBox turned;
+    turned.dims = {3, 5, 2};
+    turned.to_world = &turn;
+    l = union_lattice({g0, turned});
+    EXPECT_EQ(l.lo, (std::array<std::int64_t, 3>{-4, 0, 0}));
+    EXPECT_EQ(l.hi, (std::array<std::int64_t, 3>{10, 4, 6}));
+}
+
+TEST(MpiBricks, VoxelsForByHand) {
+    GridBox g0;
+    g0.dims = {11, 5, 7};
+    Lattice cells;
+    cells.hi = {10, 4, 6};
+    Brick inner;  // cells x [3, 7), all of y and z (the lattice's outer faces)
+    inner.lo = {3, 0, 0};
+    inner.hi = {7, 4, 6};
+    std::array<std::int64_t, 3> lo{}, hi{};
+    // The lattice's own grid: the cells' corners 3 .. 7, +- 2 ghost voxels; the outer faces reach the grid's.
+    voxels_for(inner, cells, g0, g0, 2, lo, hi);
+    EXPECT_EQ(lo, (std::array<std::int64_t, 3>{1, 0, 0}));
+    EXPECT_EQ(hi, (std::array<std::int64_t, 3>{9, 4, 6}));
+    // A finer grid (spacing 0.5, 21 x 9 x 13 voxels over the same box): world x in [3, 7] is its index
+    // [6, 14], +- 1 ghost voxel.
+    GridBox fine;
+    fine.dims = {21, 9, 13};
+    fine.spacing = glm::dvec3(0.5);
+    voxels_for(inner, cells, g0, fine, 1, lo, hi);
+    EXPECT_EQ(lo, (std::array<std::int64_t, 3>{5, 0, 0}));
+    EXPECT_EQ(hi, (std::array<std::int64_t, 3>{15, 8, 12}));
+    // A grid the brick does not meet (x from 20 to 24): a sliver at its face, never sampled.
+    GridBox far;
+    far.dims = {5, 5, 7};
+    far.origin = {20.0, 0.0, 0.0};
+    voxels_for(inner, cells, g0, far, 1, lo, hi);
+    EXPECT_EQ(lo[0], 0);
+    EXPECT_LE(hi[0], 0);
+}
+
+}  // namespace

@@ -36,6 +36,7 @@
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
+#include "core/integrate/fixed/CompositeIntegrator.h"
 #include "core/integrate/fixed/FirstHitIntegrator.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/CompensatedSum.h"
@@ -98,7 +99,6 @@ void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
     if (r.profile != ProfileId::Reference)
         throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
-    if (r.early_termination) throw Error("render.early_termination: not supported by volref-mpi yet");
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];
         const std::string key = volume_key(scene, k);
@@ -553,24 +553,30 @@ int run(const Args& args, int rank, int size) {
             });
         if (any) composite_part(samples, p);
     };
-    // ---- render.integrator "adaptive", composite: the ray's state handed from rank to rank ----
+    // ---- composite with render.integrator "adaptive" or with early termination: the ray's state
+    // handed from rank to rank ----
     // The adaptive integrator's refinement of a piece depends on the transmittance in front of it,
-    // the largest colour seen and the rules left (AdaptiveComposite.h), so a rank's pieces cannot be
-    // integrated before those of the ranks in front: every rank lists the pieces it owns (cut as the
-    // single process cuts them; a piece belongs to the brick holding its midpoint) and its key (the
-    // first one's midpoint); the keys are all-gathered, giving each pixel's ranks in ray order; in
-    // round j the j-th rank of each pixel continues that pixel's state (kStateSize doubles) over its
-    // pieces, and an MPI_Allreduce hands the states on. The error's sums run back to front the same way
-    // (what is emitted behind each leaf). Pixels' R G B A error in `chained` on every rank.
-    const bool chain = adaptive && render.projection == Projection::Composite;
+    // the largest colour seen and the rules left (AdaptiveComposite.h), and early termination on the
+    // opacity in front: a rank's part cannot be integrated before those of the ranks in front. Every
+    // rank lists what it owns (adaptive: the pieces cut as the single process cuts them, a piece
+    // belonging to the brick holding its midpoint; fixed step: the range of owned segments of each
+    // interval or piece) and its key (the first one's midpoint); the keys are all-gathered, giving each
+    // pixel's ranks in ray order; in round j the j-th rank of each pixel continues that pixel's state
+    // over what it owns, and an MPI_Allreduce hands the states on. The adaptive error's sums run back
+    // to front the same way (what is emitted behind each leaf). Pixels' R G B A (error) in `chained`.
+    const bool chain = render.projection == Projection::Composite && (adaptive || render.early_termination);
     std::vector<double> chained;
     std::size_t chain_bytes = 0;  // what this rank hands to the collectives (keys, N rounds each way)
     if (chain) {
         using Composite = AdaptiveIntegrator::Composite;
         using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
-        const auto* one = V == 1 ? dynamic_cast<const AdaptiveIntegrator*>(members[0].prepared->integrator.get()) : nullptr;
-        const std::size_t P = std::size_t(W) * std::size_t(H), S = std::size_t(Composite::kStateSize);
-        // Each pixel's owned pieces: [a, b] and (several volumes) the index of the union piece holding it.
+        const auto* one = adaptive && V == 1 ? dynamic_cast<const AdaptiveIntegrator*>(members[0].prepared->integrator.get()) : nullptr;
+        const std::size_t P = std::size_t(W) * std::size_t(H);
+        // Fixed step: FrontToBack's state, opaque, stopped.
+        constexpr std::size_t kFixedState = std::size_t(FrontToBack<Scalar>::kStateValues) + 2;
+        const std::size_t S = adaptive ? std::size_t(Composite::kStateSize) : kFixedState;
+        // Each pixel's owned parts: adaptive [a, b, union piece]; fixed step [interval or union piece,
+        // first segment, last segment].
         std::vector<std::vector<std::array<double, 3>>> pieces(P);
         std::vector<double> key(P, kNone), total(P, 0.0);
         std::vector<int> position(P, -1), count(P, 0);
@@ -589,14 +595,42 @@ int run(const Args& args, int rank, int size) {
                 });
             });
         };
+        // The spans the fixed step's segments are placed on: one volume's intervals, or the pieces of
+        // several volumes' union (MultiVolumeIntegrator::composite).
+        auto fixed_spans = [&](const std::vector<std::vector<Interval>>& intervals) {
+            std::vector<MultiVolumeIntegrator::Piece> spans;
+            if (V == 1)
+                for (const Interval& iv : intervals[0]) spans.push_back({iv, {0}});
+            else
+                spans = MultiVolumeIntegrator::pieces(intervals.data(), V);
+            return spans;
+        };
+        const double fixed_step = V == 1 ? members[0].prepared->step : (multi ? multi->step() : 0.0);
         try {
-            if (V == 1 && !one) throw Error("render.integrator: internal: volref-mpi found no adaptive integrator");
+            if (adaptive && V == 1 && !one) throw Error("render.integrator: internal: volref-mpi found no adaptive integrator");
             each_pixel(-1, [&](std::size_t px, const std::vector<Ray>& rays, const std::vector<std::vector<Interval>>& intervals) {
                 std::vector<double> cut, all;
                 const Ray& ray = rays[0];
                 auto keep = [&](double a, double b, std::size_t piece) {
                     if (owned_point(ray, 0.5 * (a + b))) pieces[px].push_back({a, b, double(piece)});
                 };
+                if (!adaptive) {  // the owned segments of each span: one run (the brick is convex)
+                    Interval range;
+                    if (!intersect_box(ray, blo, bhi, range)) return;
+                    const auto spans = fixed_spans(intervals);
+                    for (std::size_t i = 0; i < spans.size(); ++i) {
+                        std::int64_t first = -1, last = -1;
+                        owned_segments(ray, spans[i].span, fixed_step, range, [&](const Segment& sg, std::int64_t k, std::int64_t) {
+                            if (first < 0) {
+                                first = k;
+                                if (key[px] == kNone) key[px] = sg.midpoint();
+                            }
+                            last = k;
+                        });
+                        if (first >= 0) pieces[px].push_back({double(i), double(first), double(last)});
+                    }
+                    return;
+                }
                 if (V == 1) {  // AdaptiveIntegrator::composite's pieces
                     for (const Interval& iv : intervals[0]) total[px] += iv.length();
                     for (const Interval& iv : intervals[0]) {
@@ -621,7 +655,7 @@ int run(const Args& args, int rank, int size) {
         if (any_error(err, rank, size)) return 1;
         std::vector<double> keys(P * std::size_t(size));
         MPI_Allgather(key.data(), int(P), MPI_DOUBLE, keys.data(), int(P), MPI_DOUBLE, MPI_COMM_WORLD);
-        chain_bytes = P * sizeof(double) * (1 + std::size_t(size) * (S + 5));
+        chain_bytes = P * sizeof(double) * (1 + std::size_t(size) * (S + (adaptive ? 5 : 0)));
         for (std::size_t px = 0; px < P; ++px)
             for (int r = 0; r < size; ++r) {
                 const double k = keys[std::size_t(r) * P + px];
@@ -631,20 +665,66 @@ int run(const Args& args, int rank, int size) {
             }
         for (std::size_t px = 0; px < P; ++px)
             if (key[px] != kNone) ++position[px];  // from -1: the ranks in front of this one
-        const double tolerance = render.tolerance, safety = V == 1 ? one->safety() : multi->adaptive_safety();
-        std::vector<double> state(P * S), delta(P * S), next(P * S);
+        const double tolerance = render.tolerance;
+        const double safety = !adaptive ? 1.0 : V == 1 ? one->safety() : multi->adaptive_safety();
+        const Termination stop = early_termination(render);
+        std::vector<double> state(P * S, 0.0), delta(P * S), next(P * S);
         const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
-        {
+        if (adaptive) {
             const Composite fresh(none, tolerance, safety, 1.0);
             for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
+        } else {
+            const FrontToBack<Scalar> fresh;
+            bool opaque = false;
+            for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S], opaque);
         }
+        // The fixed step over one rank's segments, continuing `acc` (CompositeIntegrator::front_to_back,
+        // MultiVolumeIntegrator::composite); true once the ray stops (opaque or terminated).
+        auto fixed_step_part = [&](std::size_t px, const std::vector<Ray>& rays, const std::vector<std::vector<Interval>>& intervals,
+                                   FrontToBack<Scalar>& acc) {
+            const auto spans = fixed_spans(intervals);
+            MultiVolumeIntegrator::MixScratch scratch;
+            const SamplePipeline& pipeline = *members[0].prepared->pipeline;
+            const double unit = pipeline.classifier().unit_distance();
+            for (const auto& owned : pieces[px]) {
+                const MultiVolumeIntegrator::Piece& span = spans[std::size_t(owned[0])];
+                const std::int64_t n = segment_count(span.span, fixed_step);
+                for (std::int64_t k = std::int64_t(owned[1]); k <= std::int64_t(owned[2]); ++k) {
+                    const Segment sg = segment(span.span, fixed_step, k, n);
+                    if (V == 1) {
+                        const PipelineSample q = pipeline.sample(rays[0], sg.midpoint(), SamplePipeline::Use::Composite);
+                        if (!(q.opacity > 0.0)) continue;
+                        const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, q.opacity, sg.length(), unit);
+                        const double c[3] = {q.color.r, q.color.g, q.color.b};
+                        acc.add(true, o.solid, o.tau, o.alpha, c);
+                        if (o.solid || acc.stops(o.partial, stop)) return true;
+                    } else {
+                        const MultiVolumeIntegrator::MixedSegment m = multi->mix(rays.data(), span.present, sg, scratch);
+                        if (!m.opaque && !(m.tau > 0.0)) continue;
+                        const double c[3] = {m.color.r, m.color.g, m.color.b};
+                        acc.add(true, m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), c);
+                        if (m.opaque || acc.stops(true, stop)) return true;
+                    }
+                }
+            }
+            return false;
+        };
         std::vector<std::vector<adaptive_detail::Leaf>> leaves(P);
         for (int j = 0; j < size; ++j) {
             std::fill(delta.begin(), delta.end(), 0.0);
             try {
                 each_pixel(j, [&](std::size_t px, const std::vector<Ray>& rays, const std::vector<std::vector<Interval>>& intervals) {
                     const Ray& ray = rays[0];
-                    if (V == 1) {
+                    if (!adaptive) {
+                        FrontToBack<Scalar> acc;
+                        double* in = &state[px * S];
+                        bool opaque = in[kFixedState - 2] != 0.0, stopped = in[kFixedState - 1] != 0.0;
+                        acc.load(in, opaque);
+                        if (!stopped) stopped = fixed_step_part(px, rays, intervals, acc);
+                        acc.save(&delta[px * S], opaque);
+                        delta[px * S + kFixedState - 2] = opaque ? 1.0 : 0.0;
+                        delta[px * S + kFixedState - 1] = stopped ? 1.0 : 0.0;
+                    } else if (V == 1) {
                         const AdaptiveIntegrator::OneVolume medium{one, &ray};
                         Composite st(medium, tolerance, safety, total[px]);
                         st.load(&state[px * S]);
@@ -681,34 +761,44 @@ int run(const Args& args, int rank, int size) {
             for (std::size_t px = 0; px < P; ++px)
                 if (count[px] > j) std::copy(&next[px * S], &next[px * S] + S, &state[px * S]);
         }
-        // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c.
-        constexpr std::size_t E = 5;
-        std::vector<double> sums(P * E, 0.0), dsums(P * E), nsums(P * E);
-        for (std::size_t px = 0; px < P; ++px)
-            for (int i = 0; i < 3; ++i) sums[px * E + std::size_t(i)] = state[px * S + 12 + std::size_t(i)];
-        for (int j = size - 1; j >= 0; --j) {
-            std::fill(dsums.begin(), dsums.end(), 0.0);
+        if (!adaptive) {  // the fixed step's pixels: FrontToBack's colour and alpha
+            chained.assign(P * 4, 0.0);
             for (std::size_t px = 0; px < P; ++px) {
-                if (position[px] != j) continue;
-                double* q = &sums[px * E];
-                glm::dvec3 behind(q[0], q[1], q[2]);
-                double colour_err = q[3], tau_err = q[4];
-                Composite::error_sums(leaves[px], behind, colour_err, tau_err);
-                double* d = &dsums[px * E];
-                d[0] = behind.r, d[1] = behind.g, d[2] = behind.b, d[3] = colour_err, d[4] = tau_err;
+                FrontToBack<Scalar> acc;
+                acc.load(&state[px * S], state[px * S + kFixedState - 2] != 0.0);
+                for (int c = 0; c < 3; ++c) chained[px * 4 + std::size_t(c)] = acc.color(c);
+                chained[px * 4 + 3] = acc.alpha();
             }
-            MPI_Allreduce(dsums.data(), nsums.data(), int(P * E), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+        } else {
+            // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c.
+            constexpr std::size_t E = 5;
+            std::vector<double> sums(P * E, 0.0), dsums(P * E), nsums(P * E);
             for (std::size_t px = 0; px < P; ++px)
-                if (count[px] > j) std::copy(&nsums[px * E], &nsums[px * E] + E, &sums[px * E]);
-        }
-        chained.assign(P * 5, 0.0);
-        for (std::size_t px = 0; px < P; ++px) {
-            if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as the single process)
-            Composite st(none, tolerance, safety, total[px]);
-            st.load(&state[px * S]);
-            const PixelValue v = st.result_from(sums[px * E + 3], sums[px * E + 4]);
-            for (int c = 0; c < 4; ++c) chained[px * 5 + std::size_t(c)] = v.rgba[c];
-            chained[px * 5 + 4] = v.error;
+                for (int i = 0; i < 3; ++i) sums[px * E + std::size_t(i)] = state[px * S + 12 + std::size_t(i)];
+            for (int j = size - 1; j >= 0; --j) {
+                std::fill(dsums.begin(), dsums.end(), 0.0);
+                for (std::size_t px = 0; px < P; ++px) {
+                    if (position[px] != j) continue;
+                    double* q = &sums[px * E];
+                    glm::dvec3 behind(q[0], q[1], q[2]);
+                    double colour_err = q[3], tau_err = q[4];
+                    Composite::error_sums(leaves[px], behind, colour_err, tau_err);
+                    double* d = &dsums[px * E];
+                    d[0] = behind.r, d[1] = behind.g, d[2] = behind.b, d[3] = colour_err, d[4] = tau_err;
+                }
+                MPI_Allreduce(dsums.data(), nsums.data(), int(P * E), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+                for (std::size_t px = 0; px < P; ++px)
+                    if (count[px] > j) std::copy(&nsums[px * E], &nsums[px * E] + E, &sums[px * E]);
+            }
+            chained.assign(P * 5, 0.0);
+            for (std::size_t px = 0; px < P; ++px) {
+                if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as the single process)
+                Composite st(none, tolerance, safety, total[px]);
+                st.load(&state[px * S]);
+                const PixelValue v = st.result_from(sums[px * E + 3], sums[px * E + 4]);
+                for (int c = 0; c < 4; ++c) chained[px * 5 + std::size_t(c)] = v.rgba[c];
+                chained[px * 5 + 4] = v.error;
+            }
         }
     }
     if (!chain) try {

@@ -447,6 +447,16 @@ if a.mode == "volumes":
     s = base_scene("composite", "persp", shaded=True)
     s["volume"]["transform"] = {"scale": [1, 1.5, 0.7], "rotate": {"axis": [1, 0, 1], "degrees": 50}, "translate": [3, 0, -2]}
     cases.append(("one-volume-transform-shaded-persp", s))
+    # Early termination (front to back): the ray's state handed from rank to rank, so a ray stops
+    # where the single process's does; one volume and the mix of three, low thresholds so that most
+    # rays stop inside some brick.
+    for cam in ("ortho", "persp"):
+        s = base_scene("composite", cam, shaded=True)
+        s["render"]["early_termination"] = 0.3
+        cases.append(("early-termination-" + cam, s))
+        s = two_volumes("composite", cam)
+        s["render"]["early_termination"] = 0.25
+        cases.append(("vols-early-termination-" + cam, s))
     s = json.load(open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "reference_scenes",
                                     "two-volumes-clipped.json")))
     s["image"] = {"width": 40, "height": 32}
@@ -541,8 +551,8 @@ if a.mode == "adaptive":
 
 if a.mode == "refusals":
     cases = {
-        "render.early_termination": ("render", "early_termination", 0.99),
         "render.profile": ("render", "profile", "vtk-gpu"),
+        "volume.classify": ("volume", "classify", "pre"),
     }
     def expect_refusal(key, scene):
         out = os.path.join(a.work, "refused.exr")

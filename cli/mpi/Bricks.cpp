@@ -133,7 +133,13 @@ int ghost_voxels(const VolumeSpec& vs, const RenderSpec& render) {
     GradientSpec::Scheme scheme = vs.gradient.scheme;
     if (scheme == GradientSpec::Scheme::Default) scheme = tricubic ? GradientSpec::Scheme::Analytic : GradientSpec::Scheme::Central;
     const bool differences = gradient && scheme != GradientSpec::Scheme::Analytic;
-    return 1 + (tricubic ? 1 : 0) + (differences ? 1 : 0);
+    const int ghost = 1 + (tricubic ? 1 : 0) + (differences ? 1 : 0);
+    // A gradient cache is the scheme at every voxel, trilinearly interpolated: the cell's corners (one
+    // voxel beyond the owned cells, for rounding) read the scheme's taps around them: one voxel further
+    // for differences, two for the analytic tricubic derivative (conservatively: its kernel reads taps
+    // i - 1 .. i + 2, though at a voxel the weight of i + 2 is 0; a ghost of 2 gave the same image).
+    if (gradient && vs.gradient.cache) return std::max(ghost, 1 + (scheme == GradientSpec::Scheme::Analytic ? 2 : 1));
+    return ghost;
 }
 
 bool owns(const Brick& b, const Lattice& lattice, const glm::dvec3& u) {

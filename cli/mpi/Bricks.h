@@ -51,7 +51,8 @@ void voxels_for(const Brick& b, const Lattice& lattice, const GridBox& first, co
 
 // The ghost layer a volume's reconstruction needs (conventions §14): 1 voxel for nearest and
 // trilinear (a midpoint owned by the brick may round to the neighbouring cell), +1 for tricubic taps
-// (i - 1 .. i + 2), +1 when gradients are taken by differences (x +- h reads one voxel further).
+// (i - 1 .. i + 2), +1 when gradients are taken by differences (x +- h reads one voxel further); with
+// a gradient cache at least 1 + the scheme's reach (1 for differences, 2 for the analytic tricubic).
 int ghost_voxels(const VolumeSpec& vs, const RenderSpec& render);
 
 // Whether the point with continuous grid index u (u_a = (x_a - origin_a) / spacing_a of the whole

@@ -104,8 +104,9 @@ void check_supported(const Scene& scene) {
         const std::string key = volume_key(scene, k);
         if (vs.bounds.type != BoundsSpec::Type::Box)
             throw Error(key + ".bounds: volref-mpi supports box bounds only (meshes and shells are not supported yet)");
-        if (vs.gradient.cache || vs.gradient.cache_auto) throw Error(key + ".gradient.cache: not supported by volref-mpi yet");
-        if (vs.classify == VolumeSpec::Classify::Pre) throw Error(key + ".classify: \"pre\" is not supported by volref-mpi yet");
+        // "auto" decides from the whole volume's voxels (resolve_gradient_cache), which no rank holds.
+        if (vs.gradient.cache_auto)
+            throw Error(key + ".gradient.cache: \"auto\" is not supported by volref-mpi yet (say true or false)");
     }
 }
 

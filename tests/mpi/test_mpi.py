@@ -447,6 +447,23 @@ if a.mode == "volumes":
     s = base_scene("composite", "persp", shaded=True)
     s["volume"]["transform"] = {"scale": [1, 1.5, 0.7], "rotate": {"axis": [1, 0, 1], "degrees": 50}, "translate": [3, 0, -2]}
     cases.append(("one-volume-transform-shaded-persp", s))
+    # Pre-classification (the RGBA volume, Levoy's pre-shading with shading) and a gradient cache:
+    # per voxel, so a brick's (with its ghost layer) equals the whole volume's there.
+    for cam in ("ortho", "persp"):
+        for shaded in (False, True):
+            s = base_scene("composite", cam, shaded=shaded)
+            s["volume"]["classify"] = "pre"
+            cases.append(("pre-classified-%s%s" % (cam, "-shaded" if shaded else ""), s))
+        s = base_scene("composite", cam, shaded=True)
+        s["volume"]["gradient"] = {"cache": True}
+        cases.append(("gradient-cache-shaded-" + cam, s))
+    s = base_scene("composite", "persp", shaded=True)
+    s["volume"].update({"interpolation": "tricubic-bspline", "gradient": {"cache": True}})  # analytic, cached
+    cases.append(("gradient-cache-tricubic-shaded-persp", s))
+    s = two_volumes("composite", "persp", shaded=True)
+    s["volumes"][1]["gradient"] = {"cache": True}
+    s["volumes"][0]["classify"] = "pre"
+    cases.append(("vols-pre-classified-gradient-cache-persp", s))
     # Early termination (front to back): the ray's state handed from rank to rank, so a ray stops
     # where the single process's does; one volume and the mix of three, low thresholds so that most
     # rays stop inside some brick.
@@ -552,7 +569,6 @@ if a.mode == "adaptive":
 if a.mode == "refusals":
     cases = {
         "render.profile": ("render", "profile", "vtk-gpu"),
-        "volume.classify": ("volume", "classify", "pre"),
     }
     def expect_refusal(key, scene):
         out = os.path.join(a.work, "refused.exr")
@@ -569,7 +585,7 @@ if a.mode == "refusals":
         expect_refusal(key, s)
     # Several volumes: the key names the volume at fault.
     s = two_volumes("composite", "ortho")
-    s["volumes"][1]["gradient"] = {"cache": True}
+    s["volumes"][1]["gradient"] = {"cache": "auto"}
     s["volumes"][1]["shading"] = {"model": "phong"}
     expect_refusal("volumes[1].gradient.cache", s)
 

@@ -50,6 +50,7 @@
 #include "geometry/BoxIntersection.h"
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
+#include "geometry/TriangleMesh.h"
 #include "geometry/VolumeTransform.h"
 #include "cli/mpi/BrickReader.h"
 #include "cli/mpi/Bricks.h"
@@ -102,8 +103,8 @@ void check_supported(const Scene& scene) {
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];
         const std::string key = volume_key(scene, k);
-        if (vs.bounds.type != BoundsSpec::Type::Box)
-            throw Error(key + ".bounds: volref-mpi supports box bounds only (meshes and shells are not supported yet)");
+        if (vs.bounds.type != BoundsSpec::Type::Box && vs.bounds.type != BoundsSpec::Type::Mesh)
+            throw Error(key + ".bounds: volref-mpi supports box and mesh bounds only (shells are not supported yet)");
         // "auto" decides from the whole volume's voxels (resolve_gradient_cache), which no rank holds.
         if (vs.gradient.cache_auto)
             throw Error(key + ".gradient.cache: \"auto\" is not supported by volref-mpi yet (say true or false)");
@@ -253,12 +254,26 @@ int run(const Args& args, int rank, int size) {
             const glm::dvec3 domain_lo = m.grid.origin;
             const glm::dvec3 domain_hi =
                 m.grid.origin + glm::dvec3(double(m.grid.dims[0] - 1), double(m.grid.dims[1] - 1), double(m.grid.dims[2] - 1)) * m.grid.spacing;
-            const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
-            if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
-                throw Error(volume_key(scene, k) + ".bounds: min must not exceed max");
-            m.geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+            glm::dvec3 lo, hi;  // the shape AND domain's box
+            if (vs.bounds.type == BoundsSpec::Type::Mesh) {  // as PreparedVolume: the whole mesh, the whole domain
+                const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
+                glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
+                for (const glm::dvec3& v : mesh.vertices) {
+                    mlo = glm::min(mlo, v);
+                    mhi = glm::max(mhi, v);
+                }
+                lo = glm::max(mlo, domain_lo);
+                hi = glm::min(mhi, domain_hi);
+                m.geometry_id = geometry.add_mesh(mesh, domain_lo, domain_hi);
+            } else {
+                const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
+                if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
+                    throw Error(volume_key(scene, k) + ".bounds: min must not exceed max");
+                m.geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+                lo = glm::max(box_lo, domain_lo);
+                hi = glm::min(box_hi, domain_hi);
+            }
             // The world box of the shape AND domain (its transformed corners): PreparedVolume::view_lo.
-            const glm::dvec3 lo = glm::max(box_lo, domain_lo), hi = glm::min(box_hi, domain_hi);
             for (int c = 0; c < 8; ++c) {
                 glm::dvec3 x(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
                 if (m.transform) x = m.transform->to_world(x);

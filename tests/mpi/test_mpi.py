@@ -13,7 +13,7 @@ failed       : a truncated raw file whose last brick cannot be read: exit status
                `volref: error:` line naming the file, no image.
 formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.nii, scaled) read as bricks
                by 2, 3 and 4 ranks equal `volref render`; gzip data and a flipped NIfTI are one-line errors.
-volumes      : several volumes (different grids, overlapping, one cropped and clipped, transformed) on every
+volumes      : mesh bounds; several volumes (different grids, overlapping, one cropped and clipped, transformed) on every
                projection and order, orthographic and perspective, shaded and unshaded, by 2, 3 and
                4 ranks equal `volref render`; a constant medium beside a second one has a closed form.
 adaptive     : render.integrator "adaptive" on every projection, one volume and three (the composite's
@@ -464,6 +464,22 @@ if a.mode == "volumes":
     s["volumes"][1]["gradient"] = {"cache": True}
     s["volumes"][0]["classify"] = "pre"
     cases.append(("vols-pre-classified-gradient-cache-persp", s))
+    # Mesh bounds: two disjoint boxes (one closed OBJ), so rays enter and leave the shape twice.
+    obj = os.path.join(a.work, "two-boxes.obj")
+    with open(obj, "w") as f:
+        quads = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+        for base, (lo, hi) in enumerate((((-2.5, 2.0, 1.0), (6.0, 20.0, 18.0)), ((10.0, 4.0, 5.0), (16.5, 19.0, 19.5)))):
+            for c in range(8):
+                f.write("v %g %g %g\n" % tuple(hi[i] if c >> i & 1 else lo[i] for i in range(3)))
+        for base in (0, 8):
+            for q in quads:  # corner c = x + 2 y + 4 z; outward faces
+                v = [base + 1 + (0, 1, 3, 2, 4, 5, 7, 6)[i] for i in q]
+                f.write("f %d %d %d\nf %d %d %d\n" % (v[0], v[1], v[2], v[0], v[2], v[3]))
+    for cam in ("ortho", "persp"):
+        for p in ("composite", "mip", "first-hit"):
+            s = base_scene(p, cam, shaded=p == "composite")
+            s["volume"]["bounds"] = {"type": "mesh", "file": obj}
+            cases.append(("mesh-bounds-%s-%s" % (p, cam), s))
     # Early termination (front to back): the ray's state handed from rank to rank, so a ray stops
     # where the single process's does; one volume and the mix of three, low thresholds so that most
     # rays stop inside some brick.

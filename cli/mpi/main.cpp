@@ -95,7 +95,7 @@ std::string volume_key(const Scene& scene, std::size_t k) {
     return scene.volumes.size() == 1 ? std::string("volume") : "volumes[" + std::to_string(k) + "]";
 }
 
-// The first version's scope (docs/conventions.md §14): one-line errors naming the key.
+// What volref-mpi does not render yet (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
     if (r.profile != ProfileId::Reference)

@@ -50,7 +50,6 @@
 #include "geometry/BoxIntersection.h"
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
-#include "geometry/TriangleMesh.h"
 #include "geometry/VolumeTransform.h"
 #include "cli/mpi/BrickReader.h"
 #include "cli/mpi/Bricks.h"
@@ -88,11 +87,6 @@ bool any_error(const std::string& mine, int rank, int size) {
                 break;
             }
     return true;
-}
-
-// The key of volume k ("volume" for a scene of one, "volumes[k]" otherwise).
-std::string volume_key(const Scene& scene, std::size_t k) {
-    return scene.volumes.size() == 1 ? std::string("volume") : "volumes[" + std::to_string(k) + "]";
 }
 
 // What volref-mpi does not render yet (docs/conventions.md §14): one-line errors naming the key.
@@ -254,32 +248,11 @@ int run(const Args& args, int rank, int size) {
             const glm::dvec3 domain_lo = m.grid.origin;
             const glm::dvec3 domain_hi =
                 m.grid.origin + glm::dvec3(double(m.grid.dims[0] - 1), double(m.grid.dims[1] - 1), double(m.grid.dims[2] - 1)) * m.grid.spacing;
-            glm::dvec3 lo, hi;  // the shape AND domain's box
-            if (vs.bounds.type == BoundsSpec::Type::Mesh) {  // as PreparedVolume: the whole mesh, the whole domain
-                const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
-                glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
-                for (const glm::dvec3& v : mesh.vertices) {
-                    mlo = glm::min(mlo, v);
-                    mhi = glm::max(mhi, v);
-                }
-                lo = glm::max(mlo, domain_lo);
-                hi = glm::min(mhi, domain_hi);
-                m.geometry_id = geometry.add_mesh(mesh, domain_lo, domain_hi);
-            } else {
-                const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
-                if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
-                    throw Error(volume_key(scene, k) + ".bounds: min must not exceed max");
-                m.geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
-                lo = glm::max(box_lo, domain_lo);
-                hi = glm::min(box_hi, domain_hi);
-            }
-            // The world box of the shape AND domain (its transformed corners): PreparedVolume::view_lo.
-            for (int c = 0; c < 8; ++c) {
-                glm::dvec3 x(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
-                if (m.transform) x = m.transform->to_world(x);
-                view_lo = glm::min(view_lo, x);
-                view_hi = glm::max(view_hi, x);
-            }
+            glm::dvec3 lo, hi, world_lo, world_hi;  // the shape AND domain's box, and its world box
+            m.geometry_id = add_cartesian_bounds(geometry, vs, volume_key(scene, k), domain_lo, domain_hi, lo, hi);
+            world_box(m.transform ? &*m.transform : nullptr, lo, hi, world_lo, world_hi);
+            view_lo = glm::min(view_lo, world_lo);
+            view_hi = glm::max(view_hi, world_hi);
         }
         geometry.commit();
         if (members.size() > 1) {  // the single-process render's mix (composite) and combination (others)
@@ -398,7 +371,6 @@ int run(const Args& args, int rank, int size) {
         p[4] = tau.value();
         p[5] = opaque ? 1.0 : 0.0;
     };
-    // Volume k's part of the ray (its own step and projection), as a single-volume render's.
     const bool adaptive = render.integrator == IntegrationMethod::Adaptive;
     // First hit: the part of a hit at t found in the piece or segment whose midpoint is `key`.
     auto hit_part = [&](const SamplePipeline& pipeline, const Ray& ray, double t, double key, double* p) {
@@ -457,11 +429,7 @@ int run(const Args& args, int rank, int size) {
                 return extremum_part(pipeline, ray, acc, p);
             }
             default: {  // average, xray: AdaptiveIntegrator::line_integral's budget, this rank's pieces
-                CompensatedSum length;
-                for (const Interval& iv : intervals) length.add(iv.length());
-                const double L = length.value(), tol = render.tolerance;
-                const double per_length =
-                    render.projection == Projection::Average ? tol : (L > 0.0 ? tol / (render.gain * L) : 0.0);
+                const double per_length = integrator->line_budget(AdaptiveIntegrator::line_length(intervals));
                 AdaptiveIntegrator::LineSums sums;
                 CompensatedSum owned_length;
                 bool any = false;
@@ -484,6 +452,7 @@ int run(const Args& args, int rank, int size) {
             }
         }
     };
+    // Volume k's part of the ray (its own step and projection), as a single-volume render's.
     auto volume_part = [&](std::size_t vk, const Ray* rays, const std::vector<Interval>& intervals, const Interval& range,
                            double* p) {
         if (adaptive) return adaptive_part(vk, rays, intervals, p);
@@ -790,7 +759,7 @@ int run(const Args& args, int rank, int size) {
             constexpr std::size_t E = 5;
             std::vector<double> sums(P * E, 0.0), dsums(P * E), nsums(P * E);
             for (std::size_t px = 0; px < P; ++px)
-                for (int i = 0; i < 3; ++i) sums[px * E + std::size_t(i)] = state[px * S + 12 + std::size_t(i)];
+                for (int i = 0; i < 3; ++i) sums[px * E + std::size_t(i)] = state[px * S + Composite::kStateOpaqueColour + std::size_t(i)];
             for (int j = size - 1; j >= 0; --j) {
                 std::fill(dsums.begin(), dsums.end(), 0.0);
                 for (std::size_t px = 0; px < P; ++px) {

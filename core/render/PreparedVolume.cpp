@@ -68,12 +68,48 @@ bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, c
     return sampler->interpolation() == Interpolation::Trilinear;
 }
 
-// "volume" for a scene of one volume, "volumes[i]" otherwise (the key path in messages).
+}  // namespace
+
 std::string volume_key(const Scene& scene, std::size_t index) {
     return scene.volumes.size() == 1 ? "volume" : "volumes[" + std::to_string(index) + "]";
 }
 
-}  // namespace
+int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const std::string& key,
+                         const glm::dvec3& domain_lo, const glm::dvec3& domain_hi, glm::dvec3& lo, glm::dvec3& hi) {
+    if (vs.bounds.type == BoundsSpec::Type::Mesh) {
+        const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
+        glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
+        for (const glm::dvec3& p : mesh.vertices) {
+            mlo = glm::min(mlo, p);
+            mhi = glm::max(mhi, p);
+        }
+        lo = glm::max(mlo, domain_lo);
+        hi = glm::min(mhi, domain_hi);
+        return geometry.add_mesh(mesh, domain_lo, domain_hi);
+    }
+    const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
+    if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
+        throw Error(key + ".bounds: min must not exceed max");
+    lo = glm::max(box_lo, domain_lo);
+    hi = glm::min(box_hi, domain_hi);
+    return geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
+}
+
+void world_box(const VolumeTransform* transform, const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3& world_lo,
+               glm::dvec3& world_hi) {
+    if (!transform) {
+        world_lo = lo;
+        world_hi = hi;
+        return;
+    }
+    world_lo = glm::dvec3(std::numeric_limits<double>::infinity());
+    world_hi = -world_lo;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 p = transform->to_world(glm::dvec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z));
+        world_lo = glm::min(world_lo, p);
+        world_hi = glm::max(world_hi, p);
+    }
+}
 
 void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
     if (!is_shell(vs.bounds)) {
@@ -235,39 +271,10 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                                    : geometry.add_spherical_shell(vs.bounds.sphere);
         }
     } else {
-        const glm::dvec3 domain_lo = volume.domain_min(), domain_hi = volume.domain_max();
-        if (vs.bounds.type == BoundsSpec::Type::Mesh) {
-            const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
-            glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
-            for (const glm::dvec3& p : mesh.vertices) {
-                mlo = glm::min(mlo, p);
-                mhi = glm::max(mhi, p);
-            }
-            lo = glm::max(mlo, domain_lo);
-            hi = glm::min(mhi, domain_hi);
-            geometry_id = geometry.add_mesh(mesh, domain_lo, domain_hi);
-        } else {
-            const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
-            if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
-                throw Error(key + ".bounds: min must not exceed max");
-            lo = glm::max(box_lo, domain_lo);
-            hi = glm::min(box_hi, domain_hi);
-            geometry_id = geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
-        }
+        geometry_id = add_cartesian_bounds(geometry, vs, key, volume.domain_min(), volume.domain_max(), lo, hi);
     }
     geometry.commit();
-    if (!transform) {
-        view_lo = lo;
-        view_hi = hi;
-    } else {  // the world box of the transformed corners
-        view_lo = glm::dvec3(std::numeric_limits<double>::infinity());
-        view_hi = -view_lo;
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec3 p = transform->to_world(glm::dvec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z));
-            view_lo = glm::min(view_lo, p);
-            view_hi = glm::max(view_hi, p);
-        }
-    }
+    world_box(transform ? &*transform : nullptr, lo, hi, view_lo, view_hi);
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;

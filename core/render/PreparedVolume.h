@@ -12,6 +12,7 @@
 #pragma once
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -69,6 +70,20 @@ struct VolumeModel {
 
 // Fills `out` (a fresh model) for `vs`.
 void build_volume_model(const VolumeSpec& vs, VolumeModel& out);
+
+// "volume" for a scene of one volume, "volumes[i]" otherwise (the key path in messages).
+std::string volume_key(const Scene& scene, std::size_t index);
+
+// A Cartesian volume's bounding shape (`bounds`: a box, default the domain, or a closed mesh) over
+// the data domain [domain_lo, domain_hi], in the volume's own space: added to `geometry` (its id
+// returned), and [lo, hi] set to the box of the shape AND the domain. Errors name `key`.bounds.
+int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const std::string& key,
+                         const glm::dvec3& domain_lo, const glm::dvec3& domain_hi, glm::dvec3& lo, glm::dvec3& hi);
+
+// The world box of the volume-space box [lo, hi]: itself, or with a transform the bounds of its 8
+// corners mapped to the world (what the default camera frames).
+void world_box(const VolumeTransform* transform, const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3& world_lo,
+               glm::dvec3& world_hi);
 
 struct PreparedVolume {
     // `index` is the volume's position in scene.volumes (for messages); `held_bytes` is the memory

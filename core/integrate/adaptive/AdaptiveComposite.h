@@ -93,31 +93,32 @@ public:
         return out;
     }
     const std::vector<LeafRecord>& leaves() const { return leaves_; }
-    const glm::dvec3& opaque_contribution() const { return opaque_colour_; }
 
     // volref-mpi (cli/mpi/): the state a ray carries from one rank's pieces to the next's, kStateSize
-    // doubles: the accumulator, K, the rules left, the transmittance of the first unresolved piece,
-    // opaque, and the opaque piece's T c. load() starts a new list of leaves (each rank keeps its own).
-    static constexpr int kStateSize = 8 + 7;
+    // doubles: the accumulator (kAcc values), K, the rules left, the transmittance of the first
+    // unresolved piece, opaque, and from kStateOpaqueColour on the opaque piece's T c (what lies behind
+    // the last leaf, where the error's sums start). load() starts a new list of leaves (each rank keeps
+    // its own).
+    using Accumulator = FrontToBack<Scalar, TransmittanceRule::OpticalDepthSum, true>;
+    static constexpr int kAcc = Accumulator::kStateValues;
+    static constexpr int kStateOpaqueColour = kAcc + 4;
+    static constexpr int kStateSize = kStateOpaqueColour + 3;
     void save(double* s) const {
-        bool opaque_lanes = false;
-        acc_.save(s, opaque_lanes);
-        s[8] = colour_bound_;
-        s[9] = double(rules_left_);
-        s[10] = unresolved_T_;
-        s[11] = opaque_ ? 1.0 : 0.0;
-        s[12] = opaque_colour_.r;
-        s[13] = opaque_colour_.g;
-        s[14] = opaque_colour_.b;
-        (void)opaque_lanes;
+        bool opaque = false;  // the accumulator's flag, which is opaque_
+        acc_.save(s, opaque);
+        s[kAcc] = colour_bound_;
+        s[kAcc + 1] = double(rules_left_);
+        s[kAcc + 2] = unresolved_T_;
+        s[kAcc + 3] = opaque_ ? 1.0 : 0.0;
+        for (int i = 0; i < 3; ++i) s[kStateOpaqueColour + i] = opaque_colour_[i];
     }
     void load(const double* s) {
-        opaque_ = s[11] != 0.0;
+        opaque_ = s[kAcc + 3] != 0.0;
         acc_.load(s, opaque_);
-        colour_bound_ = s[8];
-        rules_left_ = long(s[9]);
-        unresolved_T_ = s[10];
-        opaque_colour_ = glm::dvec3(s[12], s[13], s[14]);
+        colour_bound_ = s[kAcc];
+        rules_left_ = long(s[kAcc + 1]);
+        unresolved_T_ = s[kAcc + 2];
+        opaque_colour_ = glm::dvec3(s[kStateOpaqueColour], s[kStateOpaqueColour + 1], s[kStateOpaqueColour + 2]);
         leaves_.clear();
     }
 
@@ -244,7 +245,7 @@ private:
     const Medium& medium_;
     double tolerance_, safety_, total_;
     // The pieces composite front to back with compensated colour sums (march/Accumulators.h).
-    FrontToBack<Scalar, TransmittanceRule::OpticalDepthSum, true> acc_;
+    Accumulator acc_;
     double colour_bound_ = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
     std::vector<LeafRecord> leaves_;
     long rules_left_ = conventions::kAdaptiveMaxRulesPerRay;  // work bound of the ray

@@ -385,13 +385,9 @@ struct LineState {
 PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals) const {
     PixelValue out;
     if (intervals.empty()) return out;
-    CompensatedSum length;
-    for (const Interval& iv : intervals) length.add(iv.length());
-    const double L = length.value();
+    const double L = line_length(intervals);
     const bool mean = ctx_.render.projection == Projection::Average;
-    const double tol = ctx_.render.tolerance;
-    // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
-    const double per_length = mean ? tol : (L > 0.0 ? tol / (ctx_.render.gain * L) : 0.0);
+    const double per_length = line_budget(L);
     LineSums st;
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
@@ -402,6 +398,19 @@ PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<I
     out.rgba = glm::dvec4(g, g, g, 1.0);
     out.error = (mean ? (L > 0.0 ? st.error / L : 0.0) : ctx_.render.gain * st.error) + rounding_bound(out.rgba);
     return out;
+}
+
+double AdaptiveIntegrator::line_length(const std::vector<Interval>& intervals) {
+    CompensatedSum length;
+    for (const Interval& iv : intervals) length.add(iv.length());
+    return length.value();
+}
+
+double AdaptiveIntegrator::line_budget(double length) const {
+    // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
+    const double tol = ctx_.render.tolerance;
+    if (ctx_.render.projection == Projection::Average) return tol;
+    return length > 0.0 ? tol / (ctx_.render.gain * length) : 0.0;
 }
 
 void AdaptiveIntegrator::line_piece(const Ray& ray, double a, double b, double per_length, LineSums& sums) const {

@@ -112,6 +112,10 @@ public:
         long rules_left = conventions::kAdaptiveMaxRulesPerRay;
     };
     void line_piece(const Ray& ray, double a, double b, double per_length, LineSums& sums) const;
+    // The ray's length L (compensated sum of its intervals') and the accepted error per unit length:
+    // tolerance (average, pixel I / L) or tolerance / (gain L) (xray, pixel gain I; 0 when L = 0).
+    static double line_length(const std::vector<Interval>& intervals);
+    double line_budget(double length) const;
 
 private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;

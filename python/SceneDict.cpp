@@ -246,8 +246,8 @@ json render_json(const RenderSpec& r) {
     if (r.profile == ProfileId::GlslBasic) j["profile_options"] = {{"intensity", r.profile_options.intensity}};
     if (r.profile == ProfileId::CudaCurvilinear || r.profile == ProfileId::GlslBasic || r.profile == ProfileId::VtkGpu) {
         // issue 17: listed when not the defaults
-        if (r.profile_options.texture_unit == ProfileOptions::TextureUnit::Hardware)
-            j["profile_options"]["texture_unit"] = "hardware";
+        if (r.profile_options.texture_unit == ProfileOptions::TextureUnit::H100)
+            j["profile_options"]["texture_unit"] = "h100";
         if (r.profile_options.texture_band) j["profile_options"]["texture_band"] = true;
         if (r.profile_options.data_unorm16) j["profile_options"]["texture_format"] = "unorm16";
     }

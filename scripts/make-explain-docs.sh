@@ -55,6 +55,7 @@ Regenerate this page with `scripts/make-explain-docs.sh` (after building `build/
 | `coords` | Cartesian, cylindrical, spherical (docs/shells.md) | `--cartesian x,y,z \| --cylindrical r,theta,h \| --spherical R,lon,lat [--center c]` |
 | `intersect` | a ray against a box or shell: slabs or roots, intervals | `--origin o --direction d` and `--box x0,y0,z0,x1,y1,z1` or `--cylinder [--center --radius r0,r1 --angle a0,a1 --height h0,h1]` or `--sphere [--center --radius --longitude --latitude]` |
 | `ray` | a whole pixel: camera, intervals, samples, pixel | `--scene S --pixel X,Y [--set P=V ...] [--no-skipping]` |
+| `texture-fetch` | a GPU texture unit's fetch: weights, texels, sum, rounding | `--volume FILE (u16 or f32) [--unit h100\|exact] [--normalized] --at X,Y,Z \| --points POINTS.csv` |
 
 ## Levoy's lecture example
 
@@ -184,7 +185,26 @@ text <<'EOF'
 
 The whole pixel; see the lecture example above. `volref trace` ([trace.md](trace.md)) lists the same
 samples with every column (grid index, gradient, each shading term) as CSV or JSON.
+
+## texture-fetch
+
+One linearly filtered fetch of a 3D texture, as an NVIDIA H100's texture unit computes it
+(`--unit h100`, the default; core/integrate/profiles/TextureUnit.h, docs/conventions.md section 9, "The
+texture unit") or with exact weights (`--unit exact`), with exact trilinear filtering beside it. The
+volume is read with volref's readers: a u16 volume is a unorm16 texture (q / 65535), an f32 volume a
+float texture; any other type is an error. `--at X,Y,Z` is an unnormalised coordinate in texels (texel i
+centred at i + 0.5) unless `--normalized` ([0, 1] over each axis); the unit takes it as a float32. Steps:
+per axis t, i0, i1 and the integer weight a; the eight integer corner weights (z split, then x in each
+slice, then y, each rounded half up); the texels (float32: truncated to 28 bits below each slice's
+largest weighted texel); the exact sum and its one rounding (unorm16: the integer sum S and
+N = (S + 128) >> 8); the fetch. The example is the first fetch of `tests/data/h100-fetches`: the H100
+returned 0.663706422 there (and 0.489043504 from the float32 volume).
+
+`--points POINTS.csv` (a header line, then `x,y,z` per line) prints a header line `x,y,z,fetch` and one
+line `x,y,z,fetch` per point instead (the fetch with 9 significant digits; `--json`: the same as a table).
+
 EOF
+example explain texture-fetch --unit h100 --volume tests/data/h100-fetches/random-volume-u16.nrrd --at 9.48425293,6.60173273,4.08762169
 
 mv "$TMP" "$OUT"
 trap - EXIT

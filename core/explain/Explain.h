@@ -20,6 +20,7 @@ namespace volref {
 
 class VolumeSampler;
 struct PreparedScene;
+struct Volume;
 
 namespace explain {
 
@@ -71,6 +72,14 @@ Explanation intersect_sphere(const Ray& ray, const SphericalShell& shell);
 // ray: pixel (x, y) of a prepared scene: the camera's ray, the intervals, every sample (the engine
 // of `volref trace`, PixelTrace.h) and the pixel.
 Explanation ray(const PreparedScene& scene, int x, int y);
+
+// texture-fetch (issue 27): one linearly filtered fetch of a 3D texture (a u16 volume read as unorm16,
+// an f32 volume as float) at a coordinate (unnormalised texels, texel i centred at i + 0.5, or normalised
+// with `normalized`), by the H100 rule (`h100`, core/integrate/profiles/TextureUnit.h) or with exact
+// weights, every step; throws volref::Error naming --volume for any other type.
+Explanation texture_fetch(const Volume& volume, const glm::dvec3& at, bool h100, bool normalized);
+// The same fetch at many points: one table, columns x, y, z, fetch.
+Explanation texture_fetch_points(const Volume& volume, const std::vector<glm::dvec3>& points, bool h100, bool normalized);
 
 }  // namespace explain
 }  // namespace volref

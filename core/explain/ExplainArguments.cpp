@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <map>
 #include <set>
@@ -15,13 +17,16 @@
 #include "core/Error.h"
 #include "core/explain/Explain.h"
 #include "core/explain/PixelTrace.h"
+#include "core/grid/Volume.h"
+#include "core/io/VolumeReader.h"
 #include "core/render/PreparedScene.h"
 #include "core/scene/SceneLoader.h"
 
 namespace volref::explain {
 
 const char* topics() {
-    return "trilinear, composite, opacity-correction, classify-isovalue, classify-boundary, shade, coords, intersect, ray";
+    return "trilinear, composite, opacity-correction, classify-isovalue, classify-boundary, shade, coords, intersect, ray, "
+           "texture-fetch";
 }
 
 namespace {
@@ -137,6 +142,32 @@ Scene scene_of(const Options& o) {
 }
 
 }  // namespace
+
+// --points FILE: a header line, then "x,y,z" per line (blank lines skipped).
+std::vector<glm::dvec3> read_points(const std::string& file) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) throw Error("--points: " + file + ": not a regular file");
+    std::ifstream in(file);
+    if (!in) throw Error("--points: " + file + ": cannot be read");
+    std::vector<glm::dvec3> out;
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+        ++n;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (n == 1 || line.find_first_not_of(" \t") == std::string::npos) continue;
+        const std::string where = "--points: " + file + " line " + std::to_string(n);
+        std::vector<double> v;
+        try {
+            v = parse_list(where, line, 3, 3, "3 numbers x,y,z");
+        } catch (const Error&) {
+            throw Error(where + ": expected x,y,z (3 finite numbers), got \"" + line.substr(0, 80) + "\"");
+        }
+        out.emplace_back(v[0], v[1], v[2]);
+    }
+    if (out.empty()) throw Error("--points: " + file + ": no points (a header line, then x,y,z per line)");
+    return out;
+}
 
 Explanation from_arguments(const std::string& t, const std::vector<std::string>& args) {
     if (t == "trilinear") {
@@ -308,6 +339,17 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         options.empty_space_skipping = !o.has("--no-skipping");
         const PreparedScene prepared(scene, options);
         return ray(prepared, p[0], p[1]);
+    }
+    if (t == "texture-fetch") {
+        const Options o(t, args, {"--unit", "--volume", "--normalized", "--at", "--points"});
+        o.flag("--normalized");
+        const std::string unit = o.has("--unit") ? o.one("--unit") : "h100";
+        if (unit != "h100" && unit != "exact") throw Error("--unit: expected h100 or exact, got \"" + unit + "\"");
+        if (o.has("--at") == o.has("--points")) throw Error("--at: give either --at X,Y,Z or --points POINTS.csv");
+        const std::string file = o.one("--volume");
+        const Volume v = read_volume(file);
+        if (o.has("--at")) return texture_fetch(v, vec3("--at", o.one("--at")), unit == "h100", o.has("--normalized"));
+        return texture_fetch_points(v, read_points(o.one("--points")), unit == "h100", o.has("--normalized"));
     }
     throw Error("explain: unknown topic \"" + t + "\" (topics: " + topics() + ")");
 }

@@ -181,13 +181,13 @@ struct ProfileOptions {
     double jitter = 1.0;
     bool fixed_normal = false, flip_normal = false, ray_box_domain = false, mip_correction = true;
     double intensity = 1.0;       // glsl-basic: seed 002's K, the sample's alpha is K times the opacity
-    // vtk-gpu, glsl-basic, cuda-curvilinear (issue 17; core/integrate/profiles/TextureUnit.h, conventions
-    // section 9, "The texture unit"): the weights of the profile's linearly filtered texture reads, exact
-    // (llvmpipe) or the hardware model; texture_band: the render writes the "error" channel, a bound on
-    // how far any texture unit within the model can be from this render. Admissible: tests only (no
-    // scene-file value): every fetch takes weights within the model's tolerances, chosen by a hash of
-    // texture_seed and the fetch's position (a Monte Carlo of the units the band covers).
-    enum class TextureUnit { Exact, Hardware, Admissible };
+    // vtk-gpu, glsl-basic, cuda-curvilinear (issues 17, 27; core/integrate/profiles/TextureUnit.h, conventions
+    // section 9, "The texture unit"): the profile's linearly filtered texture reads, exact (llvmpipe) or
+    // the NVIDIA H100's rule bit for bit; texture_band: the render writes the "error" channel, a bound
+    // on how far any texture unit of the rule's family can be from this render. Admissible: tests only
+    // (no scene-file value): every fetch is a unit of the family, chosen by a hash of texture_seed and
+    // the fetch's position (a Monte Carlo of the units the band covers).
+    enum class TextureUnit { Exact, H100, Admissible };
     TextureUnit texture_unit = TextureUnit::Exact;
     bool texture_band = false;
     unsigned long long texture_seed = 0;  // Admissible

@@ -6,6 +6,7 @@
 #include "core/scene/SceneLoader.h"
 
 #include <algorithm>
+#include <iostream>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -829,7 +830,9 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format"});
         // issue 17: the texture unit's weights (TextureUnit.h) and the band in the "error" channel
         using TU = ProfileOptions::TextureUnit;
-        s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, {{"exact", TU::Exact}, {"hardware", TU::Hardware}});
+        s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, {{"exact", TU::Exact}, {"h100", TU::H100}, {"hardware", TU::H100}});
+        if (po.has("texture_unit") && po.string("texture_unit", "") == "hardware")
+            std::cerr << "volref: notice: render.profile_options.texture_unit: \"hardware\" is a deprecated alias of \"h100\"\n";
         s.profile_options.texture_band = po.boolean("texture_band", false);
         s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, {{"float", false}, {"unorm16", true}});
         s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());

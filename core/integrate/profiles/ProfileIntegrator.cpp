@@ -18,6 +18,7 @@
 #include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"
 #include "transfer/OpacityCorrection.h"
+#include "transfer/Shader.h"
 #include "transfer/TransferFunction.h"
 
 namespace volref {
@@ -59,6 +60,11 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         throw Error("render.profile_options.texture_format: \"unorm16\" is seed 001's data texture on a shell (cylindrical or spherical bounds)");
     texture_unit_ = po.texture_unit;
     band_ = po.texture_band;
+    texels_ = &volume;
+    texture_dims_ = volume.dims;
+    // GLSL programs (vtk-gpu, glsl-basic) read their volume with normalised coordinates, seed 001's
+    // tex3D with unnormalised ones (TextureUnit.h: the 20-bit cut applies to the former only).
+    normalized_coordinates_ = p_.id != ProfileId::CudaCurvilinear;
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_) {
         const std::string key = band_ ? "render.profile_options.texture_band" : "render.profile_options.texture_unit";
         if (p_.id != ProfileId::VtkGpu && p_.id != ProfileId::GlslBasic && p_.id != ProfileId::CudaCurvilinear)
@@ -69,8 +75,6 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
                 cartesian_->interpolation() != Interpolation::Trilinear)
                 throw Error(key + ": the texture unit filters trilinearly (volume.interpolation \"trilinear\", one Cartesian grid)");
         }
-        if (band_ && ctx.pipeline.shaded() && ctx.render.projection == Projection::Composite)
-            throw Error(key + ": the band is not propagated through shading (remove volume.shading)");
         if (band_ && p_.table_entries <= 1) {
             transfer_ = ctx.pipeline.stages().transfer_function;
             if (!transfer_) throw Error(key + ": the band needs a transfer function (volume.transfer)");
@@ -138,8 +142,10 @@ double lerp_corners(const std::array<double, 8>& k, const glm::dvec3& w) {
 
 }  // namespace
 
-// The texels of seed 001's read at x (corners c = x + 2 y + 4 z, fractions w); false: outVal.
-bool ProfileIntegrator::shell_texels(const glm::dvec3& x, std::array<double, 8>& k, glm::dvec3& w) const {
+// The texels of seed 001's read at x (corners c = x + 2 y + 4 z, fractions w, the unnormalised
+// texture coordinate `coord`); false: outVal.
+bool ProfileIntegrator::shell_texels(const glm::dvec3& x, std::array<double, 8>& k, glm::dvec3& w,
+                                     glm::dvec3& coord) const {
     const glm::dvec3 c = shell_->shell_coordinates(x);
     glm::dvec3 u;
     std::array<std::int64_t, 3> i0{}, i1{};
@@ -150,67 +156,115 @@ bool ProfileIntegrator::shell_texels(const glm::dvec3& x, std::array<double, 8>&
         if (ax.angular) rel = std::fmod(std::fmod(rel, 360.0) + 360.0, 360.0);  // atan2 + 2 pi: [0, 360) from lo
         const double tex = rel / ((ax.hi - ax.lo) / n);
         if (!(tex >= 0.0 && tex <= n - 1.0)) return false;  // outVal (0: the data minimum, s = 0)
+        coord[a] = tex;
         u[a] = std::clamp(tex - 0.5, 0.0, n - 1.0);       // texel i centred at i + 0.5, clamped
         i0[std::size_t(a)] = ax.n > 1 ? std::min(std::int64_t(std::floor(u[a])), ax.n - 2) : 0;
         i1[std::size_t(a)] = ax.n > 1 ? i0[std::size_t(a)] + 1 : 0;
         w[a] = ax.n > 1 ? u[a] - double(i0[std::size_t(a)]) : 0.0;
     }
-    const Volume& v = *volume_;
     for (int j = 0; j < 8; ++j)
-        k[std::size_t(j)] = v.at((j & 1) ? i1[0] : i0[0], (j & 2) ? i1[1] : i0[1], (j & 4) ? i1[2] : i0[2]);
-    if (ctx_.render.profile_options.data_unorm16)  // seed 001's unsigned shorts over the data range, v / 65535
-        for (double& x : k) {
-            const double u = width_ > 0.0 ? std::clamp((x - lo_) / width_, 0.0, 1.0) : 0.0;
-            x = lo_ + width_ * (std::nearbyint(u * 65535.0) / 65535.0);
-        }
+        k[std::size_t(j)] = texel((j & 1) ? i1[0] : i0[0], (j & 2) ? i1[1] : i0[1], (j & 4) ? i1[2] : i0[2]);
     return true;
+}
+
+// seed 001's unsigned shorts over the data range (texture_format "unorm16"): q = round(s 65535).
+std::uint16_t ProfileIntegrator::texel_code(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    const double v = texels_->at(i, j, k);
+    const double u = width_ > 0.0 ? std::clamp((v - lo_) / width_, 0.0, 1.0) : 0.0;
+    return static_cast<std::uint16_t>(std::nearbyint(u * 65535.0));
+}
+
+// A texel as the profile's texture holds it, as a value: the voxel, or seed 001's min + (max - min) q / 65535.
+double ProfileIntegrator::texel(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    if (ctx_.render.profile_options.data_unorm16) return lo_ + width_ * (double(texel_code(i, j, k)) / 65535.0);
+    return texels_->at(i, j, k);
 }
 
 double ProfileIntegrator::seed_shell_value(const glm::dvec3& x) const {
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact) return texture_fetch(x).value;
     std::array<double, 8> k;
-    glm::dvec3 w;
-    if (!shell_texels(x, k, w)) return lo_;
+    glm::dvec3 w, coord;
+    if (!shell_texels(x, k, w, coord)) return lo_;
     return lerp_corners(k, w);
 }
 
-// TextureUnit.h: exact, the hardware model or an admissible unit, and the band around exact.
+// TextureUnit.h: exact, the h100 rule or a unit of its family, and the band around exact. The unit's
+// coordinate per axis is the exact one rounded to float32 (normalised: u = float32((i + 0.5) / n), then
+// the rule's 20-bit cut); the band takes the corner values of the exact position's cell and of the
+// unit's, and the move delta between the two positions (TextureUnit.h, "The family and its band").
 ProfileIntegrator::Fetch ProfileIntegrator::texture_fetch(const glm::dvec3& x) const {
+    namespace tu = texture_unit;
     std::array<double, 8> k;
-    glm::dvec3 w;
+    glm::dvec3 w, coord;
     Fetch out;
     if (shell_) {
-        if (!shell_texels(x, k, w)) {
+        if (!shell_texels(x, k, w, coord)) {
             out.value = out.exact = lo_;  // outVal: no texture read
             return out;
         }
         out.exact = lerp_corners(k, w);
     } else {  // VolumeSampler::trilinear, the exact path's value
         std::array<std::int64_t, 3> cell;
-        cartesian_->locate(cartesian_->continuous_index(glm::clamp(x, domain_lo_, domain_hi_)), cell, w);
+        const glm::dvec3 u = cartesian_->continuous_index(glm::clamp(x, domain_lo_, domain_hi_));
+        cartesian_->locate(u, cell, w);
         const std::array<double, 8> L = cartesian_->corners(cell);  // Levoy's order
         k = {L[0], L[1], L[3], L[2], L[4], L[5], L[7], L[6]};
         out.exact = volref::trilinear(L, w.x, w.y, w.z);
+        coord = u + 0.5;  // texel i centred at i + 0.5
     }
-    out.band = texture_unit::fetch_error_band_3d(k, w.x, w.y, w.z);
+    std::array<double, 3> xu{};
+    double delta = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t n = texture_dims_[std::size_t(a)];
+        if (normalized_coordinates_) {
+            xu[std::size_t(a)] = tu::unnormalized(tu::to_float32(coord[a] / double(n)), n);
+            delta += tu::kNormalizedDelta * double(n);
+        } else {
+            xu[std::size_t(a)] = tu::to_float32(coord[a]);
+            delta += tu::kCoordinateDelta * std::fabs(coord[a]) + 0x1p-149;
+        }
+    }
+    const tu::Fetch3d f = tu::locate_3d(xu, texture_dims_);
+    std::array<double, 8> q;  // the unit's corners as values
+    double vmin = k[0], vmax = k[0], amax = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        const auto i = f.corner_index(c);
+        q[std::size_t(c)] = texel(i[0], i[1], i[2]);
+        for (double v : {k[std::size_t(c)], q[std::size_t(c)]}) {
+            vmin = std::min(vmin, v);
+            vmax = std::max(vmax, v);
+            amax = std::max(amax, std::fabs(v));
+        }
+    }
+    const bool unorm16 = ctx_.render.profile_options.data_unorm16;
+    const double rounding = unorm16 ? width_ * tu::kUnorm16Rounding : tu::kFloatRounding * amax;
+    out.band = tu::weight_factor(delta) * (vmax - vmin) + rounding;
     switch (texture_unit_) {
         case ProfileOptions::TextureUnit::Exact: out.value = out.exact; break;
-        case ProfileOptions::TextureUnit::Hardware: out.value = texture_unit::fetch_3d(k, w.x, w.y, w.z, texture_unit::Model::Hardware); break;
+        case ProfileOptions::TextureUnit::H100:
+            if (unorm16) {
+                std::array<std::uint16_t, 8> codes;
+                for (int c = 0; c < 8; ++c) {
+                    const auto i = f.corner_index(c);
+                    codes[std::size_t(c)] = texel_code(i[0], i[1], i[2]);
+                }
+                out.value = lo_ + width_ * double(tu::filter_unorm16(f.w.data(), codes.data(), 8));
+            } else {
+                std::array<float, 8> t;
+                for (int c = 0; c < 8; ++c) t[std::size_t(c)] = static_cast<float>(q[std::size_t(c)]);
+                out.value = double(tu::filter_float(f.w.data(), t.data(), 8, 2));
+            }
+            break;
         case ProfileOptions::TextureUnit::Admissible: {
-            texture_unit::Admissible r(ctx_.render.profile_options.texture_seed, x.x, x.y, x.z);
-            const std::array<double, 8> wc = texture_unit::admissible_corner_weights(w.x, w.y, w.z, r);
+            tu::Admissible r(ctx_.render.profile_options.texture_seed, x.x, x.y, x.z);
+            const std::array<double, 8> wc = tu::admissible_weights(tu::exact_weights(f.axis), r);
             out.value = 0.0;
-            for (int c = 0; c < 8; ++c) out.value += wc[std::size_t(c)] * k[std::size_t(c)];
+            for (int c = 0; c < 8; ++c) out.value += wc[std::size_t(c)] * q[std::size_t(c)];
+            out.value += 0.999 * rounding * r.next();
             break;
         }
     }
     return out;
-}
-
-double ProfileIntegrator::table_weight(double w, double pos) const {
-    if (texture_unit_ == ProfileOptions::TextureUnit::Hardware) return texture_unit::weight(w, texture_unit::Model::Hardware);
-    texture_unit::Admissible r(ctx_.render.profile_options.texture_seed, pos, 0.25, -1.0);
-    return texture_unit::admissible_weight(w, r);
 }
 
 ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
@@ -226,9 +280,27 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
     const int n = p_.table_entries;
     const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale ? std::clamp(normalised(v) * ctx_.render.profile_options.transfer_scale, 0.0, 1.0)
                                      : normalised(v);
+    if (texture_unit_ == ProfileOptions::TextureUnit::H100) {  // TextureUnit.h: 1D, normalised, float32 texels
+        const texture_unit::AxisRead r = texture_unit::axis_read(texture_unit::unnormalized(texture_unit::to_float32(u), n), n);
+        const int w[2] = {texture_unit::kWeightOne - r.a, r.a};
+        auto channel = [&](double t0, double t1) {
+            const float t[2] = {static_cast<float>(t0), static_cast<float>(t1)};
+            return double(texture_unit::filter_float(w, t, 2, 1));
+        };
+        const glm::dvec4& e0 = table_[std::size_t(r.i0)];
+        const glm::dvec4& e1 = table_[std::size_t(r.i1)];
+        out.color = glm::dvec3(channel(e0.r, e1.r), channel(e0.g, e1.g), channel(e0.b, e1.b));
+        out.opacity = channel(e0.a, e1.a);
+        out.alpha = channel(table_alpha_[std::size_t(r.i0)], table_alpha_[std::size_t(r.i1)]);
+        return out;
+    }
     const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
     const int i = std::min(int(pos), n - 2);
-    const double w = texture_unit_ == ProfileOptions::TextureUnit::Exact ? pos - double(i) : table_weight(pos - double(i), pos);
+    double w = pos - double(i);
+    if (texture_unit_ == ProfileOptions::TextureUnit::Admissible) {  // within the band's 1D tolerance
+        texture_unit::Admissible r(ctx_.render.profile_options.texture_seed, pos, 0.25, -1.0);
+        w += (0.5 / 256.0 + texture_unit::kNormalizedDelta * double(n)) * r.next();
+    }
     const glm::dvec4 e = table_[std::size_t(i)] + w * (table_[std::size_t(i) + 1] - table_[std::size_t(i)]);
     out.color = glm::dvec3(e);
     out.opacity = e.a;
@@ -380,7 +452,8 @@ ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, d
         return b;
     }
     // A table of n texels read at pos(v), monotone in v: its curve's extremes at the ends and the texel
-    // centres between, and the weight's 1/512 of each segment it can read.
+    // centres between, the position widened by the unit's coordinate move, and the weight's 1/512 plus
+    // the float32 rounding of each segment it can read.
     const int n = p_.table_entries;
     auto pos = [&](double v) {
         const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale
@@ -399,7 +472,9 @@ ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, d
         entry(std::size_t(i) + 1, e);
         for (int j = 0; j < 5; ++j) c[j] = a[j] + w * (e[j] - a[j]);
     };
-    const double plo = pos(vlo), phi = pos(vhi);
+    // The unit reads at float32(u) cut to 20 bits: within n kNormalizedDelta texels of pos (TextureUnit.h).
+    const double move = double(n) * texture_unit::kNormalizedDelta;
+    const double plo = std::max(0.0, pos(vlo) - move), phi = std::min(double(n - 1), pos(vhi) + move);
     double c[5];
     curve(plo, c);
     start(c);
@@ -415,7 +490,10 @@ ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, d
         double a[5], e[5];
         entry(std::size_t(i), a);
         entry(std::size_t(i) + 1, e);
-        for (int j = 0; j < 5; ++j) slack[j] = std::max(slack[j], texture_unit::kWeightError * std::fabs(e[j] - a[j]));
+        // the 8-bit weight (|a / 256 - f| <= 1/512), the texels as float32, truncated, the result rounded
+        for (int j = 0; j < 5; ++j)
+            slack[j] = std::max(slack[j], std::fabs(e[j] - a[j]) / 512.0 +
+                                              texture_unit::kFloatRounding * std::max(std::fabs(a[j]), std::fabs(e[j])));
     }
     for (int j = 0; j < 5; ++j) {
         b.lo[j] -= slack[j];
@@ -450,6 +528,62 @@ ProfileIntegrator::Box ProfileIntegrator::sample_range(double vlo, double vhi, d
     return b;
 }
 
+// The shaded colour over every gradient G in the box G0 +- dG (per-axis half-widths) and every material
+// colour in b's colour box, as composite() shades (Shader.h; clamped when the profile clamps). With
+// eps = |dG| (2-norm) and the normal N = -G / |G|: |N - N0| <= rho = min(2, 2 eps / |G0|), so every dot
+// product N.X with a unit X lies in [N0.X - rho, N0.X + rho] cut to [-1, 1]; max(., 0), |.| and the
+// specular power are monotone on such intervals, the rest are products of intervals. Where some G in
+// the box has |G| <= the zero-gradient tolerance the sample may be unshaded (c = m): hulled in.
+void ProfileIntegrator::shade_range(Box& b, const glm::dvec3& G0, const glm::dvec3& dG, const glm::dvec3& V,
+                                    double depth) const {
+    const Shader& sh = *ctx_.pipeline.shader();
+    const ShadingSpec& k = sh.spec();
+    const double eps = glm::length(dG), len = glm::length(G0), tol = sh.zero_gradient_tolerance();
+    const bool maybe_unshaded = !(len - eps > tol), maybe_shaded = len + eps > tol;
+    const double rho = len > 0.0 ? std::min(2.0, 2.0 * eps / len) : 2.0;
+    const glm::dvec3 N0 = len > 0.0 ? -G0 / len : glm::dvec3(0.0);
+    auto dot_range = [&](const glm::dvec3& X) {
+        const double d = glm::dot(N0, X);
+        return Iv{std::max(-1.0, d - rho), std::min(1.0, d + rho)};
+    };
+    auto clamp_dot = [&](Iv x) {
+        if (!k.two_sided) return Iv{std::max(x.lo, 0.0), std::max(x.hi, 0.0)};
+        if (x.lo <= 0.0 && x.hi >= 0.0) return Iv{0.0, std::max(-x.lo, x.hi)};
+        return Iv{std::min(std::fabs(x.lo), std::fabs(x.hi)), std::max(std::fabs(x.lo), std::fabs(x.hi))};
+    };
+    const Iv m[3] = {{b.lo[0], b.hi[0]}, {b.lo[1], b.hi[1]}, {b.lo[2], b.hi[2]}};
+    Iv c[3] = {};
+    const double cue = 1.0 / (k.kc + k.kl * depth);
+    for (const LightSpec& light : sh.lights()) {
+        const glm::dvec3 L = light.type == LightSpec::Type::Headlight ? V : light.direction;
+        const Iv nl = clamp_dot(dot_range(L));
+        Iv sp{0.0, 0.0};
+        if (k.ks != 0.0) {
+            Iv dot;
+            if (k.model == ShadingSpec::Model::Phong) {  // R.V = 2 (N.L)(N.V) - L.V, max(., 0)
+                const Iv p = product(dot_range(L), dot_range(V));
+                dot = {std::max(0.0, std::max(-1.0, 2.0 * p.lo - glm::dot(L, V))), std::max(0.0, std::min(1.0, 2.0 * p.hi - glm::dot(L, V)))};
+            } else {
+                dot = clamp_dot(dot_range(glm::normalize(L + V)));
+            }
+            sp = {k.ks * std::pow(dot.lo, k.n), k.ks * std::pow(dot.hi, k.n)};
+        }
+        for (int j = 0; j < 3; ++j) {
+            const Iv amb = product(Iv{k.ka, k.ka}, m[j]);
+            const Iv dif = product(product(Iv{k.kd * cue, k.kd * cue}, m[j]), nl);
+            const Iv spec{sp.lo * cue, sp.hi * cue};
+            c[j] = sum(c[j], product(Iv{light.color[j], light.color[j]}, sum(sum(amb, dif), spec)));
+        }
+    }
+    for (int j = 0; j < 3; ++j) {
+        Iv r = maybe_shaded ? c[j] : m[j];
+        if (maybe_unshaded) r = {std::min(r.lo, m[j].lo), std::max(r.hi, m[j].hi)};
+        if (p_.clamp_shaded) r = {std::clamp(r.lo, 0.0, 1.0), std::clamp(r.hi, 0.0, 1.0)};
+        b.lo[j] = r.lo;
+        b.hi[j] = r.hi;
+    }
+}
+
 double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& intervals, const glm::dvec4& rendered) const {
     const ProfileOptions& o = ctx_.render.profile_options;
     Iv F[4];  // the pixel's R, G, B, A over all units
@@ -460,12 +594,26 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
     };
     struct S {
         double t, d, vlo, vhi;
+        glm::dvec3 g{0.0}, dg{0.0};  // shaded composite: the exact gradient and the half-widths of its box
     };
     std::vector<S> samples;
+    const Shader* shader = ctx_.render.projection == Projection::Composite ? ctx_.pipeline.shader() : nullptr;
     for_each_sample(intervals, [&](double t, double d) {
-        const Fetch f = texture_fetch(ray.at(t));
-        if (std::isfinite(f.exact)) samples.push_back({t, d, f.exact - f.band, f.exact + f.band});
-        else samples.push_back({t, d, f.exact, f.exact});
+        const glm::dvec3 x = ray.at(t);
+        const Fetch f = texture_fetch(x);
+        S q{t, d, f.exact, f.exact};
+        if (std::isfinite(f.exact)) q.vlo = f.exact - f.band, q.vhi = f.exact + f.band;
+        if (shader) {  // gradient() with each fetch's exact value and band
+            for (int a = 0; a < 3; ++a) {
+                glm::dvec3 e(0.0);
+                e[a] = offset_[a];
+                const Fetch fp = texture_fetch(x + e), fm = p_.forward_gradient ? f : texture_fetch(x - e);
+                const double h = p_.forward_gradient ? offset_[a] : 2.0 * offset_[a];
+                q.g[a] = (fp.exact - fm.exact) / h;
+                q.dg[a] = (fp.band + fm.band) / h;
+            }
+        }
+        samples.push_back(q);
         return true;
     });
     switch (ctx_.render.projection) {
@@ -502,7 +650,8 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
                 bool certain = false;
                 for (const S& q : samples) {
                     if (!std::isfinite(q.vlo)) continue;
-                    const Box b = sample_range(q.vlo, q.vhi, q.d);
+                    Box b = sample_range(q.vlo, q.vhi, q.d);
+                    if (shader) shade_range(b, p_.normal_along_gradient ? -q.g : q.g, q.dg, -ray.direction, q.t);
                     const Iv a{b.lo[4], b.hi[4]};
                     const Iv Ta = product(T, a);
                     for (int c = 0; c < 3; ++c) C[c] = sum(C[c], product(Ta, Iv{b.lo[c], b.hi[c]}));

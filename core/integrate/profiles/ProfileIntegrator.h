@@ -18,6 +18,7 @@
 // in image space, called from the render step (PreparedScene::pixels).
 #pragma once
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -60,13 +61,14 @@ private:
     double value(const glm::dvec3& x) const;
     double seed_shell_value(const glm::dvec3& x) const;  // Profile::seed_shell_reads
     // A texture fetch under render.profile_options.texture_unit (TextureUnit.h): the value the unit
-    // returns, the exact trilinear value and the band |fetch - exact| <= band for any unit in the model.
+    // returns, the exact trilinear value and the band |fetch - exact| <= band for any unit of the family.
     struct Fetch {
         double value = 0.0, exact = 0.0, band = 0.0;
     };
     Fetch texture_fetch(const glm::dvec3& x) const;
-    bool shell_texels(const glm::dvec3& x, std::array<double, 8>& corners, glm::dvec3& w) const;
-    double table_weight(double w, double pos) const;  // a 1D table texel weight under the texture unit
+    bool shell_texels(const glm::dvec3& x, std::array<double, 8>& corners, glm::dvec3& w, glm::dvec3& coord) const;
+    double texel(std::int64_t i, std::int64_t j, std::int64_t k) const;              // as a value
+    std::uint16_t texel_code(std::int64_t i, std::int64_t j, std::int64_t k) const;  // seed 001's unorm16
     // The texture band (conventions section 9, "The texture unit"): intervals of every sample's value,
     // classification and the projection's accumulation over all units within the model.
     struct Box {
@@ -74,6 +76,8 @@ private:
     };
     Box lookup_range(double vlo, double vhi, double d) const;
     Box sample_range(double vlo, double vhi, double d) const;  // composite: cutoff, colour, K, filter
+    // The shaded colour box over gradients G0 +- dG (shaded composite).
+    void shade_range(Box& b, const glm::dvec3& G0, const glm::dvec3& dG, const glm::dvec3& view, double depth) const;
     double band(const Ray& ray, const std::vector<Interval>& intervals, const glm::dvec4& rendered) const;
     Lookup lookup(double v, double d) const;
     double alpha(double a, double d) const;
@@ -102,6 +106,9 @@ private:
     std::vector<double> table_alpha_;  // corrected for the step (composite)
     ProfileOptions::TextureUnit texture_unit_ = ProfileOptions::TextureUnit::Exact;
     bool band_ = false;
+    const Volume* texels_ = nullptr;             // the texture's texels (the volume)
+    std::array<std::int64_t, 3> texture_dims_{};  // its texels per axis
+    bool normalized_coordinates_ = true;         // GLSL's texture(): normalised; seed 001's tex3D: not
     const VolumeSampler* cartesian_ = nullptr;         // texture_unit / band on Cartesian grids
     const class TransferFunction* transfer_ = nullptr;  // band without a table: its knots
 };

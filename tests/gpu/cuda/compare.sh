@@ -5,7 +5,7 @@
 # For each scene under tests/gpu/cuda/scenes/: the program's image (OUT/NAME-cuda.exr), volref's with the
 # profile's texture band (OUT/NAME-profile.exr, render.profile_options.texture_band true: the error
 # channel bounds what any texture unit within the 1/256-weight model can do) and, for reference, with
-# the hardware model (OUT/NAME-hardware.exr); `volref compare --tolerance-from-error --tolerance T`
+# the H100 texture unit (OUT/NAME-h100.exr); `volref compare --tolerance-from-error --tolerance T`
 # must pass. Both volref renders read the data as the program does (texture_format "unorm16": v / 65535).
 # T (default 2e-3, VOLREF_CUDA_TOLERANCE) stands for what the band does not hold: float32 positions and
 # the seed's s -= step accumulation, float32 barycentric intersections with the same triangles, the
@@ -33,12 +33,12 @@ for scene in "$here"/scenes/*.json; do
     fi
     "$volref" render "$scene" -o "$out/$name-profile.exr" --set render.profile=cuda-curvilinear \
         --set render.profile_options.texture_format=unorm16 --set render.profile_options.texture_band=true > /dev/null || exit 2
-    "$volref" render "$scene" -o "$out/$name-hardware.exr" --set render.profile=cuda-curvilinear \
-        --set render.profile_options.texture_format=unorm16 --set render.profile_options.texture_unit=hardware > /dev/null || exit 2
+    "$volref" render "$scene" -o "$out/$name-h100.exr" --set render.profile=cuda-curvilinear \
+        --set render.profile_options.texture_format=unorm16 --set render.profile_options.texture_unit=h100 > /dev/null || exit 2
     "$volref" compare "$out/$name-cuda.exr" "$out/$name-profile.exr" --tolerance-from-error --tolerance "$tol" \
         --heatmap "$out/$name-diff.png" > "$out/$name-compare.txt" 2>&1
     rc=$?
-    "$volref" compare "$out/$name-cuda.exr" "$out/$name-hardware.exr" > "$out/$name-compare-hardware.txt" 2>&1
+    "$volref" compare "$out/$name-cuda.exr" "$out/$name-h100.exr" > "$out/$name-compare-h100.txt" 2>&1
     case $rc in
         0) result=pass ;;
         1) result=DIFFERS; [ $status -eq 0 ] && status=1 ;;
@@ -46,5 +46,5 @@ for scene in "$here"/scenes/*.json; do
     esac
     printf '%-22s %-8s %s\n' "$name" "$result" "$(grep -i 'max' "$out/$name-compare.txt" | head -1)"
 done
-echo "compare.sh: details in $out/*-compare.txt (against the hardware model: *-compare-hardware.txt)"
+echo "compare.sh: details in $out/*-compare.txt (against the H100 texture unit: *-compare-h100.txt)"
 exit $status

@@ -1,8 +1,10 @@
 // volref compare A B: metrics of the difference of two images, pixels over a tolerance, a heat map and
 // (--fit) the convention parameters that best explain the difference (docs/compare.md).
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <vector>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -116,13 +118,26 @@ int run_compare(const CompareArgs& args) {
     std::optional<glm::dvec4> background;
     if (!args.background.empty()) background = parse_background(args.background);
 
-    const ComparedImage a = read_compared_image(args.a, background);
-    const ComparedImage b = read_compared_image(args.b, background);
+    ComparedImage a = read_compared_image(args.a, background);
+    ComparedImage b = read_compared_image(args.b, background);
     if (a.rgba.width != b.rgba.width || a.rgba.height != b.rgba.height)
         throw Error(args.a.string() + " is " + std::to_string(a.rgba.width) + "x" + std::to_string(a.rgba.height) +
                     " but " + args.b.string() + " is " + std::to_string(b.rgba.width) + "x" +
                     std::to_string(b.rgba.height) + ": compare needs images of the same size");
 
+    // issue 28: pixels where a mirrored program does not finish (either image's `fault` channel) are
+    // reported apart and left out of the metrics and the tolerance test (0 in both).
+    std::vector<std::array<int, 2>> faults;
+    if (!a.fault.empty() || !b.fault.empty())
+        for (int y = 0; y < a.rgba.height; ++y)
+            for (int x = 0; x < a.rgba.width; ++x) {
+                const std::size_t p = std::size_t(y) * std::size_t(a.rgba.width) + std::size_t(x);
+                if (!((!a.fault.empty() && a.fault[p]) || (!b.fault.empty() && b.fault[p]))) continue;
+                faults.push_back({x, y});
+                for (std::size_t c = 0; c < 4; ++c) a.rgba.at(x, y, c) = b.rgba.at(x, y, c) = 0.0;
+                if (!a.error.empty()) a.error[p] = 0.0;
+                if (!b.error.empty()) b.error[p] = 0.0;
+            }
     const ToleranceSpec tspec{args.tolerance, args.tolerance_from_error};
     const std::vector<double> tolerance = tolerance_map(a, b, tspec);
     const ImageMetrics m = measure_difference(a.rgba, b.rgba, tolerance);
@@ -152,6 +167,8 @@ int run_compare(const CompareArgs& args) {
         j["pixels"] = m.pixels;
         j["pixels_over"] = m.overall.over;
         j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};
+        j["fault"] = nlohmann::json::array();
+        for (const auto& f : faults) j["fault"].push_back({f[0], f[1]});
         j["fraction_over"] = m.fraction_over();
         j["within_tolerance"] = within;
         if (!args.heatmap.empty()) j["heatmap"] = {{"path", args.heatmap.string()}, {"scale", scale}};
@@ -180,6 +197,9 @@ int run_compare(const CompareArgs& args) {
         print_row(m.overall);
         std::printf("pixels over tolerance: %ld of %ld (%s)\n", m.overall.over, m.pixels,
                     number(m.fraction_over()).c_str());
+        if (!faults.empty())
+            std::printf("%zu pixels where the mirrored program does not finish (fault channel): left out of the metrics "
+                        "and the tolerance test\n", faults.size());
         if (m.non_finite_a > 0 || m.non_finite_b > 0)
             std::printf("non-finite pixels: %ld in A, %ld in B, %ld disagreeing (those are over the tolerance); all left "
                         "out of the metrics and the fit\n", m.non_finite_a, m.non_finite_b, m.non_finite_disagree);

@@ -35,6 +35,15 @@ int run_render(const RenderArgs& args) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_image(image, args.output, scene.image.background);
     std::fprintf(stderr, "volref: rendered %dx%d in %.3f s\n", image.width, image.height, seconds);
+    // issue 28: the rays the mirrored program does not finish (NaN pixels, "fault" channel 1)
+    for (std::size_t c = 0; c < image.channels.size(); ++c)
+        if (image.channels[c] == "fault") {
+            std::size_t n = 0;
+            for (int y = 0; y < image.height; ++y)
+                for (int x = 0; x < image.width; ++x) n += image.at(x, y, c) != 0.0;
+            if (n > 0)
+                std::fprintf(stderr, "volref: %zu pixels where the mirrored program does not finish (its loop cannot end: NaN, fault channel 1; volref trace says why)\n", n);
+        }
     if (args.timing) {
         // The median frame (the mean of the middle two for an even count); samples per second over it.
         std::vector<double> sorted = stats.frames_s;

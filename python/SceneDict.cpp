@@ -251,6 +251,8 @@ json render_json(const RenderSpec& r) {
         if (r.profile_options.texture_band) j["profile_options"]["texture_band"] = true;
         if (r.profile_options.data_unorm16) j["profile_options"]["texture_format"] = "unorm16";
     }
+    if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.kernel == ProfileOptions::Kernel::Double)
+        j["profile_options"]["kernel"] = "double";  // issue 28
     if (r.profile == ProfileId::VtkJs)  // issue 22
         j["profile_options"] = {{"jitter", r.profile_options.jitter}, {"fixed_normal", r.profile_options.fixed_normal},
                                 {"flip_normal", r.profile_options.flip_normal},

@@ -81,6 +81,7 @@ ComparedImage read_compared_image(const std::filesystem::path& path, const std::
     }
     const int a = find_channel(spec, "A");
     const int e = find_channel(spec, "error");
+    const int fault = find_channel(spec, "fault");
 
     ComparedImage out;
     out.path = path;
@@ -89,6 +90,7 @@ ComparedImage read_compared_image(const std::filesystem::path& path, const std::
     out.rgba = Image(w, h, {"R", "G", "B", "A"});
     if (out.unassociated && out.bits > 0) out.stored.resize(std::size_t(w) * std::size_t(h) * 4);
     if (e >= 0) out.error.resize(std::size_t(w) * std::size_t(h));
+    if (fault >= 0) out.fault.resize(std::size_t(w) * std::size_t(h));
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
@@ -106,6 +108,7 @@ ComparedImage read_compared_image(const std::filesystem::path& path, const std::
             }
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
             if (e >= 0) out.error[p] = px[e];
+            if (fault >= 0) out.fault[p] = px[fault] != 0.0;
         }
     return out;
 }

@@ -2,7 +2,7 @@
 // `volref compare` compares in: linear premultiplied (associated) RGBA in double.
 //
 //   - Colour channels are found by name: R, G, B (or a single Y, used for all three); A if present,
-//     else alpha = 1 (opaque). Any other channel is ignored, except `error` (kept, see below).
+//     else alpha = 1 (opaque). Any other channel is ignored, except `error` and `fault` (kept, see below).
 //   - Unassociated alpha (PNG, TIFF as volref writes them: colour divided by alpha) is converted to
 //     premultiplied, C = u a, in double, from the stored values (OIIO is asked not to premultiply).
 //     Associated inputs (EXR) are taken as they are.
@@ -27,6 +27,8 @@ struct ComparedImage {
     std::filesystem::path path;
     Image rgba;                      // channels R, G, B, A: premultiplied, linear
     std::vector<double> error;       // the file's `error` channel (width * height), empty if none
+    std::vector<char> fault;         // the file's `fault` channel != 0 (width * height: the rays a mirrored
+                                     // program does not finish, issue 28), empty if none
     int bits = 0;                    // bits per integer sample (8 for PNG), 0 for floating point
     bool unassociated = false;       // the file stored colour divided by alpha
     std::vector<double> stored;      // unassociated integer inputs: the stored (unassociated) R, G, B, A

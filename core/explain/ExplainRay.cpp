@@ -83,6 +83,7 @@ Explanation ray(const PreparedScene& scene, int x, int y) {
 
     Section& px = e.section("pixel");
     add(px, "RGBA", {t.pixel.rgba.r, t.pixel.rgba.g, t.pixel.rgba.b, t.pixel.rgba.a}, "premultiplied; = the last sample's acc");
+    if (t.pixel.fault) px.notes.push_back("fault: " + t.fault);
     return e;
 }
 

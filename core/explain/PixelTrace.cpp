@@ -114,6 +114,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.skipping = v.macrocells != nullptr && t.projection == Projection::Composite;  // the traced mip / minip loop does not skip
     Collector collector(scene, t.samples);
     t.pixel = scene.trace_pixel(x, y, collector);
+    if (t.pixel.fault) t.fault = v.integrator->fault_reason(v.volume_ray(t.ray));
     return t;
 }
 
@@ -291,6 +292,7 @@ std::string trace_json(const PixelTrace& t, int indent) {
     }
     j["samples"] = std::move(samples);
     j["pixel_value"] = jvec(t.pixel.rgba);
+    if (t.pixel.fault) j["fault"] = t.fault;
     return j.dump(indent);
 }
 

@@ -52,6 +52,7 @@ struct PixelTrace {
     bool skipping = false;       // empty-space skipping was on (skipped segments are not listed)
     std::vector<TracedSample> samples;
     PixelValue pixel;            // what the integrator returned
+    std::string fault;           // issue 28: why the mirrored program does not finish this ray (empty: it does)
 };
 
 // Throws volref::Error: a pixel outside the image ("--pixel: ..."), first-hit ("trace: first-hit is

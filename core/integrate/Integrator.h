@@ -4,6 +4,7 @@
 #pragma once
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -26,6 +27,8 @@ struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)
     double error = 0.0;  // the estimated bound on |error| over R, G, B, A (integrators that write "error")
+    // The mirrored program cannot finish this ray (its loop cannot end: issue 28); rgba is NaN.
+    bool fault = false;
 };
 
 // What every integrator reads: the sample pipeline, the step in world units, the render settings.
@@ -69,6 +72,13 @@ public:
     virtual bool writes_depth() const { return false; }
     // True when PixelValue::error is this integrator's error estimate (the "error" channel).
     virtual bool writes_error() const { return false; }
+    // True when PixelValue::fault can be set (the "fault" channel: a mirrored program's loop that cannot end).
+    virtual bool writes_fault() const { return false; }
+    // Why the mirrored program does not finish `ray` (empty when it does), for trace and explain.
+    virtual std::string fault_reason(const Ray& ray) const {
+        (void)ray;
+        return {};
+    }
 
 protected:
     const IntegrationContext& ctx_;

@@ -41,6 +41,7 @@ struct PreparedScene {
     const vtkcpu::VtkFixedPointRenderer* image_space() const { return volumes.front()->image_space.get(); }
     bool writes_depth() const { return !image_space() && integrator().writes_depth(); }
     bool writes_error() const { return !image_space() && integrator().writes_error(); }
+    bool writes_fault() const { return !image_space() && volumes.size() == 1 && integrator().writes_fault(); }
 
     // Scratch space of one thread for integrate(): each volume's local rays and intervals.
     struct Scratch {

@@ -291,7 +291,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     } else if (p.renderer == Profile::Renderer::VtkJs) {  // issue 22
         integrator = std::make_unique<VtkJsIntegrator>(*context, volume, vs, scene);
     } else {
-        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume);
+        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds);
     }
     // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed
     // volume whose gradient is used.

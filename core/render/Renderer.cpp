@@ -185,6 +185,8 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     if (prepared.writes_depth()) channels.push_back("Z");
     const std::size_t error_channel = channels.size();
     if (prepared.writes_error()) channels.push_back("error");
+    const std::size_t fault_channel = channels.size();
+    if (prepared.writes_fault()) channels.push_back("fault");  // issue 28: 1 where the mirrored program does not finish
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
@@ -219,6 +221,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
                             for (int c = 0; c < 4; ++c) image.at(px[i], py[i], std::size_t(c)) = values[i].rgba[c];
                             if (prepared.writes_depth()) image.at(px[i], py[i], 4) = values[i].depth;
                             if (prepared.writes_error()) image.at(px[i], py[i], error_channel) = values[i].error;
+                            if (prepared.writes_fault()) image.at(px[i], py[i], fault_channel) = values[i].fault ? 1.0 : 0.0;
                         }
                     }
                 progress.tile_done();

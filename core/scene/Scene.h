@@ -189,6 +189,12 @@ struct ProfileOptions {
     // the fetch's position (a Monte Carlo of the units the band covers).
     enum class TextureUnit { Exact, H100, Admissible };
     TextureUnit texture_unit = TextureUnit::Exact;
+    // cuda-curvilinear on shells (issue 28; Seed001Kernel.h): "float32" (the default) runs seed 001's kernel
+    // as the program does, in float32 on the host's bounding triangles with its unsigned-short data (composite
+    // and x-ray; other projections keep the double-precision profile); "double": the earlier profile, in double
+    // on the exact shell.
+    enum class Kernel { Float32, Double };
+    Kernel kernel = Kernel::Float32;
     bool texture_band = false;
     unsigned long long texture_seed = 0;  // Admissible
     // cuda-curvilinear on shells: the data texture as seed 001 holds it, the values normalised over the

@@ -86,11 +86,11 @@ double seed_cylinder_value(double r) { return 4.0 * r > 3.0 ? 0.0 : std::max(4.0
 // X-ray: brightness times max s = 2.5 / 3 (volref's own shell sampler reads r = 1 as v = 3: s = 1).
 TEST(CudaCurvilinearProfile, CylinderAcrossItsHeightXray) {
     const std::string render = R"({"projection": "xray", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear",
-                                   "profile_options": {"brightness": 0.8}})";
+                                   "profile_options": {"brightness": 0.8, "kernel": "double"}})";
     EXPECT_NEAR(render_json(shell_scene(kCylinder, {4, 8, 2}, 0, kAcrossTheHeight, render)).r, 0.8 * 2.5 / 3.0, 1e-12);
     // Iso threshold 0.9 (in s): no sample reaches it: maxVal stays 0.
     const std::string iso = R"({"projection": "xray", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear",
-                                "profile_options": {"iso_threshold": 0.9}})";
+                                "profile_options": {"iso_threshold": 0.9, "kernel": "double"}})";
     EXPECT_EQ(render_json(shell_scene(kCylinder, {4, 8, 2}, 0, kAcrossTheHeight, iso)).r, 0.0);
 }
 
@@ -98,7 +98,8 @@ TEST(CudaCurvilinearProfile, CylinderAcrossItsHeightXray) {
 // 0.5 + 0.5 j/8, read at pos = clamp(9 s - 0.5, 0, 8); sum = lerp(sum, col, col.a) from z = -1 to z = 1.
 // The outVal samples (s = 0) read entry 0: red, a = 0.5 (iso threshold 0 keeps them).
 TEST(CudaCurvilinearProfile, CylinderAcrossItsHeightComposite) {
-    const std::string render = R"({"projection": "composite", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear"})";
+    const std::string render = R"({"projection": "composite", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear",
+                                   "profile_options": {"kernel": "double"}})";
     const glm::dvec4 p = render_json(shell_scene(kCylinder, {4, 8, 2}, 0, kAcrossTheHeight, render));
     glm::dvec4 sum(0.0);
     for (int k = 0; k <= 8; ++k) {
@@ -122,7 +123,8 @@ TEST(CudaCurvilinearProfile, CylinderAcrossItsHeightComposite) {
 TEST(CudaCurvilinearProfile, SphericalSectorXray) {
     const std::string sector = R"({"type": "spherical", "center": [0, 0, 0], "radius": [0, 1], "longitude": [0, 90], "latitude": [-45, 45]})";
     const std::string camera = R"({"type": "orthographic", "eye": [-5, 0, -0.3], "target": [0, 0, -0.3], "up": [0, 1, 0], "height": 0.01})";
-    const std::string render = R"({"projection": "xray", "step": 0.1, "step_units": "world", "profile": "cuda-curvilinear"})";
+    const std::string render = R"({"projection": "xray", "step": 0.1, "step_units": "world", "profile": "cuda-curvilinear",
+                                   "profile_options": {"kernel": "double"}})";
     const double x1 = std::sqrt(1.0 - 0.09);
     double best = 0.0;
     for (int k = 0; k <= 9; ++k) {

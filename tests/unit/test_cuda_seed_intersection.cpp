@@ -33,7 +33,8 @@ std::string inside_scene(const std::string& bounds_extra, const std::string& pro
                "transfer": {"color": [[0, 1, 0, 0], [3, 0, 0, 1]], "opacity": [[0, 0.5], [3, 1]]}},
               "camera": {"type": "orthographic", "eye": [0, 0.5, 0.5], "target": [0, 0.5, -1], "up": [0, 1, 0], "height": 0.01},
               "image": {"width": 1, "height": 1},
-              "render": {"projection": ")" + projection + R"(", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear"}})";
+              "render": {"projection": ")" + projection + R"(", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear",
+                         "profile_options": {"kernel": "double"}}})";
 }
 
 glm::dvec4 render_json(const std::string& json) { return rgba(render_scene(parse_scene(json, ".", "test"), {1, false}), 0, 0); }
@@ -84,7 +85,7 @@ TEST(CudaSeedIntersection, DataReadAsUnorm16ByHand) {
                   "camera": {"type": "orthographic", "eye": [0, 0.5, 5], "target": [0, 0.5, 0], "up": [0, 1, 0], "height": 0.01},
                   "image": {"width": 1, "height": 1},
                   "render": {"projection": "xray", "step": 0.25, "step_units": "world", "profile": "cuda-curvilinear",
-                             "profile_options": {"brightness": 0.8, "texture_format": ")" + format + R"("}}})";
+                             "profile_options": {"brightness": 0.8, "kernel": "double", "texture_format": ")" + format + R"("}}})";
     };
     EXPECT_NEAR(render_json(scene("float")).r, 0.8 * (2.0 / 7.0 + 1.0) / 2.0, 1e-12);
     const double q = 0.8 * (18724.0 / 65535.0 + 1.0) / 2.0;

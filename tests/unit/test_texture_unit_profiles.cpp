@@ -180,7 +180,7 @@ Scene random_scene(std::mt19937_64& g, ProfileId profile, Projection projection,
     if (profile == ProfileId::CudaCurvilinear)
         options = R"(, "profile_options": {"density": )" + number_list({0.5 + 1.5 * U(g)}) + R"(, "transfer_scale": )" +
                   number_list({0.7 + 0.6 * U(g)}) + R"(, "iso_threshold": )" + number_list({0.4 * U(g)}) +
-                  R"(, "brightness": )" + number_list({0.5 + U(g)}) + "}";
+                  R"(, "brightness": )" + number_list({0.5 + U(g)}) + R"(, "kernel": "double"})";  // the double profile's band
     const std::string json = R"({"volume": {"source": {"field": "cells", "dims": [)" + std::to_string(nx) + ", " +
                              std::to_string(ny) + ", " + std::to_string(nz) + R"(], "values": [)" + number_list(values) + "]}" +
                              (shell ? R"(, "bounds": )" + bounds : std::string()) +

@@ -14,6 +14,7 @@
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
+#include "core/integrate/profiles/Seed001Kernel.h"
 #include "core/integrate/profiles/TextureUnit.h"
 #include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"
@@ -39,7 +40,8 @@ void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, con
         throw Error(where + "needs a classification by value alone (no gradient opacity or Levoy classification)");
 }
 
-ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume)
+ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                                     const BoundsSpec* bounds)
     : OneLoopIntegrator(ctx), p_(profile) {
     check_profile_applies(p_, ctx.pipeline, ctx.render);
     if (p_.renderer != Profile::Renderer::RayCaster)
@@ -86,6 +88,14 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
             if (cartesian ? volume.spacing[a] < volume.spacing[axis] : volume.dims[a] > volume.dims[axis]) axis = a;
         const double n = double(volume.dims[std::size_t(axis)]);
         if (n > 1.0) step_ = ctx.step * (n - 1.0) / n;
+    }
+    // issue 28: seed 001's kernel in float32 (Seed001Kernel.h) for what the seed renders (composite, x-ray)
+    if (p_.id == ProfileId::CudaCurvilinear && shell_ && bounds && po.kernel == ProfileOptions::Kernel::Float32 &&
+        (ctx.render.projection == Projection::Composite || ctx.render.projection == Projection::Xray)) {
+        if (texture_unit_ == ProfileOptions::TextureUnit::Admissible)
+            throw Error("render.profile_options.texture_unit: the float32 kernel reads through the exact or the h100 unit");
+        kernel_ = std::make_unique<Seed001Kernel>(seed001_frame(volume, *bounds, ctx.pipeline.classifier(), ctx.render, step_),
+                                                  texture_unit_ == ProfileOptions::TextureUnit::H100, band_);
     }
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
                                                : p_.gradient_offset * volume.spacing;
@@ -356,8 +366,42 @@ void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, doub
 
 }  // namespace
 
+// Seed 001's kernel (issue 28): the pixel, its band and fault; traced: each sample the kernel takes, at
+// t = s (the kernel's distance along its float ray from the origin), its value as the profile's value.
+template <class Rec>
+PixelValue ProfileIntegrator::seed_kernel(const Ray& ray, Rec& rec) const {
+    std::vector<Seed001Kernel::Sample> samples;
+    const Seed001Pixel px = kernel_->pixel(ray, Rec::kOn ? &samples : nullptr);
+    PixelValue out;
+    out.rgba = px.rgba;
+    out.error = px.error;
+    out.fault = px.fault;
+    if constexpr (Rec::kOn) {
+        const glm::dvec3 c = kernel_->frame().center;
+        const double h = double(kernel_->frame().step);
+        for (const Seed001Kernel::Sample& s : samples) {
+            SampleRecord r{};
+            const glm::dvec3 x = c + glm::dvec3(s.point[0], s.point[1], s.point[2]);
+            begin_record(rec, r, x, double(s.s), h, lo_ + width_ * double(s.sample));
+            r.sample.classified = s.used;
+            r.composited = ctx_.render.projection == Projection::Composite;
+            r.running = kernel_->frame().xray ? double(s.sum[0]) : 0.0;
+            r.accumulated = glm::dvec4(s.sum[0], s.sum[1], s.sum[2], s.sum[3]);
+            rec.recorder.record(r);
+        }
+    }
+    return out;
+}
+
+std::string ProfileIntegrator::fault_reason(const Ray& ray) const {
+    if (!kernel_) return {};
+    const Seed001Pixel px = kernel_->pixel(ray);
+    return px.fault ? px.why.text() : std::string();
+}
+
 template <class Rec>
 PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    if (kernel_) return seed_kernel(ray, rec);
     PixelValue out;
     switch (ctx_.render.projection) {
         case Projection::Composite: out = composite(ray, intervals, rec); break;

@@ -32,6 +32,8 @@
 namespace volref {
 
 class ShellGrid;
+class Seed001Kernel;
+struct BoundsSpec;
 
 // What every mirror profile needs of the scene (fixed step, front-to-back order, its own termination,
 // a grid it reads, post-classification by value alone); throws volref::Error naming render.profile.
@@ -43,10 +45,15 @@ void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, con
 class ProfileIntegrator final : public OneLoopIntegrator<ProfileIntegrator> {
 public:
     // Throws volref::Error naming render.profile for what the profile cannot render.
-    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume);
+    // `bounds`: the volume's bounds (seed 001's kernel builds its triangles from them; may be null otherwise).
+    ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
+                      const BoundsSpec* bounds = nullptr);
     ~ProfileIntegrator() override;
     // render.profile_options.texture_band (issue 17): PixelValue::error is the texture band (band()).
     bool writes_error() const override { return band_; }
+    // cuda-curvilinear's float32 kernel (issue 28): the rays seed 001's loop cannot finish.
+    bool writes_fault() const override { return kernel_ != nullptr; }
+    std::string fault_reason(const Ray& ray) const override;
 
 private:
     friend class OneLoopIntegrator<ProfileIntegrator>;
@@ -111,6 +118,9 @@ private:
     bool normalized_coordinates_ = true;         // GLSL's texture(): normalised; seed 001's tex3D: not
     const VolumeSampler* cartesian_ = nullptr;         // texture_unit / band on Cartesian grids
     const class TransferFunction* transfer_ = nullptr;  // band without a table: its knots
+    std::unique_ptr<Seed001Kernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell (issue 28)
+    template <class Rec>
+    PixelValue seed_kernel(const Ray& ray, Rec& rec) const;
 };
 
 }  // namespace volref

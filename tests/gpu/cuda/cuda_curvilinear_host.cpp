@@ -13,6 +13,9 @@
 #include <vector>
 
 #include "core/film/ImageWriter.h"
+#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/render/PreparedVolume.h"
+#include "transfer/Classifier.h"
 #include "geometry/ShellCoordinates.h"
 #include "geometry/ShellTessellation.h"
 #include "seed001.h"
@@ -47,55 +50,27 @@ int run(int argc, char** argv) {
     if (cam.type != CameraSpec::Type::Perspective && cam.type != CameraSpec::Type::Orthographic)
         fail(2, "camera: perspective or orthographic");
 
-    Seed001Frame f;
-    glm::dvec3 center(0.0);
-    TriangleMesh mesh;
-    std::array<glm::dvec3, 2> box;
-    const int segments = vs.bounds.tessellate > 0 ? vs.bounds.tessellate : 64;
-    const double rad = std::numbers::pi / 180.0;
-    if (vs.bounds.type == BoundsSpec::Type::Cylindrical) {
-        const CylindricalShell& c = vs.bounds.cylinder;
-        if (c.r0 != 0.0 || c.a0 != 0.0 || c.h0 != 0.0) fail(2, "volume.bounds: the seed's cylinder starts at radius, angle and height 0");
-        f.geomType = 0;
-        f.geomSize[0] = float(c.r1), f.geomSize[1] = float(c.a1 * rad), f.geomSize[2] = float(c.h1);
-        center = c.center;
-        mesh = tessellate(c, segments);
-        box = bounding_box(c);
-    } else if (vs.bounds.type == BoundsSpec::Type::Spherical) {
-        const SphericalShell& s = vs.bounds.sphere;
-        if (s.r0 != 0.0 || s.lon0 != 0.0 || s.lat0 != -s.lat1 || s.axes != std::array<int, 3>{0, 1, 2})
-            fail(2, "volume.bounds: the seed's sphere has radius and longitude from 0, latitude [-F, F], the default axes");
-        f.geomType = 1;
-        f.geomSize[0] = float(s.r1), f.geomSize[1] = float(s.lon1 * rad), f.geomSize[2] = float(s.lat1 * rad);
-        center = s.center;
-        mesh = tessellate(s, segments);
-        box = bounding_box(s);
-    } else {
-        fail(2, "volume.bounds: a cylindrical or spherical shell");
-    }
-
-    // The data: unsigned short over the data range (the seed's readVtk normalises to [0, 65535]).
-    const Volume vol = load_volume(vs);
-    const auto [vmin, vmax] = vol.value_range();
-    const std::size_t n = std::size_t(vol.dims[0] * vol.dims[1] * vol.dims[2]);
-    f.data.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double s = vmax > vmin ? (double(vol.values[i]) - vmin) / (vmax - vmin) : 0.0;
-        f.data[i] = static_cast<unsigned short>(std::lrint(std::clamp(s, 0.0, 1.0) * 65535.0));
-    }
-    for (int a = 0; a < 3; ++a) f.dims[a] = int(vol.dims[std::size_t(a)]);
-    // The 9-entry table: cuda-curvilinear's entries, colour and opacity at min + j (max - min) / 8.
-    const TransferFunction tf(vs.transfer, vol);
-    for (int j = 0; j < 9; ++j) {
-        const Classified k = tf.classify(vmin + double(j) * (vmax - vmin) / 8.0, 0.0);
-        f.table.insert(f.table.end(), {float(k.color.r), float(k.color.g), float(k.color.b), float(k.opacity)});
-    }
-    // The bounding triangles (volref's tessellation, outward), in the seed's frame (world - centre).
-    for (const auto& t : mesh.triangles)
-        for (std::uint32_t k : t) {
-            const glm::dvec3 v = mesh.vertices[k] - center;
-            f.triangles.insert(f.triangles.end(), {float(v.x), float(v.y), float(v.z), 0.0f});
-        }
+    // The frame is volref's own (core/integrate/profiles/Seed001Kernel.h, seed001_frame), so that this
+    // program and the cuda-curvilinear profile read the same bounding triangles (volref's tessellation,
+    // bounds.tessellate segments per turn, 64 when absent, minus the centre, in float), the same unsigned
+    // shorts and the same 9-entry table. Its data are the volume as volref renders it (build_volume_model):
+    // a procedural field on a shell is evaluated at the shell's samples. Until issue 28 this host used
+    // load_volume, which evaluates a field at origin + index x spacing: the fixtures recorded on the H100
+    // (tests/gpu/h100/seed001) with a Gaussian or linear field hold that index-space field (their scenes
+    // name it as data files).
+    VolumeModel model;
+    build_volume_model(vs, model);
+    const std::unique_ptr<Classifier> classifier = make_classifier(vs, model.volume);
+    const volref::Seed001Frame k = seed001_frame(model.volume, vs.bounds, *classifier, r, r.step);
+    ::Seed001Frame f;
+    f.geomType = k.geom_type;
+    for (int a = 0; a < 3; ++a) f.geomSize[a] = k.geom_size[std::size_t(a)], f.dims[a] = int(k.dims[std::size_t(a)]);
+    f.data = k.data;
+    for (const auto& e : k.table) f.table.insert(f.table.end(), e.begin(), e.end());
+    for (const auto& v : k.vertices) f.triangles.insert(f.triangles.end(), {v[0], v[1], v[2], 0.0f});
+    const glm::dvec3 center = k.center;
+    const std::array<glm::dvec3, 2> box = vs.bounds.type == BoundsSpec::Type::Cylindrical ? bounding_box(vs.bounds.cylinder)
+                                                                                          : bounding_box(vs.bounds.sphere);
     // The rays: volref's camera, in double, then float.
     f.width = scene.image.width;
     f.height = scene.image.height;
@@ -107,14 +82,14 @@ int run(int argc, char** argv) {
             f.origins.insert(f.origins.end(), {float(o.x), float(o.y), float(o.z)});
             f.directions.insert(f.directions.end(), {float(d.x), float(d.y), float(d.z)});
         }
-    f.step = float(r.step);
+    f.step = k.step;
     f.triCubic = tricubic ? 1 : 0;
-    f.density = float(r.profile_options.density);
-    f.regBrightness = 1.0f;
-    f.xrayBrightness = float(r.profile_options.brightness);
-    f.isoValue = float(r.profile_options.iso_threshold);
-    f.transferScale = float(r.profile_options.transfer_scale);
-    f.compoType = r.projection == Projection::Xray ? 1 : 0;
+    f.density = k.density;
+    f.regBrightness = k.reg_brightness;
+    f.xrayBrightness = k.xray_brightness;
+    f.isoValue = k.iso;
+    f.transferScale = k.transfer_scale;
+    f.compoType = k.xray ? 1 : 0;
 
     std::vector<float> px;
     if (const std::string e = seed001_render(f, px); !e.empty()) fail(3, e);

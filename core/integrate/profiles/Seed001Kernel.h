@@ -1,0 +1,128 @@
+// Seed001Kernel: seed 001's CUDA kernel (tests/gpu/cuda/cuda_curvilinear.cu) as it runs on an NVIDIA GPU,
+// in float32 on the CPU (issue 28): the bounding triangles the host builds (volref's tessellation, minus the
+// centre, in float), rayIntersectTriangles with baryTriangleCoefs and its fallback as written, the march
+// `for (float s = outAbs; s >= inAbs; s -= step)` at O + s vect, cartToCyl / cartToSpher, the data texture
+// (unsigned shorts, read as normalised float through the texture unit: TextureUnit.h, exact or h100), the
+// 9-entry float4 table, sum = lerp(sum, col, col.w density) or the x-ray maximum. nvcc contracts a * b + c
+// into fma (its default -fmad=true): the emulation uses fmaf where NVVM forms one (conventions section 9,
+// "cuda-curvilinear and seed 001"); atan2f and rsqrtf are CUDA's own approximations (2 ulp), here the
+// correctly rounded values. What that may change is the error channel (band()).
+//
+// A ray whose loop cannot end (`s -= step` leaves s unchanged in float32: s >= 2^24 step about) is a
+// fault: the real program hangs there. The pixel is NaN with fault = true and the reason recorded.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "core/camera/Ray.h"
+
+namespace volref {
+
+struct BoundsSpec;
+struct RenderSpec;
+struct Volume;
+class Classifier;
+
+// What seed 001's host hands its kernel (cuda_curvilinear_host.cpp builds the same frame).
+struct Seed001Frame {
+    int geom_type = 0;                     // 0 cylinder (R, angle, H), 1 sphere (R, longitude, latitude)
+    std::array<float, 3> geom_size{};      // radians for the angles
+    glm::dvec3 center{0.0};
+    std::vector<std::array<float, 3>> vertices;  // 3 per triangle, world - centre, outward
+    std::array<std::int64_t, 3> dims{};
+    std::vector<std::uint16_t> data;       // round(s 65535), s over the data range, x fastest
+    std::array<std::array<float, 4>, 9> table{};  // colour and opacity at min + j (max - min) / 8
+    float step = 0.01f, density = 1.0f, reg_brightness = 1.0f, xray_brightness = 1.0f, iso = 0.0f,
+          transfer_scale = 1.0f;
+    bool xray = false;
+};
+
+// The host's frame for a scene: `volume` on the shell of `bounds` (tessellate segments per turn, 64
+// when absent), the table from `classifier`, the render's profile options, `step` (world units).
+Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const Classifier& classifier,
+                           const RenderSpec& render, double step);
+
+// Why a ray faulted, for trace and explain.
+struct Seed001Fault {
+    int triangle = -1;    // the triangle whose s set outAbs
+    float d = 0.0f;       // its dot(n, vect)
+    float out_abs = 0.0f, in_abs = 0.0f;
+    float ulp = 0.0f;     // the float32 spacing at outAbs
+    float step = 0.0f;
+    std::string text() const;
+};
+
+struct Seed001Pixel {
+    glm::dvec4 rgba{0.0};   // NaN when fault
+    double error = 0.0;     // the band: how far the program's float32 can be (band() only)
+    bool fault = false;
+    Seed001Fault why;
+    bool hit = false;       // rayIntersectTriangles returned true and outAbs >= 0
+    float in_abs = 0.0f, out_abs = 0.0f;
+    std::int64_t samples = 0;
+};
+
+class Seed001Kernel {
+public:
+    // h100: the data and table fetches through TextureUnit.h's H100 rule (else exact weights, rounded
+    // to float32); band: also compute the error channel.
+    Seed001Kernel(Seed001Frame frame, bool h100, bool band);
+    // One pixel: the host's float ray (origin - centre, normalize(direction)) through the kernel.
+    Seed001Pixel pixel(const Ray& ray) const;
+    // Every sample of one ray as the kernel takes it, for trace: (s, the point in the seed's frame, the
+    // sample, used (>= isoValue), the running sum after it).
+    struct Sample {
+        float s;
+        std::array<float, 3> point;
+        float sample;
+        bool used;
+        std::array<float, 4> sum;
+    };
+    Seed001Pixel pixel(const Ray& ray, std::vector<Sample>* samples) const;
+    const Seed001Frame& frame() const { return f_; }
+    // The float32 value at a point (interpolateCyl / interpolateSpher with outVal 0).
+    float sample_at(const std::array<float, 3>& point) const;
+
+    struct Span {
+        bool ok = false;
+        float in_abs = 0.0f, out_abs = 0.0f;
+        int in_triangle = -1, out_triangle = -1;
+        double eps = 0.0;        // the uncertainty of the positions (world units)
+    };
+    struct Hit {                 // one triangle's test, for the band's alternatives
+        int triangle;
+        float s, d;
+        bool entry;              // d < 0
+        bool accepted;
+        bool ambiguous;          // acceptance (or the sign of d) within rounding
+        double eps;              // the uncertainty of s
+    };
+    // rayIntersectTriangles; `hits` (optional) receives every triangle with d != 0 the ray's line meets
+    // or nearly meets.
+    Span intersect(const std::array<float, 3>& O, const std::array<float, 3>& V, std::vector<Hit>* hits) const;
+    static Span span_of(const std::vector<Hit>& hits, const std::vector<char>& accepted, float geom_r);
+
+private:
+    std::array<float, 4> table_fetch(float u) const;
+    double band(const std::array<float, 3>& O, const std::array<float, 3>& V, const std::vector<Hit>& hits,
+                const Span& nominal, const glm::dvec4& rendered, bool& may_fault) const;
+    struct Box {
+        double lo[4], hi[4];
+    };
+    // The interval of the program's output over a span, its positions uncertain by eps.
+    Box span_range(const std::array<float, 3>& O, const std::array<float, 3>& V, const Span& sp, bool& may_fault) const;
+    void sample_range(const std::array<float, 3>& point, double eps, double& lo, double& hi) const;
+    void table_range(double ulo, double uhi, double* lo, double* hi) const;
+
+    Seed001Frame f_;
+    bool h100_, band_;
+    std::array<float, 3> step_{};  // lengthStep, angleStep / longStep, heightStep / latStep as the kernel has them
+};
+
+}  // namespace volref

@@ -127,17 +127,7 @@ int run_compare(const CompareArgs& args) {
 
     // issue 28: pixels where a mirrored program does not finish (either image's `fault` channel) are
     // reported apart and left out of the metrics and the tolerance test (0 in both).
-    std::vector<std::array<int, 2>> faults;
-    if (!a.fault.empty() || !b.fault.empty())
-        for (int y = 0; y < a.rgba.height; ++y)
-            for (int x = 0; x < a.rgba.width; ++x) {
-                const std::size_t p = std::size_t(y) * std::size_t(a.rgba.width) + std::size_t(x);
-                if (!((!a.fault.empty() && a.fault[p]) || (!b.fault.empty() && b.fault[p]))) continue;
-                faults.push_back({x, y});
-                for (std::size_t c = 0; c < 4; ++c) a.rgba.at(x, y, c) = b.rgba.at(x, y, c) = 0.0;
-                if (!a.error.empty()) a.error[p] = 0.0;
-                if (!b.error.empty()) b.error[p] = 0.0;
-            }
+    const std::vector<std::array<int, 2>> faults = exclude_faults(a, b);
     const ToleranceSpec tspec{args.tolerance, args.tolerance_from_error};
     const std::vector<double> tolerance = tolerance_map(a, b, tspec);
     const ImageMetrics m = measure_difference(a.rgba, b.rgba, tolerance);

@@ -227,11 +227,12 @@ compare::ComparedImage compared_input(py::handle v, const char* name, py::handle
     }
     ComparedImage out;
     py::array pixels;
-    std::optional<py::array> error;
+    std::optional<py::array> error, fault;
     if (py::isinstance<RenderResult>(v)) {
         const RenderResult& r = v.cast<const RenderResult&>();
         pixels = pixel_view(py::reinterpret_borrow<py::object>(v), 0, 4);
         if (const auto e = r.channel("error")) error = pixel_view(py::reinterpret_borrow<py::object>(v), *e, 0);
+        if (const auto f = r.channel("fault")) fault = pixel_view(py::reinterpret_borrow<py::object>(v), *f, 0);
         out.path = "<render " + arg + ">";
     } else if (py::isinstance<py::array>(v)) {
         pixels = py::reinterpret_borrow<py::array>(v);
@@ -282,6 +283,13 @@ compare::ComparedImage compared_input(py::handle v, const char* name, py::handle
             }
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
         }
+    if (fault) {  // issue 28
+        const py::array_t<double, py::array::forcecast> e(*fault);
+        const auto q = e.unchecked<2>();
+        out.fault.resize(std::size_t(w) * std::size_t(h));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) out.fault[std::size_t(y) * std::size_t(w) + std::size_t(x)] = q(y, x) != 0.0;
+    }
     if (error) {
         const py::array_t<double, py::array::forcecast> e(*error);
         const auto q = e.unchecked<2>();
@@ -362,6 +370,7 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     if (from_error && a.error.empty() && b.error.empty())
         throw Error("error: neither " + a.path.string() + " nor " + b.path.string() + " has an `error` channel");
 
+    const std::vector<std::array<int, 2>> faults = compare::exclude_faults(a, b);  // issue 28
     const compare::ToleranceSpec tspec{absolute, from_error};
     compare::ImageMetrics m;
     {
@@ -380,6 +389,8 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     j["pixels"] = m.pixels;
     j["pixels_over"] = m.overall.over;
     j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};  // issue 22
+    j["fault"] = nlohmann::json::array();  // issue 28: the pixels (x, y) where a mirrored program does not finish
+    for (const auto& f : faults) j["fault"].push_back({f[0], f[1]});
     j["fraction_over"] = m.fraction_over();
     j["within_tolerance"] = m.overall.over == 0;
     return json_loads(j.dump());

@@ -1,5 +1,6 @@
 #include "core/compare/ComparedImage.h"
 
+#include <algorithm>
 #include <cstdint>
 
 #include <OpenImageIO/imageio.h>
@@ -109,6 +110,22 @@ ComparedImage read_compared_image(const std::filesystem::path& path, const std::
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
             if (e >= 0) out.error[p] = px[e];
             if (fault >= 0) out.fault[p] = px[fault] != 0.0;
+        }
+    return out;
+}
+
+std::vector<std::array<int, 2>> exclude_faults(ComparedImage& a, ComparedImage& b) {
+    std::vector<std::array<int, 2>> out;
+    if (a.fault.empty() && b.fault.empty()) return out;
+    const int w = std::min(a.rgba.width, b.rgba.width), h = std::min(a.rgba.height, b.rgba.height);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            if (!((!a.fault.empty() && a.fault[p]) || (!b.fault.empty() && b.fault[p]))) continue;
+            out.push_back({x, y});
+            for (std::size_t c = 0; c < 4; ++c) a.rgba.at(x, y, c) = b.rgba.at(x, y, c) = 0.0;
+            if (!a.error.empty()) a.error[p] = 0.0;
+            if (!b.error.empty()) b.error[p] = 0.0;
         }
     return out;
 }

@@ -12,6 +12,7 @@
 //     written over a non-transparent image.background.
 //   - Integer inputs remember their bit depth: their quantisation enters the tolerance (Tolerance.h).
 #pragma once
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -35,6 +36,11 @@ struct ComparedImage {
                                      // before premultiplying (for the quantisation bound); else empty
     std::string description() const; // e.g. "64x64, 8-bit, unassociated alpha (premultiplied here)"
 };
+
+// Issue 28: the pixels where either input's `fault` channel is set (a mirrored program does not finish the
+// ray), as (x, y); each is set to 0 in both images (RGBA and `error`), so that the metrics, the tolerance
+// test and --fit leave it out.
+std::vector<std::array<int, 2>> exclude_faults(ComparedImage& a, ComparedImage& b);
 
 // Reads `path`; throws volref::Error naming the file when it cannot be read or has no R, G, B (or Y).
 ComparedImage read_compared_image(const std::filesystem::path& path,

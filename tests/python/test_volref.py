@@ -472,3 +472,21 @@ def test_help_explains_the_arguments():
         assert len(pydoc.render_doc(f)) > 400
     stub = pathlib.Path(volref.__file__).with_name("volref.pyi")
     assert stub.exists() and "def render(" in stub.read_text()
+
+
+def test_compare_returns_the_rays_the_program_does_not_finish(tmp_path):
+    """Issue 28: seed 001's float32 kernel faults where the real program hangs (tests/gpu/h100/seed001:
+    sphere-composite, 3 rays its guard marked); compare lists them and leaves them out, as the CLI does."""
+    scene = SOURCE / "tests" / "gpu" / "h100" / "seed001" / "sphere-composite.json"
+    r = volref.render(scene)
+    got = volref.compare(r, r)
+    gpu = SOURCE / "tests" / "gpu" / "h100" / "seed001" / "sphere-composite.h100.exr"
+    _, px = read_exr(gpu)
+    marked = sorted([int(x), int(y)] for y, x in zip(*np.nonzero((px[..., 0] == -1) & (px[..., 3] == -1))))
+    assert sorted(got["fault"]) == marked and len(marked) == 3
+    assert got["within_tolerance"] is True and got["non_finite"]["a"] == 0
+    out = tmp_path / "k.exr"
+    cli("render", scene, "-o", out)
+    expected = json.loads(cli("compare", out, gpu, "--json", check=False).stdout)
+    assert sorted(expected["fault"]) == marked
+    assert sorted(volref.compare(str(out), str(gpu))["fault"]) == marked

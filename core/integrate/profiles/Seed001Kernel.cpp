@@ -62,15 +62,23 @@ constexpr double kU = 0x1p-24;                                   // float32 unit
 constexpr double kAmbiguousBary = 0x1p-14;   // a barycentric coordinate this close to 0 may take either sign
 constexpr double kAmbiguousD = 0x1p-18;      // |d| <= this |n|: the sign of d is not decided
 constexpr int kMostAmbiguous = 6;            // 2^6 alternatives at most; more: the band is infinite
+constexpr double kMostSteps = 0x1p26;        // a loop longer than this is taken as one that does not end
 
 }  // namespace
 
 std::string Seed001Fault::text() const {
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "the mirrored loop cannot end: triangle %d (d = dot(n, vect) = %.9g) sets outAbs = %.9g (inAbs %.9g); "
-                  "the float32 spacing there is %.9g, so s -= %.9g leaves s unchanged",
-                  triangle, double(d), double(out_abs), double(in_abs), double(ulp), double(step));
+    char buf[400];
+    if (double(ulp) > 2.0 * double(step) || !std::isfinite(out_abs))
+        std::snprintf(buf, sizeof buf,
+                      "the mirrored loop cannot end: triangle %d (d = dot(n, vect) = %.9g) sets outAbs = %.9g (inAbs %.9g); "
+                      "the float32 spacing there is %.9g, so s -= %.9g leaves s unchanged",
+                      triangle, double(d), double(out_abs), double(in_abs), double(ulp), double(step));
+    else
+        std::snprintf(buf, sizeof buf,
+                      "the mirrored loop does not end in 2^26 steps: triangle %d (d = dot(n, vect) = %.9g) sets outAbs = %.9g "
+                      "(inAbs %.9g), (outAbs - inAbs) / step = %.6g steps of %.9g",
+                      triangle, double(d), double(out_abs), double(in_abs),
+                      (double(out_abs) - double(in_abs)) / double(step), double(step));
     return buf;
 }
 
@@ -273,7 +281,8 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
         px.hit = true;
         const float in = std::fmax(0.0f, sp.in_abs);
         px.in_abs = in;
-        if (!(sp.out_abs - f_.step != sp.out_abs)) {  // s -= step cannot move s (or s is not finite)
+        // s -= step cannot move s (or s is not finite), or more than kMostSteps steps (a practical end)
+        if (!(sp.out_abs - f_.step != sp.out_abs) || !((double(sp.out_abs) - double(in)) / double(f_.step) < kMostSteps)) {
             px.fault = true;
             px.why = {sp.out_triangle, 0.0f, sp.out_abs, in, 0.0f, f_.step};
             if (std::isfinite(sp.out_abs))
@@ -439,7 +448,8 @@ Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Spa
     Box box{};
     if (!sp.ok || !(sp.out_abs >= 0.0f)) return box;  // the pixel stays 0
     const float in = std::fmax(0.0f, sp.in_abs);
-    if (!(sp.out_abs - f_.step != sp.out_abs)) {
+    // a loop that cannot end, or one longer than the GPU fixtures' guard (4,000,000 steps): infinite band
+    if (!(sp.out_abs - f_.step != sp.out_abs) || !((double(sp.out_abs) - double(in)) / double(f_.step) < 4.0e6)) {
         may_fault = true;
         return box;
     }

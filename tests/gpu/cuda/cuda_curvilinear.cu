@@ -3,7 +3,7 @@
 // (docs/gpu-checking.md): it is compiled wherever CMake finds a CUDA compiler, and
 // tests/gpu/cuda/compare.sh runs it against volref's cuda-curvilinear profile where a GPU exists.
 //
-// From the seed, kept as written (modernised only where CUDA 12+ removed the API):
+// From the seed, kept as written (modernised only where CUDA 12+ removed the API; the loops' guard below):
 //   - the kernel's loops: `for (s = outAbs; s >= inAbs; s -= step)` in float, from the exit backwards;
 //     regular composition `sum = lerp(sum, col, col.w * density)` over the samples with
 //     sample >= isoValue, col = tex1D(transferTex, sample * transferScale); x-ray
@@ -66,6 +66,12 @@ __device__ inline float lerp(float a, float b, float t) { return a + t * (b - a)
 __device__ inline float4 lerp(float4 a, float4 b, float t) {
     return make_float4(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z), a.w + t * (b.w - a.w));
 }
+
+// The one change to the seed's loops (issue 28): a ray whose `for (s = outAbs; s >= inAbs; s -= step)` has
+// not ended after kGuardSteps steps is written as (R, G, B, A) = (-1, outAbs, inAbs, -1) instead of hanging
+// the frame (in float32 s -= step cannot move s once outAbs >= about 2^24 step: the seed hangs there; the
+// cuda-curvilinear profile marks those rays in its `fault` channel). Every other pixel is the seed's.
+constexpr unsigned kGuardSteps = 4000000u;
 
 struct Params {
     cudaTextureObject_t data;      // the seed's dataTex
@@ -237,7 +243,8 @@ __global__ void kernel(Params p) {
         inAbs = fmaxf(s, inAbs);
         if (p.compoType == 0) {
             float4 sum = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
-            for (float s = outAbs; s >= inAbs; s -= p.step) {
+            unsigned guard_ = 0;  // the guard (below): not the seed's
+            for (float s = outAbs; s >= inAbs && guard_ < kGuardSteps; s -= p.step, ++guard_) {
                 float sample = interpolate(p, O + s * vect, 0, p.triCubic);
                 if (sample >= p.isoValue) {
                     // Lookup in transfer function texture
@@ -246,14 +253,17 @@ __global__ void kernel(Params p) {
                     sum = lerp(sum, col, col.w * p.density);
                 }
             }
+            if (guard_ >= kGuardSteps) { p.output[i] = make_float4(-1.0f, outAbs, inAbs, -1.0f); return; }
             p.output[i] = make_float4(sum.x * p.regBrightness, sum.y * p.regBrightness, sum.z * p.regBrightness,
                                       sum.w * p.regBrightness);
         } else {
             float maxVal = 0.0f;
-            for (float s = outAbs; s >= inAbs; s -= p.step) {
+            unsigned guard_ = 0;  // the guard (below): not the seed's
+            for (float s = outAbs; s >= inAbs && guard_ < kGuardSteps; s -= p.step, ++guard_) {
                 float sample = interpolate(p, O + s * vect, 0, p.triCubic);
                 if (sample >= p.isoValue) maxVal = fmaxf(maxVal, sample);
             }
+            if (guard_ >= kGuardSteps) { p.output[i] = make_float4(-1.0f, outAbs, inAbs, -1.0f); return; }
             maxVal *= p.xrayBrightness;
             p.output[i] = make_float4(maxVal, maxVal, maxVal, 1.0f);
         }

@@ -2,7 +2,7 @@
 // surfaceless platform: no X server, no window), on one volref scene. It renders into a GL_RGBA32F
 // framebuffer and writes the premultiplied RGBA floats as EXR for `volref compare`.
 //
-//   glsl_raycaster SCENE.json OUT.exr [--set key=value]... [--require-renderer SUBSTRING] [--define MACRO]
+//   glsl_raycaster SCENE.json OUT.exr [--set key=value]... [--require-renderer SUBSTRING] [--define MACRO] [--egl-device]
 // (--define: a macro put after the shader's #version line; raycast.frag's SEED_NO_* variants leave one
 // quirk out, for the tests that show the comparison sees it.)
 //
@@ -72,14 +72,29 @@ GLuint compile(GLenum type, const std::string& src) {
     return s;
 }
 
-// An EGL display on Mesa's surfaceless platform and a current OpenGL 3.3 core context without a surface.
-void make_context(const std::string& require_renderer) {
+// A current OpenGL 3.3 core context without a surface: on Mesa's surfaceless platform (llvmpipe), or, with
+// --egl-device (a GPU machine: NVIDIA's driver has no surfaceless platform, issue 28), on the first EGL
+// device that initialises (EGL_EXT_platform_device).
+void make_context(const std::string& require_renderer, bool egl_device) {
     auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (!get_platform_display) fail(1, "EGL: no eglGetPlatformDisplayEXT");
-    EGLDisplay dpy = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (dpy == EGL_NO_DISPLAY) fail(1, "EGL: no surfaceless display (is libegl-mesa0 installed?)");
+    EGLDisplay dpy = EGL_NO_DISPLAY;
     EGLint major = 0, minor = 0;
-    if (!eglInitialize(dpy, &major, &minor)) fail(1, "EGL: eglInitialize failed");
+    if (egl_device) {
+        auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        EGLDeviceEXT devices[8];
+        EGLint count = 0;
+        if (!query_devices || !query_devices(8, devices, &count) || count < 1) fail(1, "EGL: no EGL device (EGL_EXT_device_enumeration)");
+        for (EGLint d = 0; d < count && dpy == EGL_NO_DISPLAY; ++d) {
+            dpy = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[d], nullptr);
+            if (dpy != EGL_NO_DISPLAY && !eglInitialize(dpy, &major, &minor)) dpy = EGL_NO_DISPLAY;
+        }
+        if (dpy == EGL_NO_DISPLAY) fail(1, "EGL: no EGL device initialises");
+    } else {
+        dpy = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        if (dpy == EGL_NO_DISPLAY) fail(1, "EGL: no surfaceless display (is libegl-mesa0 installed?)");
+        if (!eglInitialize(dpy, &major, &minor)) fail(1, "EGL: eglInitialize failed");
+    }
     if (!eglBindAPI(EGL_OPENGL_API)) fail(1, "EGL: no OpenGL API");
     // Mesa's surfaceless platform may offer no config for OpenGL: then EGL_KHR_no_config_context.
     const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
@@ -101,15 +116,17 @@ void make_context(const std::string& require_renderer) {
 int run(int argc, char** argv) {
     std::vector<std::string> overrides;
     std::string require_renderer, defines;
+    bool egl_device = false;
     std::vector<std::string> positional;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--set" && i + 1 < argc) overrides.emplace_back(argv[++i]);
         else if (a == "--require-renderer" && i + 1 < argc) require_renderer = argv[++i];
         else if (a == "--define" && i + 1 < argc) defines += std::string("#define ") + argv[++i] + "\n";
+        else if (a == "--egl-device") egl_device = true;
         else positional.push_back(a);
     }
-    if (positional.size() != 2) fail(2, "usage: glsl_raycaster SCENE.json OUT.exr [--set key=value]... [--require-renderer S]");
+    if (positional.size() != 2) fail(2, "usage: glsl_raycaster SCENE.json OUT.exr [--set key=value]... [--require-renderer S] [--define M] [--egl-device]");
     using namespace volref;
     const Scene scene = load_scene(positional[0], overrides);
     if (scene.volumes.size() != 1) fail(2, "one volume only");
@@ -132,7 +149,7 @@ int run(int argc, char** argv) {
     const glm::dvec3 lo = vol.domain_min(), extent = vol.domain_max() - vol.domain_min();
     const int W = scene.image.width, H = scene.image.height;
 
-    make_context(require_renderer);
+    make_context(require_renderer, egl_device);
 
     // The volume: GL_R32F, linear, clamped to the edge.
     std::vector<float> voxels(std::size_t(vol.dims[0] * vol.dims[1] * vol.dims[2]));

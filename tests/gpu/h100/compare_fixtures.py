@@ -19,7 +19,7 @@ With --bands (and --check) each fixture is also rendered with texture_unit "h100
 pixel must lie within the error channel plus 2e-4 (seed 002: plus derive_tolerance.py's bound), and seed
 001's `fault` pixels must be exactly the rays the program's guard marked (issue 28).
 
-Usage: compare_fixtures.py VOLREF OUTDIR [--check] [--bands] [--markdown] [--only seed001|seed002]
+Usage: compare_fixtures.py VOLREF OUTDIR [--check] [--bands] [--markdown] [--only seed001|seed002] [--fixtures DIR]
 """
 import json
 import os
@@ -30,6 +30,7 @@ import numpy as np
 import OpenImageIO as oiio
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+FIXTURES = HERE  # --fixtures DIR: another folder of seed001/ and seed002/ (tests/gpu/device/collect.sh)
 
 
 def read_channels(path):
@@ -68,6 +69,10 @@ def main(argv):
     if "--only" in argv:
         only = argv[argv.index("--only") + 1]
         args.remove(only)
+    global FIXTURES
+    if "--fixtures" in argv:
+        FIXTURES = argv[argv.index("--fixtures") + 1]
+        args.remove(FIXTURES)
     volref, outdir = args[0], args[1]
     os.makedirs(outdir, exist_ok=True)
     rows, failures = [], []
@@ -77,7 +82,7 @@ def main(argv):
             continue
         if seed == "seed001" and "--check" in argv and "--markdown" not in argv:
             continue  # the check needs seed 002's exact-against-h100 lines only (seed 001: the bands below)
-        folder = os.path.join(HERE, seed)
+        folder = os.path.join(FIXTURES, seed)
         for name in sorted(f[:-5] for f in os.listdir(folder) if f.endswith(".json")):
             scene = os.path.join(folder, name + ".json")
             gpu = read_rgba(os.path.join(folder, name + ".h100.exr"))
@@ -105,7 +110,7 @@ def main(argv):
         for seed, profile, extra in (("seed002", "glsl-basic", []), ("seed001", "cuda-curvilinear", [])):
             if only and seed != only:
                 continue
-            folder = os.path.join(HERE, seed)
+            folder = os.path.join(FIXTURES, seed)
             for name in sorted(f[:-5] for f in os.listdir(folder) if f.endswith(".json")):
                 scene = os.path.join(folder, name + ".json")
                 gpu = read_rgba(os.path.join(folder, name + ".h100.exr"))

@@ -46,7 +46,9 @@ cp "$P/tests/gpu/cuda/cuda_curvilinear.cu" "$P/tests/gpu/cuda/seed001.h" "$here/
 $CXX -DVOLREF_GLSL_SHADER='"raycast.frag"' -o "$C/bin/glsl_raycaster" "$P/tests/gpu/glsl/glsl_raycaster.cpp" "$here/raw_writer.cpp" \
     -L"$B" -lvolref_core -lOpenGL -lEGL -Wl,-rpath,'$ORIGIN/../lib'
 cp "$P/tests/gpu/glsl/raycast.frag" "$C/"
-cp "$P"/tests/gpu/h100/seed002/*.json "$P"/tests/gpu/glsl/scenes/*.json ${SCENES_GLSL:-} "$C/scenes/glsl/"
+for s in "$P"/tests/gpu/h100/seed002/*.json "$P"/tests/gpu/glsl/scenes/*.json ${SCENES_GLSL:-}; do
+    [ -f "$C/scenes/glsl/$(basename "$s")" ] || cp "$s" "$C/scenes/glsl/"  # the fixtures' scenes are the glsl tests'
+done
 for l in $(LD_LIBRARY_PATH=$B ldd "$C/bin/glsl_raycaster" | awk '/=>/{print $3}' | sort -u | grep -E 'volref|embree|tbb|hwy|tinyobj|nifti|znz'); do
     cp -L "$l" "$C/lib/"
 done

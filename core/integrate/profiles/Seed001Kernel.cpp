@@ -28,17 +28,27 @@ namespace {
 
 using F3 = std::array<float, 3>;
 
+// double -> float as the host's casts do, with values past the float range taken as +-inf (a plain cast of
+// those is undefined behaviour in C++; on every GPU host it gives inf).
+float to_f(double x) {
+    constexpr double kMax = double(std::numeric_limits<float>::max());
+    if (x > kMax) return x < kMax * (1.0 + 0x1p-25) ? std::numeric_limits<float>::max() : std::numeric_limits<float>::infinity();
+    if (x < -kMax) return x > -kMax * (1.0 + 0x1p-25) ? -std::numeric_limits<float>::max() : -std::numeric_limits<float>::infinity();
+    return static_cast<float>(x);
+}
+
 F3 sub(const F3& a, const F3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 F3 scale(float s, const F3& a) { return {s * a[0], s * a[1], s * a[2]}; }
 F3 along(const F3& o, float s, const F3& v) {  // o + s * v, contracted
     return {std::fma(s, v[0], o[0]), std::fma(s, v[1], o[1]), std::fma(s, v[2], o[2])};
 }
+// CUDA's rsqrtf (2 ulp); here 1 / sqrt correctly rounded.
+float rsqrt(float x) { return to_f(1.0 / std::sqrt(double(x))); }
 float dot(const F3& a, const F3& b) { return std::fma(a[2], b[2], std::fma(a[0], b[0], a[1] * b[1])); }
 F3 cross(const F3& a, const F3& b) {
     return {std::fma(a[1], b[2], -(a[2] * b[1])), std::fma(a[2], b[0], -(a[0] * b[2])), std::fma(a[0], b[1], -(a[1] * b[0]))};
 }
-// CUDA's rsqrtf (2 ulp); here 1 / sqrt correctly rounded.
-float rsqrt(float x) { return static_cast<float>(1.0 / std::sqrt(double(x))); }
+
 F3 normalize(const F3& a) { return scale(rsqrt(dot(a, a)), a); }
 float det(float ux, float uy, float vx, float vy) { return std::fma(ux, vy, -(uy * vx)); }
 // CUDA's atan2f / atanf (2 ulp); here correctly rounded.
@@ -93,7 +103,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
         if (c.r0 != 0.0 || c.a0 != 0.0 || c.h0 != 0.0)
             throw Error("render.profile_options.kernel: \"float32\" is seed 001's kernel, whose cylinder starts at radius, angle and height 0 (volume.bounds; kernel \"double\" renders any shell)");
         f.geom_type = 0;
-        f.geom_size = {float(c.r1), float(c.a1 * rad), float(c.h1)};
+        f.geom_size = {to_f(c.r1), to_f(c.a1 * rad), to_f(c.h1)};
         f.center = c.center;
         mesh = tessellate(c, segments);
     } else if (bounds.type == BoundsSpec::Type::Spherical) {
@@ -101,7 +111,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
         if (s.r0 != 0.0 || s.lon0 != 0.0 || s.lat0 != -s.lat1 || s.axes != std::array<int, 3>{0, 1, 2})
             throw Error("render.profile_options.kernel: \"float32\" is seed 001's kernel, whose sphere has radius and longitude from 0, latitude [-F, F] and the default axes (volume.bounds; kernel \"double\" renders any shell)");
         f.geom_type = 1;
-        f.geom_size = {float(s.r1), float(s.lon1 * rad), float(s.lat1 * rad)};
+        f.geom_size = {to_f(s.r1), to_f(s.lon1 * rad), to_f(s.lat1 * rad)};
         f.center = s.center;
         mesh = tessellate(s, segments);
     } else {
@@ -110,7 +120,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     for (const auto& t : mesh.triangles)
         for (std::uint32_t k : t) {
             const glm::dvec3 v = mesh.vertices[k] - f.center;
-            f.vertices.push_back({float(v.x), float(v.y), float(v.z)});
+            f.vertices.push_back({to_f(v.x), to_f(v.y), to_f(v.z)});
         }
     const auto [vmin, vmax] = volume.value_range();
     f.dims = volume.dims;
@@ -121,14 +131,14 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     }
     for (int j = 0; j < 9; ++j) {
         const Classified k = classifier.classify(vmin + double(j) * (vmax - vmin) / 8.0, 0.0);
-        f.table[std::size_t(j)] = {float(k.color.r), float(k.color.g), float(k.color.b), float(k.opacity)};
+        f.table[std::size_t(j)] = {to_f(k.color.r), to_f(k.color.g), to_f(k.color.b), to_f(k.opacity)};
     }
     const ProfileOptions& o = render.profile_options;
-    f.step = float(step);
-    f.density = float(o.density);
-    f.xray_brightness = float(o.brightness);
-    f.iso = float(o.iso_threshold);
-    f.transfer_scale = float(o.transfer_scale);
+    f.step = to_f(step);
+    f.density = to_f(o.density);
+    f.xray_brightness = to_f(o.brightness);
+    f.iso = to_f(o.iso_threshold);
+    f.transfer_scale = to_f(o.transfer_scale);
     f.xray = render.projection == Projection::Xray;
     return f;
 }
@@ -270,7 +280,7 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray) const { return pixel(ray, null
 Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) const {
     // The host: origin - centre and the unit direction, in double, then float.
     const glm::dvec3 o = ray.origin - f_.center, dv = glm::normalize(ray.direction);
-    const F3 O{float(o.x), float(o.y), float(o.z)}, V{float(dv.x), float(dv.y), float(dv.z)};
+    const F3 O{to_f(o.x), to_f(o.y), to_f(o.z)}, V{to_f(dv.x), to_f(dv.y), to_f(dv.z)};
     std::vector<Hit> hits;
     const Span sp = intersect(O, V, band_ ? &hits : nullptr);
     Seed001Pixel px;

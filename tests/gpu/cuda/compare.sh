@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Seed 001's CUDA program (and seed 002's GLSL program) on a real GPU against volref's profiles (issues 17,
 # 27, 28). No test needs a GPU: the programs' images recorded on one are fixtures (tests/gpu/h100) that ctest
-# compares without one (h100_texture_unit, h100_fixtures). To record new ones when a GPU machine is lent
+# compares without one (ctest h100_fixtures). To record new ones when a GPU machine is lent
 # (it has CUDA and a driver but none of Debian's libraries, and carries at most 64 MiB: inputs, not
 # libraries), three steps (tests/gpu/device/README.md):
 #   tests/gpu/cuda/compare.sh prepare [BUILD_DIR [CARRY_DIR]]           here: frames, sources, the GLSL bundle

@@ -10,7 +10,7 @@ with exact texture filtering and once with the H100 texture unit (render.profile
                                         its guard) are left out and counted
 
 Prints one line per fixture (max |difference| over RGBA and the pixels over `tol` with exact and with h100)
-and, with --markdown, the table of docs/gpu-checking.md. With --check (ctest `h100_texture_unit`): exit 1
+and, with --markdown, the table of docs/gpu-checking.md. With --check (ctest `h100_fixtures`): exit 1
 unless glsl-basic with "h100" is at least as close to every seed 002 image as with "exact" (the max
 difference and the count over the derived tolerance, derive_tolerance.py). The seed 001 lines are
 reported, not checked (issue 28: its geometry is not mirrored in float32 yet).

@@ -39,13 +39,14 @@ struct Worked {
     std::array<double, 8> e{};
 };
 
-Worked work(const Volume& v, const glm::dvec3& at, bool h100, bool normalized) {
+// `option`: the command-line option the point came from (for messages).
+Worked work(const Volume& v, const glm::dvec3& at, bool h100, bool normalized, const char* option) {
     const bool unorm16 = is_unorm16(v);
     Worked w;
     for (int a = 0; a < 3; ++a) {
         const float c = static_cast<float>(at[a]);
         if (!std::isfinite(c))
-            throw Error(std::string("--at: the ") + kAxis[a] + " coordinate is not a finite float32, got " + std::to_string(at[a]));
+            throw Error(std::string(option) + ": the " + kAxis[a] + " coordinate is not a finite float32, got " + std::to_string(at[a]));
         w.given[std::size_t(a)] = at[a];
         w.coordinate[std::size_t(a)] = normalized ? tu::unnormalized(tu::to_float32(at[a]), v.dims[std::size_t(a)]) : tu::to_float32(at[a]);
     }
@@ -80,7 +81,7 @@ std::string corner_name(int c) {
 
 Explanation texture_fetch(const Volume& v, const glm::dvec3& at, bool h100, bool normalized) {
     const bool unorm16 = is_unorm16(v);
-    const Worked w = work(v, at, h100, normalized);
+    const Worked w = work(v, at, h100, normalized, "--at");
     Explanation e;
     e.topic = "texture-fetch";
     Section& tex = e.section("texture");
@@ -162,7 +163,7 @@ Explanation texture_fetch_points(const Volume& v, const std::vector<glm::dvec3>&
     Section& s = e.section("points");
     s.columns = {"x", "y", "z", "fetch"};
     for (const glm::dvec3& p : points) {
-        const Worked w = work(v, p, h100, normalized);
+        const Worked w = work(v, p, h100, normalized, "--points");
         s.rows.push_back({p.x, p.y, p.z, double(w.fetch)});
     }
     return e;

@@ -180,13 +180,12 @@ bool ProfileIntegrator::shell_texels(const glm::dvec3& x, std::array<double, 8>&
 // seed 001's unsigned shorts over the data range (texture_format "unorm16"): q = round(s 65535).
 std::uint16_t ProfileIntegrator::texel_code(std::int64_t i, std::int64_t j, std::int64_t k) const {
     const double v = texels_->at(i, j, k);
-    const double u = width_ > 0.0 ? std::clamp((v - lo_) / width_, 0.0, 1.0) : 0.0;
-    return static_cast<std::uint16_t>(std::nearbyint(u * 65535.0));
+    return texture_unit::unorm16(width_ > 0.0 ? (v - lo_) / width_ : 0.0);
 }
 
 // A texel as the profile's texture holds it, as a value: the voxel, or seed 001's min + (max - min) q / 65535.
 double ProfileIntegrator::texel(std::int64_t i, std::int64_t j, std::int64_t k) const {
-    if (ctx_.render.profile_options.data_unorm16) return lo_ + width_ * (double(texel_code(i, j, k)) / 65535.0);
+    if (ctx_.render.profile_options.data_unorm16) return code_value(texel_code(i, j, k));
     return texels_->at(i, j, k);
 }
 
@@ -235,29 +234,30 @@ ProfileIntegrator::Fetch ProfileIntegrator::texture_fetch(const glm::dvec3& x) c
         }
     }
     const tu::Fetch3d f = tu::locate_3d(xu, texture_dims_);
-    std::array<double, 8> q;  // the unit's corners as values
+    const bool unorm16 = ctx_.render.profile_options.data_unorm16;
+    std::array<double, 8> q;            // the unit's corners as values
+    std::array<std::uint16_t, 8> codes{};  // and as seed 001's unsigned shorts (unorm16)
     double vmin = k[0], vmax = k[0], amax = 0.0;
     for (int c = 0; c < 8; ++c) {
         const auto i = f.corner_index(c);
-        q[std::size_t(c)] = texel(i[0], i[1], i[2]);
+        if (unorm16) {  // texel(), keeping the code for the h100 filter
+            codes[std::size_t(c)] = texel_code(i[0], i[1], i[2]);
+            q[std::size_t(c)] = code_value(codes[std::size_t(c)]);
+        } else {
+            q[std::size_t(c)] = texel(i[0], i[1], i[2]);
+        }
         for (double v : {k[std::size_t(c)], q[std::size_t(c)]}) {
             vmin = std::min(vmin, v);
             vmax = std::max(vmax, v);
             amax = std::max(amax, std::fabs(v));
         }
     }
-    const bool unorm16 = ctx_.render.profile_options.data_unorm16;
     const double rounding = unorm16 ? width_ * tu::kUnorm16Rounding : tu::kFloatRounding * amax;
     out.band = tu::weight_factor(delta) * (vmax - vmin) + rounding;
     switch (texture_unit_) {
         case ProfileOptions::TextureUnit::Exact: out.value = out.exact; break;
         case ProfileOptions::TextureUnit::H100:
             if (unorm16) {
-                std::array<std::uint16_t, 8> codes;
-                for (int c = 0; c < 8; ++c) {
-                    const auto i = f.corner_index(c);
-                    codes[std::size_t(c)] = texel_code(i[0], i[1], i[2]);
-                }
                 out.value = lo_ + width_ * double(tu::filter_unorm16(f.w.data(), codes.data(), 8));
             } else {
                 std::array<float, 8> t;
@@ -495,9 +495,8 @@ ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, d
         }
         return b;
     }
-    // A table of n texels read at pos(v), monotone in v: its curve's extremes at the ends and the texel
-    // centres between, the position widened by the unit's coordinate move, and the weight's 1/512 plus
-    // the float32 rounding of each segment it can read.
+    // A table of n texels read at pos(v), monotone in v, the position widened by the unit's coordinate
+    // move: texture_unit::table_hull per channel.
     const int n = p_.table_entries;
     auto pos = [&](double v) {
         const double u = p_.table_coordinate == Profile::TableCoordinate::DataRangeTimesTransferScale
@@ -505,44 +504,12 @@ ProfileIntegrator::Box ProfileIntegrator::lookup_range(double vlo, double vhi, d
                              : normalised(v);
         return std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
     };
-    auto entry = [&](std::size_t j, double* c) {
-        c[0] = table_[j].r, c[1] = table_[j].g, c[2] = table_[j].b, c[3] = table_[j].a, c[4] = table_alpha_[j];
-    };
-    auto curve = [&](double p, double* c) {
-        const int i = std::min(int(p), n - 2);
-        const double w = p - double(i);
-        double a[5], e[5];
-        entry(std::size_t(i), a);
-        entry(std::size_t(i) + 1, e);
-        for (int j = 0; j < 5; ++j) c[j] = a[j] + w * (e[j] - a[j]);
-    };
+    auto entry = [&](int j, int c) { return c < 4 ? table_[std::size_t(j)][c] : table_alpha_[std::size_t(j)]; };
     // The unit reads at float32(u) cut to 20 bits: within n kNormalizedDelta texels of pos (TextureUnit.h).
     const double move = double(n) * texture_unit::kNormalizedDelta;
     const double plo = std::max(0.0, pos(vlo) - move), phi = std::min(double(n - 1), pos(vhi) + move);
-    double c[5];
-    curve(plo, c);
-    start(c);
-    curve(phi, c);
-    add(c);
-    for (int j = int(std::ceil(plo)); j <= int(std::floor(phi)) && j < n; ++j) {
-        entry(std::size_t(j), c);
-        add(c);
-    }
-    double slack[5] = {0, 0, 0, 0, 0};
-    const int s0 = std::clamp(int(std::ceil(plo)) - 1, 0, n - 2), s1 = std::clamp(int(std::floor(phi)), 0, n - 2);
-    for (int i = s0; i <= s1; ++i) {
-        double a[5], e[5];
-        entry(std::size_t(i), a);
-        entry(std::size_t(i) + 1, e);
-        // the 8-bit weight (|a / 256 - f| <= 1/512), the texels as float32, truncated, the result rounded
-        for (int j = 0; j < 5; ++j)
-            slack[j] = std::max(slack[j], std::fabs(e[j] - a[j]) / 512.0 +
-                                              texture_unit::kFloatRounding * std::max(std::fabs(a[j]), std::fabs(e[j])));
-    }
-    for (int j = 0; j < 5; ++j) {
-        b.lo[j] -= slack[j];
-        b.hi[j] += slack[j];
-    }
+    for (int c = 0; c < 5; ++c)  // r, g, b, opacity, vtk-gpu's corrected alpha
+        texture_unit::table_hull([&](int j) { return entry(j, c); }, n, plo, phi, b.lo[c], b.hi[c]);
     return b;
 }
 

@@ -76,6 +76,7 @@ private:
     bool shell_texels(const glm::dvec3& x, std::array<double, 8>& corners, glm::dvec3& w, glm::dvec3& coord) const;
     double texel(std::int64_t i, std::int64_t j, std::int64_t k) const;              // as a value
     std::uint16_t texel_code(std::int64_t i, std::int64_t j, std::int64_t k) const;  // seed 001's unorm16
+    double code_value(std::uint16_t q) const { return lo_ + width_ * (double(q) / 65535.0); }  // min + (max - min) q / 65535
     // The texture band (conventions section 9, "The texture unit"): intervals of every sample's value,
     // classification and the projection's accumulation over all units within the model.
     struct Box {

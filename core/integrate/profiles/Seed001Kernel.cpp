@@ -126,8 +126,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     f.dims = volume.dims;
     f.data.resize(volume.values.size());
     for (std::size_t i = 0; i < f.data.size(); ++i) {
-        const double s = vmax > vmin ? (volume.values[i] - vmin) / (vmax - vmin) : 0.0;
-        f.data[i] = static_cast<std::uint16_t>(std::lrint(std::clamp(s, 0.0, 1.0) * 65535.0));
+        f.data[i] = tu::unorm16(vmax > vmin ? (volume.values[i] - vmin) / (vmax - vmin) : 0.0);
     }
     for (int j = 0; j < 9; ++j) {
         const Classified k = classifier.classify(vmin + double(j) * (vmax - vmin) / 8.0, 0.0);
@@ -426,32 +425,13 @@ void Seed001Kernel::sample_range(const F3& p, double eps, double& lo, double& hi
     if (maybe_out) lo = 0.0;
 }
 
-// The 9-entry table over normalised coordinates [ulo, uhi]: the hull of its piecewise-linear curve,
-// the position widened by the 20-bit cut and the float32 product sample * transferScale, each channel
-// widened by the 8-bit weight (1/512 of a segment) and the texels' float32 rounding.
+// The 9-entry table over normalised coordinates [ulo, uhi], the position widened by the 20-bit cut and the
+// float32 product sample * transferScale: texture_unit::table_hull per channel.
 void Seed001Kernel::table_range(double ulo, double uhi, double* lo, double* hi) const {
     const double move = 9.0 * tu::kNormalizedDelta + 9.0 * 2.0 * kU;
     const double plo = std::clamp(ulo * 9.0 - 0.5 - move, 0.0, 8.0), phi = std::clamp(uhi * 9.0 - 0.5 + move, 0.0, 8.0);
-    for (int c = 0; c < 4; ++c) {
-        auto curve = [&](double p) {
-            const int i = std::min(int(p), 7);
-            const double w = p - double(i);
-            const double a = f_.table[std::size_t(i)][std::size_t(c)], b = f_.table[std::size_t(i) + 1][std::size_t(c)];
-            return a + w * (b - a);
-        };
-        double l = std::min(curve(plo), curve(phi)), h = std::max(curve(plo), curve(phi));
-        for (int j = int(std::ceil(plo)); j <= int(std::floor(phi)); ++j) {
-            l = std::min(l, double(f_.table[std::size_t(j)][std::size_t(c)]));
-            h = std::max(h, double(f_.table[std::size_t(j)][std::size_t(c)]));
-        }
-        double slack = 0.0;
-        for (int i = std::clamp(int(std::ceil(plo)) - 1, 0, 7); i <= std::clamp(int(std::floor(phi)), 0, 7); ++i) {
-            const double a = f_.table[std::size_t(i)][std::size_t(c)], b = f_.table[std::size_t(i) + 1][std::size_t(c)];
-            slack = std::max(slack, std::fabs(b - a) / 512.0 + tu::kFloatRounding * std::max(std::fabs(a), std::fabs(b)));
-        }
-        lo[c] = l - slack;
-        hi[c] = h + slack;
-    }
+    for (int c = 0; c < 4; ++c)
+        tu::table_hull([&](int j) { return double(f_.table[std::size_t(j)][std::size_t(c)]); }, 9, plo, phi, lo[c], hi[c]);
 }
 
 Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Span& sp, bool& may_fault) const {
@@ -540,8 +520,7 @@ double Seed001Kernel::band(const F3& O, const F3& V, const std::vector<Hit>& hit
             // an ambiguous hit may be accepted or not (d's sign unsure: also counted as either side)
             a[unsure[k]] = ((mask >> k) & 1u) ? char(h.d != 0.0f) : char(0);
         }
-        Span sp = span_of(hits, a, geom_r);
-        if (mask == 0 && unsure.empty()) sp.eps = std::max(sp.eps, nominal.eps);
+        const Span sp = span_of(hits, a, geom_r);
         const std::array<float, 3> key{sp.ok ? 1.0f : 0.0f, sp.in_abs, sp.out_abs};
         if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
         seen.push_back(key);

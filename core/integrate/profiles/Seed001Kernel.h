@@ -93,7 +93,7 @@ public:
         bool ok = false;
         float in_abs = 0.0f, out_abs = 0.0f;
         int in_triangle = -1, out_triangle = -1;
-        double eps = 0.0;        // the uncertainty of the positions (world units)
+        double eps = 0.0;        // the uncertainty of the positions (world units; span_of sets it, intersect leaves 0)
     };
     struct Hit {                 // one triangle's test, for the band's alternatives
         int triangle;

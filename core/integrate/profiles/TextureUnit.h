@@ -34,7 +34,9 @@
 // rounding = 2^-22 max |v_c| for float32 texels (texel to float32 2^-24, truncation 2^-27, the result 2^-24,
 // with room), 0.5 / 65535 + 2^-24 for unorm16 (in units of the normalised value).
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace volref::texture_unit {
@@ -52,6 +54,10 @@ inline constexpr double kUnorm16Rounding = 0.5 / 65535.0 + 0x1p-24;   // normali
 // A float32 coordinate is within 2^-24 |x| of the double one; a normalised one is also cut to 2^-20.
 inline constexpr double kNormalizedDelta = 0x1p-20 + 0x1p-24;          // times n texels
 inline constexpr double kCoordinateDelta = 0x1p-24;                    // times |x| texels (+ 2^-149)
+
+// A value s normalised over the data range as seed 001's host stores it: round(clamp(s, 0, 1) 65535), to
+// nearest, ties to even (its readVtk's rounding is not in its report; lrint is the host's).
+inline std::uint16_t unorm16(double s) { return static_cast<std::uint16_t>(std::lrint(std::clamp(s, 0.0, 1.0) * 65535.0)); }
 
 // x rounded to float32 (to nearest, ties to even), as a double. Through a volatile: GCC 12.2 at -O2/-O3
 // drops the rounding of double(float(x)) when it vectorises two such conversions side by side (seen
@@ -107,6 +113,34 @@ std::array<double, 8> exact_weights(const std::array<AxisRead, 3>& axis);
 
 // The band's weight term factor for values spread max - min: kL1Max / 2 + sum delta.
 inline double weight_factor(double delta_sum) { return 0.5 * kL1Max + delta_sum; }
+
+// The band of a 1D table read (one channel): every value a unit of the family returns reading n texels
+// t(0) .. t(n - 1) (texel(j) gives t(j)) at a position in [plo, phi] (0 <= plo <= phi <= n - 1): the hull of
+// the table's piecewise-linear curve there (its extremes lie at the ends and the texel centres between),
+// widened by the largest over the segments it can read of |t(i+1) - t(i)| / 512 (the 8-bit weight) +
+// kFloatRounding max(|t(i)|, |t(i+1)|) (the texels in float32, truncated, the result rounded).
+template <class Texel>
+void table_hull(const Texel& texel, int n, double plo, double phi, double& lo, double& hi) {
+    auto curve = [&](double p) {
+        const int i = std::min(int(p), n - 2);
+        const double w = p - double(i), a = texel(i);
+        return a + w * (texel(i + 1) - a);
+    };
+    lo = std::min(curve(plo), curve(phi));
+    hi = std::max(curve(plo), curve(phi));
+    for (int j = int(std::ceil(plo)); j <= int(std::floor(phi)) && j < n; ++j) {
+        lo = std::min(lo, texel(j));
+        hi = std::max(hi, texel(j));
+    }
+    double slack = 0.0;
+    const int s0 = std::clamp(int(std::ceil(plo)) - 1, 0, n - 2), s1 = std::clamp(int(std::floor(phi)), 0, n - 2);
+    for (int i = s0; i <= s1; ++i) {
+        const double a = texel(i), e = texel(i + 1);
+        slack = std::max(slack, std::fabs(e - a) / 512.0 + kFloatRounding * std::max(std::fabs(a), std::fabs(e)));
+    }
+    lo -= slack;
+    hi += slack;
+}
 
 // --- simulated units of the family (tests: a Monte Carlo of the units the band covers) -------------
 // A deterministic stream of numbers in [-1, 1] from a key (splitmix64): a quarter of them exactly -1 or

@@ -253,6 +253,7 @@ json render_json(const RenderSpec& r) {
     }
     if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.kernel == ProfileOptions::Kernel::Double)
         j["profile_options"]["kernel"] = "double";  // issue 28
+    if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.tricubic) j["profile_options"]["tricubic"] = true;
     if (r.profile == ProfileId::VtkJs)  // issue 22
         j["profile_options"] = {{"jitter", r.profile_options.jitter}, {"fixed_normal", r.profile_options.fixed_normal},
                                 {"flip_normal", r.profile_options.flip_normal},

@@ -195,6 +195,10 @@ struct ProfileOptions {
     // on the exact shell.
     enum class Kernel { Float32, Double };
     Kernel kernel = Kernel::Float32;
+    // cuda-curvilinear on shells: seed 001's tri-cubic option (its --tricubic, cubicInterpolate: the seed's
+    // cubic weights through 8 linear fetches at the mixture coordinates; conventions section 9,
+    // "cuda-curvilinear and seed 001") instead of one linear fetch per sample.
+    bool tricubic = false;
     bool texture_band = false;
     unsigned long long texture_seed = 0;  // Admissible
     // cuda-curvilinear on shells: the data texture as seed 001 holds it, the values normalised over the

@@ -827,7 +827,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         ObjectReader po(*o, r.path("profile_options"), ctx);
         if (s.profile == ProfileId::GlslBasic) po.allow({"intensity", "texture_unit", "texture_band"});
         else if (s.profile == ProfileId::VtkGpu) po.allow({"texture_unit", "texture_band"});
-        else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format", "kernel"});
+        else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format", "kernel", "tricubic"});
         // issue 17: the texture unit's weights (TextureUnit.h) and the band in the "error" channel
         using TU = ProfileOptions::TextureUnit;
         s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, {{"exact", TU::Exact}, {"h100", TU::H100}, {"hardware", TU::H100}});
@@ -837,6 +837,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, {{"float", false}, {"unorm16", true}});
         using K = ProfileOptions::Kernel;  // issue 28: seed 001's kernel in float32, or the double profile
         s.profile_options.kernel = po.choice<K>("kernel", K::Float32, {{"float32", K::Float32}, {"double", K::Double}});
+        s.profile_options.tricubic = po.boolean("tricubic", false);  // issue 28: seed 001's --tricubic
         s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());
         s.profile_options.density = po.number("density", 1.0, Range::non_negative());
         s.profile_options.transfer_scale = po.number("transfer_scale", 1.0, Range::non_negative());

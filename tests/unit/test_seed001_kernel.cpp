@@ -18,6 +18,7 @@
 #include "core/Error.h"
 #include "core/explain/PixelTrace.h"
 #include "core/film/ImageWriter.h"
+#include "core/integrate/profiles/Seed001Kernel.h"
 #include "core/render/PreparedScene.h"
 #include "core/scene/SceneLoader.h"
 
@@ -206,4 +207,162 @@ TEST(Seed001Kernel, BandHoldsTheOtherUnit) {
             }
     }
     EXPECT_GT(used, 0.01);  // the two units differ somewhere by a visible part of the band
+}
+
+// ---- seed 001's tri-cubic option (render.profile_options.tricubic; Seed001Kernel.h, seed001_cubic) ----
+
+namespace {
+
+// The seed's cubic along one axis of linear data by hand: the linear read of texels f_j = j is
+// F(m) = clamp(m - 0.5, 0, n - 1); at t = i + a the mixture reads m0 = i + a (1 - a), m1 = i + 1 - a (1 - a)
+// with weight a, so inside (1 <= t < n - 1) (1 - a)(m0 - 0.5) + a (m1 - 0.5) = t - 0.5 + a (1 - a)(1 - 2a):
+// Keys' cubic with parameter -1 does not reproduce a linear function (up to 0.096 off, at a = 0.211).
+double cubic_of_index(double t, double n) {
+    const double i = std::floor(t), a = t - i;
+    auto F = [&](double m) { return std::clamp(m - 0.5, 0.0, n - 1.0); };
+    return (1.0 - a) * F(i + a * (1.0 - a)) + a * F(i + 1.0 - a * (1.0 - a));
+}
+
+Seed001Frame ramp_frame(bool tricubic) {
+    Seed001Frame f;
+    f.dims = {8, 8, 8};
+    f.data.resize(512);
+    for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) f.data[std::size_t(i + 8 * (j + 8 * k))] = std::uint16_t(std::lround(65535.0 * i / 7.0));
+    f.geom_size = {1.0f, 1.0f, 1.0f};
+    f.tricubic = tricubic;
+    return f;
+}
+
+}  // namespace
+
+TEST(Seed001Kernel, CubicClosedFormOnARamp) {
+    // the formula in double against the closed form, and against the expansion with the weights as written
+    for (double t : {1.0, 1.25, 1.5, 2.1, 3.75, 5.999}) {
+        const double a = t - std::floor(t);
+        const double v = seed001_cubic({t, 2.5, 4.0}, [](const std::array<double, 3>& m) { return std::clamp(m[0] - 0.5, 0.0, 7.0); });
+        EXPECT_NEAR(v, t - 0.5 + a * (1.0 - a) * (1.0 - 2.0 * a), 1e-14) << t;
+        EXPECT_NEAR(v, cubic_of_index(t, 8.0), 1e-14) << t;
+        const double w0 = -a * a * a + 2 * a * a - a, w1 = a * a * a - 2 * a * a + 1;
+        if (a > 0.0) {
+            const double w2 = -a * a * a + a * a + a, w3 = a * a * a - a * a;
+            // (w0 and w0 + w1 cancel near a = 1 in double too: 5e-14 at a = 0.999)
+            EXPECT_NEAR(std::floor(t) - w0 / (w0 + w1), std::floor(t) + a * (1.0 - a), 1e-12);
+            EXPECT_NEAR(std::floor(t) + 1 + w3 / (w2 + w3), std::floor(t) + 1.0 - a * (1.0 - a), 1e-12);
+        }
+    }
+    EXPECT_NEAR(cubic_of_index(2.25, 8.0), 1.84375, 1e-15);  // 2.25 - 0.5 + 0.25 * 0.75 * 0.5
+    // The float32 kernel (exact unit) on unsigned shorts round(65535 i / 7): within their rounding, also
+    // where a = 0 (w2 + w3 = 0: a NaN coordinate read with weight 0) and next to the edges (clamped reads).
+    const Seed001Kernel k(ramp_frame(true), false, false);
+    for (float t : {1.0f, 1.25f, 2.5f, 3.0f, 4.8f, 6.0f, 0.3f, 6.7f, 0.0f, 7.0f}) {
+        const float v = k.cubic({t, 3.3f, 5.0f});
+        ASSERT_TRUE(std::isfinite(v)) << t;
+        EXPECT_NEAR(double(v), cubic_of_index(double(t), 8.0) / 7.0, 1e-5) << t;
+        // the H100 rule: 8-bit weights, within kL1Max / 2 of the three texels' range (2 / 7)
+        const Seed001Kernel h(ramp_frame(true), true, false);
+        EXPECT_NEAR(double(h.cubic({t, 3.3f, 5.0f})), cubic_of_index(double(t), 8.0) / 7.0, 0.0295867919921875 / 2 * 2.0 / 7.0 + 1e-5) << t;
+    }
+    // without the option the same point is one linear read: (t - 0.5) / 7 (the shorts 9362 and 18724 read
+    // with weights 1/4, 3/4: 16383.5 / 65535, within 0.5 / 65535)
+    const Seed001Kernel lin(ramp_frame(false), false, false);
+    EXPECT_NEAR(double(lin.fetch({2.25f, 3.3f, 5.0f})), 16383.5 / 65535.0, 1e-7);
+    EXPECT_NEAR(double(lin.fetch({2.25f, 3.3f, 5.0f})), 1.75 / 7.0, 0.5 / 65535.0);
+}
+
+// The chord of ChordThroughTheHostsTrianglesByHand with tricubic: the data is the radial index, constant
+// along angle and height, so each sample is the radial cubic of x_r = 4 r (over the range [0, 3]:
+// cubic_of_index / 3), outVal where x_r > 3 or x_angle > 7. X-ray: the largest.
+TEST(Seed001Kernel, TricubicChordByHand) {
+    double best = 0.0;
+    for (int k = 0; k <= 7; ++k) {
+        const double z = -(1.0 - 0.05 * std::tan(2.8125 * 3.14159265358979323846 / 180.0)) + 0.25 * k;
+        const double r = std::hypot(0.05, z);
+        double angle = std::atan2(-z, 0.05) * 180.0 / 3.14159265358979323846;
+        if (angle < 0.0) angle += 360.0;
+        if (4.0 * r > 3.0 || angle / 45.0 > 7.0) continue;
+        best = std::max(best, cubic_of_index(4.0 * r, 4.0) / 3.0);
+    }
+    const glm::dvec4 x = render_json(chord_scene("xray", R"("tricubic": true)"));
+    EXPECT_NEAR(x.r, best, 2e-6);
+    EXPECT_GT(std::fabs(x.r - render_json(chord_scene("xray", "")).r), 1e-3);  // the option changes the value
+    // At step 0.001 both kernels (float32 on the triangles, double on the exact circle) approach the
+    // supremum over the chord: the radial cubic increases (d/dt = 2 - 6a + 6a^2 >= 1/2), so it is its
+    // value at x_r = 3, F(3) / 3 = 2.5 / 3; the samples' r moves by <= 0.001 (x_r by 0.004, value by 0.003).
+    for (const char* opt : {R"("tricubic": true)", R"("tricubic": true, "kernel": "double")"}) {
+        std::string j = chord_scene("xray", opt);
+        j.replace(j.find("\"step\": 0.25"), 12, "\"step\": 0.001");
+        EXPECT_NEAR(render_json(j).r, 2.5 / 3.0, 3e-3) << opt;
+    }
+}
+
+// The band holds the tri-cubic kernel through the other unit (BandHoldsTheOtherUnit's scenes).
+TEST(Seed001Kernel, TricubicBandHoldsTheOtherUnit) {
+    std::mt19937_64 g(281);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    double used = 0.0;
+    for (int trial = 0; trial < 4; ++trial) {
+        std::string values;
+        for (int k = 0; k < 5 * 6 * 4; ++k) values += (values.empty() ? "" : ", ") + std::to_string(U(g));
+        const double th = 6.283185307179586 * U(g), ph = 0.4 + 0.8 * U(g);
+        char eye[128];
+        std::snprintf(eye, sizeof eye, "[%.17g, %.17g, %.17g]", 4.0 * std::cos(th) * std::sin(ph), 0.5 + 4.0 * std::cos(ph),
+                      4.0 * std::sin(th) * std::sin(ph));
+        const std::string json = R"({"volume": {"source": {"field": "cells", "dims": [5, 6, 4], "values": [)" + values + R"(]},
+               "bounds": {"type": "cylindrical", "center": [0, 0, 0], "radius": [0, 1], "angle": [0, 300], "height": [0, 1], "tessellate": 24},
+               "transfer": {"color": [[0, 1, 0.2, 0], [1, 0, 0.5, 1]], "opacity": [[0, 0.05], [0.5, 0.4], [1, 0.9]]}},
+              "camera": {"type": "perspective", "eye": )" + std::string(eye) + R"(, "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40},
+              "image": {"width": 8, "height": 8},
+              "render": {"projection": ")" + std::string(trial % 2 ? "xray" : "composite") + R"(", "step": 0.05, "step_units": "world",
+                         "profile": "cuda-curvilinear", "profile_options": {"iso_threshold": 0.1, "density": 0.7, "tricubic": true}}})";
+        Scene s = parse_scene(json, ".", "t");
+        s.render.profile_options.texture_unit = ProfileOptions::TextureUnit::H100;
+        s.render.profile_options.texture_band = true;
+        const Image h = render_scene(s, {1, false});
+        ASSERT_EQ(h.channels.size(), 6u);
+        s.render.profile_options.texture_unit = ProfileOptions::TextureUnit::Exact;
+        s.render.profile_options.texture_band = false;
+        const Image e = render_scene(s, {1, false});
+        s.render.profile_options.tricubic = false;
+        const Image l = render_scene(s, {1, false});
+        double changed = 0.0;
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) {
+                const double band = h.at(x, y, 4);
+                for (std::size_t c = 0; c < 4; ++c) {
+                    const double d = std::fabs(h.at(x, y, c) - e.at(x, y, c));
+                    EXPECT_LE(d, band) << "trial " << trial << " pixel " << x << ", " << y << " channel " << c;
+                    if (std::isfinite(band) && band > 1e-7) used = std::max(used, d / band);
+                    changed = std::max(changed, std::fabs(e.at(x, y, c) - l.at(x, y, c)));
+                }
+            }
+        EXPECT_GT(changed, 1e-3) << trial;  // tri-cubic is not the linear read
+    }
+    EXPECT_GT(used, 0.005);
+}
+
+TEST(Seed001Kernel, TricubicRefusalsNameTheKey) {
+    auto error_of = [](const std::string& json) {
+        try {
+            render_scene(parse_scene(json, ".", "t"), {1, false});
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    // the double kernel reads exactly: the h100 unit with it is refused
+    std::string m = error_of(chord_scene("composite", R"("tricubic": true, "kernel": "double", "texture_unit": "h100")"));
+    EXPECT_NE(m.find("render.profile_options.tricubic"), std::string::npos) << m;
+    // a Cartesian grid: seed 001 renders shells only
+    std::string j = chord_scene("composite", R"("tricubic": true)");
+    const auto b = j.find("\"bounds\"");
+    j.erase(b, j.find('}', b) - b + 2);
+    m = error_of(j);
+    EXPECT_NE(m.find("tricubic"), std::string::npos) << m;
+    // another profile has no such option: the loader names the key
+    j = chord_scene("composite", R"("tricubic": true)");
+    j.replace(j.find("cuda-curvilinear"), 16, "glsl-basic");
+    m = error_of(j);
+    EXPECT_NE(m.find("tricubic"), std::string::npos) << m;
 }

@@ -97,6 +97,13 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         kernel_ = std::make_unique<Seed001Kernel>(seed001_frame(volume, *bounds, ctx.pipeline.classifier(), ctx.render, step_),
                                                   texture_unit_ == ProfileOptions::TextureUnit::H100, band_);
     }
+    if (po.tricubic) {  // issue 28: seed 001's cubicInterpolate (Seed001Kernel.h, seed001_cubic)
+        if (!shell_)
+            throw Error("render.profile_options.tricubic: seed 001's tri-cubic option reads a shell's data (cylindrical or spherical bounds)");
+        if (!kernel_ && (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_))
+            throw Error("render.profile_options.tricubic: with kernel \"double\" (or a projection other than composite and x-ray) the cubic reads exactly; the h100 unit and texture_band need kernel \"float32\"");
+        tricubic_ = true;
+    }
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
                                                : p_.gradient_offset * volume.spacing;
     const auto [vmin, vmax] = volume.value_range();
@@ -194,6 +201,18 @@ double ProfileIntegrator::seed_shell_value(const glm::dvec3& x) const {
     std::array<double, 8> k;
     glm::dvec3 w, coord;
     if (!shell_texels(x, k, w, coord)) return lo_;
+    if (tricubic_) {  // 8 exact linear reads (tex3D's convention) at the seed's mixture coordinates
+        return seed001_cubic({coord.x, coord.y, coord.z}, [&](const std::array<double, 3>& m) {
+            const texture_unit::Fetch3d fe = texture_unit::locate_3d(m, texture_dims_);
+            const std::array<double, 8> e = texture_unit::exact_weights(fe.axis);
+            double v = 0.0;
+            for (int c = 0; c < 8; ++c) {
+                const auto i = fe.corner_index(c);
+                v += e[std::size_t(c)] * texel(i[0], i[1], i[2]);
+            }
+            return v;
+        });
+    }
     return lerp_corners(k, w);
 }
 

@@ -114,6 +114,7 @@ private:
     std::vector<double> table_alpha_;  // corrected for the step (composite)
     ProfileOptions::TextureUnit texture_unit_ = ProfileOptions::TextureUnit::Exact;
     bool band_ = false;
+    bool tricubic_ = false;                      // render.profile_options.tricubic (seed 001's cubicInterpolate)
     const Volume* texels_ = nullptr;             // the texture's texels (the volume)
     std::array<std::int64_t, 3> texture_dims_{};  // its texels per axis
     bool normalized_coordinates_ = true;         // GLSL's texture(): normalised; seed 001's tex3D: not

@@ -139,6 +139,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     f.iso = to_f(o.iso_threshold);
     f.transfer_scale = to_f(o.transfer_scale);
     f.xray = render.projection == Projection::Xray;
+    f.tricubic = o.tricubic;
     return f;
 }
 
@@ -239,6 +240,11 @@ float Seed001Kernel::sample_at(const F3& p) const {
     }
     for (int a = 0; a < 3; ++a)
         if (tex[std::size_t(a)] < 0 || tex[std::size_t(a)] > float(f_.dims[std::size_t(a)] - 1)) return 0.0f;  // outVal
+    return f_.tricubic ? cubic(tex) : fetch(tex);
+}
+
+// tex3D(dataTex, x, y, z): unnormalised coordinates, clamped to the edge, the unsigned shorts read as q / 65535.
+float Seed001Kernel::fetch(const F3& tex) const {
     const tu::Fetch3d fe = tu::locate_3d({double(tex[0]), double(tex[1]), double(tex[2])}, f_.dims);
     std::array<std::uint16_t, 8> q;
     for (int c = 0; c < 8; ++c) {
@@ -250,6 +256,53 @@ float Seed001Kernel::sample_at(const F3& p) const {
     double v = 0.0;
     for (int c = 0; c < 8; ++c) v += e[std::size_t(c)] * (double(q[std::size_t(c)]) / 65535.0);
     return static_cast<float>(v);
+}
+
+double Seed001Kernel::exact_fetch(const std::array<double, 3>& tex) const {
+    const tu::Fetch3d fe = tu::locate_3d(tex, f_.dims);
+    const std::array<double, 8> e = tu::exact_weights(fe.axis);
+    double v = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        const auto i = fe.corner_index(c);
+        v += e[std::size_t(c)] * (double(f_.data[std::size_t(i[0] + f_.dims[0] * (i[1] + f_.dims[1] * i[2]))]) / 65535.0);
+    }
+    return v;
+}
+
+namespace {
+
+// cubicInterpMixture as the kernel computes it, each operation rounded to float32: 2 * a2 is exact, so
+// whether NVVM fuses a * a2 into the sums that follow changes w0 .. w3 by one rounding at most (not
+// measured on hardware; the band covers it). A 0 / 0 (a = 0: w2 + w3 = 0) gives a NaN coordinate whose
+// read is weighted by exactly 0.
+F3 cubic_mixture(float x) {
+    const float i = std::floor(x);
+    const float a = x - i;
+    const float a2 = a * a;
+    const float a3 = a * a2;
+    const float w0 = -a3 + (2.0f * a2) - a;
+    const float w1 = a3 - (2.0f * a2) + 1.0f;
+    const float w2 = -a3 + a2 + a;
+    const float w3 = a3 - a2;
+    return {i - (w0 / (w0 + w1)), i + 1.0f + (w3 / (w2 + w3)), w2 + w3};
+}
+
+float lerp_f(float a, float b, float t) { return std::fma(t, b - a, a); }  // a + t * (b - a), contracted
+
+}  // namespace
+
+// cubicInterpolate: 8 tex3D reads at the mixture coordinates, then lerps along x, y, z in the seed's order.
+float Seed001Kernel::cubic(const F3& tex) const {
+    const F3 mx = cubic_mixture(tex[0]), my = cubic_mixture(tex[1]), mz = cubic_mixture(tex[2]);
+    const float v000 = fetch({mx[0], my[0], mz[0]}), v010 = fetch({mx[0], my[1], mz[0]});
+    const float v001 = fetch({mx[0], my[0], mz[1]}), v011 = fetch({mx[0], my[1], mz[1]});
+    const float v100 = fetch({mx[1], my[0], mz[0]}), v110 = fetch({mx[1], my[1], mz[0]});
+    const float v101 = fetch({mx[1], my[0], mz[1]}), v111 = fetch({mx[1], my[1], mz[1]});
+    const float y0z0 = lerp_f(v000, v100, mx[2]), y1z0 = lerp_f(v010, v110, mx[2]);
+    const float z0 = lerp_f(y0z0, y1z0, my[2]);
+    const float y0z1 = lerp_f(v001, v101, mx[2]), y1z1 = lerp_f(v011, v111, mx[2]);
+    const float z1 = lerp_f(y0z1, y1z1, my[2]);
+    return lerp_f(z0, z1, mz[2]);
 }
 
 std::array<float, 4> Seed001Kernel::table_fetch(float u) const {
@@ -394,10 +447,16 @@ void Seed001Kernel::sample_range(const F3& p, double eps, double& lo, double& hi
         hi = 1.0;
         return;
     }
-    // the texels any position within delta reads: per axis the texel box around [t - d, t + d]
+    // the texels any position within delta reads: per axis the texel box around [t - d, t + d]; tricubic:
+    // i - 1 .. i + 1 for every i = floor(t') with t' in [t - d, t + d] (seed001_cubic)
     std::array<std::int64_t, 3> i_lo{}, i_hi{};
     for (int a = 0; a < 3; ++a) {
         const double n1 = double(f_.dims[std::size_t(a)] - 1);
+        if (f_.tricubic) {
+            i_lo[std::size_t(a)] = std::max<std::int64_t>(0, std::int64_t(std::floor(tex[std::size_t(a)] - delta[std::size_t(a)])) - 1);
+            i_hi[std::size_t(a)] = std::min(std::int64_t(std::floor(tex[std::size_t(a)] + delta[std::size_t(a)])) + 1, f_.dims[std::size_t(a)] - 1);
+            continue;
+        }
         const double tl = std::clamp(tex[std::size_t(a)] - delta[std::size_t(a)] - 0.5, 0.0, n1);
         const double th = std::clamp(tex[std::size_t(a)] + delta[std::size_t(a)] - 0.5, 0.0, n1);
         i_lo[std::size_t(a)] = std::int64_t(std::floor(tl));
@@ -411,14 +470,24 @@ void Seed001Kernel::sample_range(const F3& p, double eps, double& lo, double& hi
                 vmin = std::min(vmin, v);
                 vmax = std::max(vmax, v);
             }
-    // exact trilinear at the nominal coordinate
-    const tu::Fetch3d fe = tu::locate_3d(tex, f_.dims);
-    const std::array<double, 8> e = tu::exact_weights(fe.axis);
-    double v = 0.0;
-    for (int c = 0; c < 8; ++c) {
-        const auto i = fe.corner_index(c);
-        v += e[std::size_t(c)] * (double(f_.data[std::size_t(i[0] + f_.dims[0] * (i[1] + f_.dims[1] * i[2]))]) / 65535.0);
+    if (f_.tricubic) {
+        // The seed's cubic at the nominal coordinate, exactly; moved by delta per axis it changes by at most
+        // 2 delta (vmax - vmin) per axis (d/da [(1 - a) F(m0) + a F(m1)] <= (1 + |1 - 2a|) D, F a linear read);
+        // each read of a unit of the family by kL1Max / 2 of D; the float32 mixture (w0 .. w3 to a few
+        // roundings each, the ratio's error over (1 - a) or a weighted by (1 - a) or a, the coordinate's own
+        // rounding |m| u) by (24 + |t| + 1) u D per axis; the 7 lerps by 16 u; a read at an infinite
+        // coordinate (w0 + w1 rounded to 0) weighs at most 2^-18.
+        const double v = seed001_cubic(tex, [&](const std::array<double, 3>& m) { return exact_fetch(m); });
+        double round = 0.0;
+        for (int a = 0; a < 3; ++a) round += (25.0 + std::fabs(tex[std::size_t(a)])) * kU;
+        const double b = (2.0 * delta_sum + 0.5 * tu::kL1Max + round) * (vmax - vmin) + tu::kUnorm16Rounding + 16.0 * kU + 0x1p-18;
+        lo = std::max(0.0, v - b);
+        hi = std::min(1.0, v + b);
+        if (maybe_out) lo = 0.0;
+        return;
     }
+    // exact trilinear at the nominal coordinate
+    const double v = exact_fetch(tex);
     const double b = tu::weight_factor(delta_sum) * (vmax - vmin) + tu::kUnorm16Rounding + 0x1p-24;
     lo = std::max(0.0, v - b);
     hi = std::min(1.0, v + b);

@@ -12,6 +12,7 @@
 // fault: the real program hangs there. The pixel is NaN with fault = true and the reason recorded.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -41,7 +42,34 @@ struct Seed001Frame {
     float step = 0.01f, density = 1.0f, reg_brightness = 1.0f, xray_brightness = 1.0f, iso = 0.0f,
           transfer_scale = 1.0f;
     bool xray = false;
+    bool tricubic = false;                 // render.profile_options.tricubic: the seed's triCubic = 1
 };
+
+// Seed 001's cubicInterpolate in exact arithmetic, at the unnormalised texture coordinate t: per axis
+// i = floor(t), a = t - i, the weights w0 = -a^3 + 2a^2 - a, w1 = a^3 - 2a^2 + 1, w2 = -a^3 + a^2 + a,
+// w3 = a^3 - a^2 (Keys' cubic with parameter -1) folded into two linear reads at the mixture coordinates
+// m0 = i - w0 / (w0 + w1) = i + a (1 - a) and m1 = i + 1 + w3 / (w2 + w3) = i + 1 - a (1 - a), mixed with
+// weight w2 + w3 = a. `fetch(m)` is the linear texture read at m (tex3D's convention: texel j centred at
+// j + 0.5, so m0 and m1 read texels i - 1 .. i + 1: the seed does not add the half texel). Every lerp
+// weight lies in [0, 1] and every read is a convex combination, so the value is one too (no overshoot).
+template <class Fetch>
+double seed001_cubic(const std::array<double, 3>& t, const Fetch& fetch) {
+    std::array<double, 3> m0{}, m1{}, g{};
+    for (int k = 0; k < 3; ++k) {
+        const double i = std::floor(t[std::size_t(k)]), a = t[std::size_t(k)] - i;
+        m0[std::size_t(k)] = i + a * (1.0 - a);
+        m1[std::size_t(k)] = i + 1.0 - a * (1.0 - a);
+        g[std::size_t(k)] = a;
+    }
+    auto lerp = [](double a, double b, double w) { return a + w * (b - a); };
+    double v[2][2][2];  // [x][y][z]: 0 at m0, 1 at m1
+    for (int c = 0; c < 8; ++c)
+        v[c & 1][(c >> 1) & 1][c >> 2] = fetch(std::array<double, 3>{(c & 1) ? m1[0] : m0[0], (c & 2) ? m1[1] : m0[1],
+                                                                    (c & 4) ? m1[2] : m0[2]});
+    const double z0 = lerp(lerp(v[0][0][0], v[1][0][0], g[0]), lerp(v[0][1][0], v[1][1][0], g[0]), g[1]);
+    const double z1 = lerp(lerp(v[0][0][1], v[1][0][1], g[0]), lerp(v[0][1][1], v[1][1][1], g[0]), g[1]);
+    return lerp(z0, z1, g[2]);
+}
 
 // The host's frame for a scene: `volume` on the shell of `bounds` (tessellate segments per turn, 64
 // when absent), the table from `classifier`, the render's profile options, `step` (world units).
@@ -88,6 +116,12 @@ public:
     const Seed001Frame& frame() const { return f_; }
     // The float32 value at a point (interpolateCyl / interpolateSpher with outVal 0).
     float sample_at(const std::array<float, 3>& point) const;
+    // tex3D at an unnormalised coordinate (the h100 rule or exact weights rounded to float32), and the
+    // seed's cubicInterpolate in float32 (8 of them).
+    float fetch(const std::array<float, 3>& tex) const;
+    float cubic(const std::array<float, 3>& tex) const;
+    // The exact linear read at an unnormalised coordinate, in data units [0, 1].
+    double exact_fetch(const std::array<double, 3>& tex) const;
 
     struct Span {
         bool ok = false;

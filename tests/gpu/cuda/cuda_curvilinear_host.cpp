@@ -83,7 +83,7 @@ int run(int argc, char** argv) {
             f.directions.insert(f.directions.end(), {float(d.x), float(d.y), float(d.z)});
         }
     f.step = k.step;
-    f.triCubic = tricubic ? 1 : 0;
+    f.triCubic = (tricubic || k.tricubic) ? 1 : 0;  // --tricubic or render.profile_options.tricubic
     f.density = k.density;
     f.regBrightness = k.reg_brightness;
     f.xrayBrightness = k.xray_brightness;

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "core/io/InputFile.h"
 #include "core/Error.h"
 #include "core/grid/Resample.h"
 #include "core/io/NrrdWriter.h"
@@ -130,8 +131,9 @@ std::string shell_json(const BoundsSpec& s) {
 }
 
 std::string read_text_file(const fs::path& path, const std::string& why) {
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw Error(path.string() + ": cannot read file: it is a directory" + why);
+    if (const std::string problem = io::input_file_problem(path); !problem.empty())
+        throw Error(path.string() + ": cannot read file: " + problem + why);
+    io::check_whole_file(path, path.string());
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot read file: " + std::strerror(errno) + why);
     std::stringstream ss;

@@ -9,6 +9,9 @@
 #pragma once
 #include <string>
 
+#include <cstdint>
+
+#include "core/Conventions.h"
 #include "core/Error.h"
 
 namespace volref {
@@ -28,5 +31,10 @@ bool cancel_requested() noexcept;
 void throw_if_cancelled();
 // For tests and for programs that render again after a cancel: forget the request.
 void reset_cancel() noexcept;
+// Inside a loop over samples (k = 0, 1, ...): true when SIGINT / SIGTERM is requested, polled every
+// conventions::kCancellationPollSamples iterations (the caller ends the ray; the render is abandoned).
+inline bool cancel_polled(std::int64_t k) noexcept {
+    return (k & (conventions::kCancellationPollSamples - 1)) == 0 && k > 0 && cancel_requested();
+}
 
 }  // namespace volref

@@ -1,6 +1,8 @@
 // Every numerical choice of the reference profile, in one place, each with its formula.
 // docs/conventions.md states the same choices for users; change both together.
 #pragma once
+#include <cstddef>
+#include <cstdint>
 
 namespace volref::conventions {
 
@@ -138,5 +140,24 @@ inline constexpr int kStepDoublingNeighbourhood = 1;
 // objects; deeper input is an error naming the outermost path (its nesting would otherwise exhaust the
 // stack of the code that walks the document).
 inline constexpr int kMaxJsonDepth = 256;
+
+// Issue 32 (docs/robustness.md, "Extreme numbers"): every number a JSON document gives volref, and every
+// spacing and origin a volume header gives, is 0 or has a magnitude in [kMinMagnitude, kMaxMagnitude].
+// Within it a product or quotient of two such numbers (a ray parameter, a length over a step, a squared
+// distance) stays a finite, normal double, so the arithmetic of a render is exact where it is all
+// finite doubles; a number beyond it is refused with one line naming its key, not rendered as NaN.
+inline constexpr double kMaxMagnitude = 1e100;
+inline constexpr double kMinMagnitude = 1e-100;
+// The samples one ray may take in one volume at the fixed step, counted before any ray is cast as the
+// diagonal of the volume's world bounding box over the step; a smaller step is refused (render.step).
+inline constexpr double kMaxSamplesPerRay = 0x1p32;
+// Memory accounted per sample of `volref trace` (the record, plus its CSV or JSON text) and per triangle
+// of a tessellated shell (the mesh, its vertex map, Embree's BVH and the float copies), checked against
+// --max-memory before they are made.
+inline constexpr std::size_t kTraceBytesPerSampleOutput = 1024;
+inline constexpr std::size_t kMeshBytesPerTriangle = 256;
+// SIGINT / SIGTERM are polled every this many samples inside a ray's march and every piece a reader
+// decodes (core/Cancellation.h), so that even a single ray of 2^32 samples stops within milliseconds.
+inline constexpr std::int64_t kCancellationPollSamples = 4096;
 
 }  // namespace volref::conventions

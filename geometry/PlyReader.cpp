@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "core/io/InputFile.h"
 #include "core/Error.h"
 
 namespace volref {
@@ -106,6 +107,7 @@ private:
 }  // namespace
 
 TriangleMesh read_ply_mesh(const std::string& path) {
+    io::check_whole_file(path, path);
     std::ifstream file(path, std::ios::binary);
     if (!file) throw Error(path + ": cannot read the PLY file");
     std::ostringstream ss;

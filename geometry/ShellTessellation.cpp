@@ -11,6 +11,8 @@
 
 #include "core/Angles.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
+#include "core/Conventions.h"
 #include "geometry/ShellIntersection.h"
 
 namespace volref {
@@ -59,6 +61,15 @@ void check_n(int n) {
     if (n < 3) throw Error("tessellate: needs at least 3 segments per full turn, not " + std::to_string(n));
 }
 
+// issue 32: the mesh's memory (conventions::kMeshBytesPerTriangle per triangle, at most `triangles`),
+// checked against --max-memory before it is built.
+void check_mesh_memory(double triangles, int n) {
+    const double bytes = triangles * double(conventions::kMeshBytesPerTriangle);
+    check_memory(bytes >= 0x1p62 ? std::size_t(1) << 62 : std::size_t(bytes),
+                 "volume.bounds.tessellate: " + std::to_string(n) + " segments per turn (a mesh of up to " +
+                     std::to_string(std::llround(std::min(triangles, 0x1p62))) + " triangles)");
+}
+
 // The unit vector of azimuth a (degrees) in the xz-plane, and d/da of it (per radian).
 glm::dvec3 radial(double a) {
     double c, s;
@@ -92,6 +103,7 @@ TriangleMesh tessellate(const CylindricalShell& shell, int n) {
     const bool full = shell.full_turn();
     const double span = full ? 360.0 : shell.a1 - shell.a0;
     const int m = full ? n : tessellation_segments(span, n);
+    check_mesh_memory(8.0 * (double(m) + 1.0) + 4.0, n);  // 4 quads per segment, 2 end walls
     auto angle = [&](int k) { return k == m && !full ? shell.a1 : shell.a0 + span * k / m; };
     MeshBuilder b;
     // ring 0 = inner (the axis when r0 = 0), 1 = outer; level 0 = h0, 1 = h1.
@@ -125,6 +137,7 @@ TriangleMesh tessellate(const SphericalShell& shell, int n) {
     const double span = full ? 360.0 : shell.lon1 - shell.lon0;
     const int m = full ? n : tessellation_segments(span, n);
     const int p = tessellation_segments(shell.lat1 - shell.lat0, n);
+    check_mesh_memory(4.0 * (double(m) + 2.0) * (double(p) + 2.0) + 4.0 * (double(m) + double(p) + 4.0), n);
     auto lon = [&](int k) { return k == m && !full ? shell.lon1 : shell.lon0 + span * k / m; };
     auto lat = [&](int j) { return j == p ? shell.lat1 : shell.lat0 + (shell.lat1 - shell.lat0) * j / p; };
     MeshBuilder b;

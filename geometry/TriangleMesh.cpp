@@ -14,7 +14,9 @@
 #include <glm/common.hpp>
 #include <tiny_obj_loader.h>  // TINYOBJLOADER_USE_DOUBLE comes with the tinyobjloader_double target
 
+#include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/io/ByteDecoding.h"
 #include "geometry/PlyReader.h"
 
 namespace volref {
@@ -38,13 +40,69 @@ std::string first_line(const std::string& s) {
     return line;
 }
 
+// What tinyobjloader lets pass (issue 32), checked on the text first: a vertex coordinate that is not a
+// finite number (it reads "nan" or "1e999" as 0 or inf), and a face index that is 0, beyond the vertices
+// read so far or does not fit an int (it wraps 99999999999999999999 to a small index). Errors name the line.
+void check_obj_text(const std::string& path, std::string_view text) {
+    std::size_t line_no = 0, vertices = 0;
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        std::size_t end = text.find('\n', pos);
+        if (end == std::string_view::npos) end = text.size();
+        std::string_view line = text.substr(pos, end - pos);
+        pos = end + 1;
+        ++line_no;
+        auto tokens = [&] {
+            std::vector<std::string_view> t;
+            std::size_t i = 0;
+            while (i < line.size()) {
+                while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+                std::size_t j = i;
+                while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+                if (j > i) t.push_back(line.substr(i, j - i));
+                i = j;
+            }
+            return t;
+        }();
+        if (tokens.empty()) continue;
+        const std::string where = path + ": line " + std::to_string(line_no) + ": ";
+        if (tokens[0] == "v") {
+            if (tokens.size() < 4) throw Error(where + "a vertex needs 3 coordinates");
+            for (std::size_t k = 1; k < 4; ++k) {
+                const std::optional<double> v = io::parse_number(tokens[k]);
+                if (!v || !std::isfinite(*v))
+                    throw Error(where + "vertex coordinate " + io::quoted(tokens[k]) + " is not a finite number");
+            }
+            ++vertices;
+        } else if (tokens[0] == "f" || tokens[0] == "l" || tokens[0] == "p") {
+            for (std::size_t k = 1; k < tokens.size(); ++k) {
+                const std::string_view idx = tokens[k].substr(0, tokens[k].find('/'));
+                long long i = 0;
+                const auto r = std::from_chars(idx.data(), idx.data() + idx.size(), i);
+                const long long n = static_cast<long long>(vertices);
+                if (r.ec != std::errc() || r.ptr != idx.data() + idx.size() || i == 0 || i > n || i < -n)
+                    throw Error(where + "face vertex index " + io::quoted(idx) + " is not one of the " + std::to_string(vertices) +
+                                " vertices defined before it");
+            }
+        } else if (tokens[0] == "mtllib" || tokens[0] == "usemtl") {
+            continue;  // materials are not read (no file besides the OBJ is opened)
+        }
+    }
+}
+
 TriangleMesh read_obj(const std::string& path) {
     static_assert(sizeof(tinyobj::real_t) == sizeof(double), "tinyobjloader must be its double build");
+    const std::string text = io::read_file_bytes(path);  // a regular file that fits the memory limit
+    if (text.find('\0') != std::string::npos)
+        throw Error(path + ": byte " + std::to_string(text.find('\0')) + ": a NUL byte in an OBJ (text) file");
+    check_obj_text(path, text);
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;
     tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(path, config)) {
+    // From the text, with no material text: tinyobjloader opens no mtllib file (one could be a FIFO or
+    // /dev/zero) and volref does not use materials.
+    if (!reader.ParseFromString(text, std::string(), config)) {
         const std::string why = first_line(reader.Error());
         throw Error(path + ": cannot read the OBJ file" + (why.empty() ? "" : " (" + why + ")"));
     }
@@ -107,6 +165,7 @@ void merge_coincident_vertices(TriangleMesh& mesh) {
 }
 
 TriangleMesh read_mesh(const std::string& path) {
+    io::check_input_file(path, path);  // a FIFO or a device: refused by type, before its name is read
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     TriangleMesh mesh;
@@ -120,6 +179,9 @@ TriangleMesh read_mesh(const std::string& path) {
         const glm::dvec3& p = mesh.vertices[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             throw Error(path + ": vertex " + std::to_string(i) + " is not finite");
+        // issue 32: within volref's number range, like every coordinate of a scene (conventions::kMaxMagnitude)
+        if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > conventions::kMaxMagnitude)
+            throw Error(path + ": vertex " + std::to_string(i) + " " + point(p) + " is beyond volref's range (|x| <= 1e100)");
     }
     merge_coincident_vertices(mesh);
     return mesh;

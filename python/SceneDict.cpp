@@ -258,7 +258,8 @@ json render_json(const RenderSpec& r) {
         j["profile_options"] = {{"jitter", r.profile_options.jitter}, {"fixed_normal", r.profile_options.fixed_normal},
                                 {"flip_normal", r.profile_options.flip_normal},
                                 {"ray_box", r.profile_options.ray_box_domain ? "domain" : "texel"},
-                                {"mip_correction", r.profile_options.mip_correction}};
+                                {"mip_correction", r.profile_options.mip_correction},
+                                {"subpixel_bits", r.profile_options.subpixel_bits}};
     return j;
 }
 

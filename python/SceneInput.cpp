@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/scene/SceneLoader.h"
 #include "python/SceneDict.h"
@@ -41,7 +42,12 @@ bool is_path_like(py::handle scene) {
     return py::hasattr(scene, "__fspath__");
 }
 
-json to_json(py::handle v, const std::string& prefix, const std::string& path) {
+json to_json(py::handle v, const std::string& prefix, const std::string& path, int depth) {
+    // A dict or list that contains itself, or one nested too deep, would recurse without end (issue 32):
+    // the same limit as every JSON document volref reads (conventions::kMaxJsonDepth).
+    if (depth > conventions::kMaxJsonDepth)
+        throw Error(where(prefix, path.substr(0, 200)) + "...: nested deeper than " + std::to_string(conventions::kMaxJsonDepth) +
+                    " dicts and lists (a dict or list that contains itself?)");
     if (v.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
     if (py::isinstance<py::int_>(v)) {
@@ -63,14 +69,14 @@ json to_json(py::handle v, const std::string& prefix, const std::string& path) {
                 throw Error(where(prefix, path) + ": keys must be strings, got the " + type_name(item.first) + " " +
                             std::string(py::repr(item.first)));
             const std::string key = item.first.cast<std::string>();
-            j[key] = to_json(item.second, prefix, child(path, key));
+            j[key] = to_json(item.second, prefix, child(path, key), depth + 1);
         }
         return j;
     }
     if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
         json j = json::array();
         std::size_t i = 0;
-        for (py::handle e : v) j.push_back(to_json(e, prefix, index(path, i++)));
+        for (py::handle e : v) j.push_back(to_json(e, prefix, index(path, i++), depth + 1));
         return j;
     }
     const py::module_ numpy = py::module_::import("numpy");
@@ -79,7 +85,7 @@ json to_json(py::handle v, const std::string& prefix, const std::string& path) {
         if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
             throw Error(where(prefix, path) + ": cannot use numpy dtype " + std::string(py::str(v.attr("dtype"))) +
                         " in a scene (expected numbers)");
-        return to_json(v.attr("tolist")(), prefix, path);  // an array as nested lists, a scalar as its value
+        return to_json(v.attr("tolist")(), prefix, path, depth);  // an array as nested lists, a scalar as its value
     }
     if (py::hasattr(v, "__fspath__")) return fspath(v);
     throw Error(where(prefix, path) + ": cannot use a " + type_name(v) +
@@ -158,7 +164,7 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
 
     // A volume object: its "source" may be a numpy array, written to a temporary raw file.
     auto volume = [&](py::handle v, const std::string& path) -> json {
-        if (!py::isinstance<py::dict>(v)) return to_json(v, "scene: ", path);
+        if (!py::isinstance<py::dict>(v)) return to_json(v, "scene: ", path, 1);
         json j = json::object();
         for (auto item : py::reinterpret_borrow<py::dict>(v)) {
             const std::string key = py::isinstance<py::str>(item.first) ? item.first.cast<std::string>() : "";
@@ -173,7 +179,7 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
             } else {
                 if (key.empty())
                     throw Error("scene: " + path + ": keys must be strings, got " + std::string(py::repr(item.first)));
-                j[key] = to_json(item.second, "scene: ", child(path, key));
+                j[key] = to_json(item.second, "scene: ", child(path, key), 2);
             }
         }
         return j;

@@ -52,7 +52,7 @@ std::vector<std::string> override_strings(pybind11::handle overrides);
 
 // A Python value as JSON (the conversions listed above); messages name it as `prefix` + `path`
 // ("scene: " + "camera.eye"). Throws volref::Error.
-nlohmann::ordered_json to_json(pybind11::handle value, const std::string& prefix, const std::string& path);
+nlohmann::ordered_json to_json(pybind11::handle value, const std::string& prefix, const std::string& path, int depth = 0);
 
 // True for a str or os.PathLike naming a file (not JSON text).
 bool is_path_like(pybind11::handle scene);

@@ -109,4 +109,40 @@ put('fuzz_obj', 'cube.obj', ''.join(f'v {x} {y} {z}\n' for x, y, z in cube_v) +
 put('fuzz_ply', 'cube.ply', 'ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n'
     'property float z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n' +
     ''.join(f'{x} {y} {z}\n' for x, y, z in cube_v) + ''.join(f'3 {a} {b} {c}\n' for a, b, c in cube_f))
+# Issue 32: the bad-input classes, so the fuzzers start next to them (docs/robustness.md).
+# Extreme doubles in numeric keys (each refused: 0 or a magnitude in [1e-100, 1e100]), a NUL, a key twice.
+ml = {'volume': {'source': {'field': 'marschner-lobb', 'dims': [9, 9, 9]},
+                 'transfer': {'opacity': [[0, 0], [1, 0.5]]}},
+      'image': {'width': 8, 'height': 8}}
+for name, patch in [('spacing-1e200', ('volume', 'spacing', [1e200, 1e200, 1e200])),
+                    ('up-1e-200', ('camera', 'up', [1e-200, 1e-200, 0])),
+                    ('step-1e-300', ('render', 'step', 1e-300)),
+                    ('step-1e-90-world', ('render', 'step', 1e-90)),
+                    ('unit-distance-5e-324', ('volume', 'transfer', {'opacity': [[0, 0], [1, 0.5]], 'opacity_unit_distance': 5e-324})),
+                    ('radius-5e-324', ('volume', 'bounds', {'type': 'spherical', 'radius': [0, 5e-324]}))]:
+    scene = json.loads(json.dumps(ml))
+    scene.setdefault(patch[0], {})[patch[1]] = patch[2]
+    if name == 'step-1e-90-world':
+        scene['render']['step_units'] = 'world'
+    put('fuzz_scene', f'extreme-{name}.json', json.dumps(scene))
+put('fuzz_scene', 'nul-then-bytes.json', json.dumps(ml) + '\0garbage')
+put('fuzz_scene', 'duplicate-key.json', '{"image": {"width": 8, "width": 9}, "volume": {"source": {"field": "sphere", "dims": [4, 4, 4]}}}')
+# NIfTI as stored: pixdim 0, vox_offset inside the header, a NaN slope, a NaN sform entry.
+for name, (fmt, off, v) in {'pixdim-0': ('<f', 80, 0.0), 'vox-offset-10': ('<f', 108, 10.0),
+                            'slope-nan': ('<f', 112, float('nan')), 'sform-nan': ('<f', 300, float('nan'))}.items():
+    b = bytearray(h)
+    struct.pack_into(fmt, b, off, v)
+    put('fuzz_nifti', f'{name}.nii', bytes(b) + b'\0\0\0\0' + struct.pack('<8f', *values))
+# Headers that contradict themselves.
+put('fuzz_metaimage', 'offset-vs-origin.mha', 'NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nOffset = 0 0 0\n'
+    'Origin = 1 0 0\nElementDataFile = LOCAL\n' + ''.join(chr(i) for i in range(8)))
+put('fuzz_vtk', 'dimensions-twice.vtk', '# vtk DataFile Version 3.0\nseed\nASCII\nDATASET STRUCTURED_POINTS\n'
+    'DIMENSIONS 2 2 2\nDIMENSIONS 2 2 2\nPOINT_DATA 8\nSCALARS s unsigned_char 1\nLOOKUP_TABLE default\n0 1 2 3 4 5 6 7\n')
+put('fuzz_nrrd', 'space-directions-1e300.nrrd', 'NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n'
+    'space directions: (1e300,0,0) (0,1,0) (0,0,1)\nencoding: ascii\n\n0 1 2 3 4 5 6 7\n')
+# OBJ: a NaN coordinate, a 20-digit index, an mtllib (never opened).
+put('fuzz_obj', 'nan-vertex.obj', 'v nan 0 0\n' + ''.join(f'v {x} {y} {z}\n' for x, y, z in cube_v[1:]) +
+    ''.join(f'f {a + 1} {b + 1} {c + 1}\n' for a, b, c in cube_f))
+put('fuzz_obj', 'huge-index.obj', 'mtllib /dev/zero\n' + ''.join(f'v {x} {y} {z}\n' for x, y, z in cube_v) +
+    'f 1 2 99999999999999999999\n')
 print('seeds written to', CORPUS)

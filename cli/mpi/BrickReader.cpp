@@ -6,6 +6,7 @@
 #include "core/MemoryLimit.h"
 #include "core/io/ByteDecoding.h"
 #include "core/io/NiftiReader.h"
+#include "core/io/VolumeReader.h"
 
 namespace volref::mpi {
 
@@ -16,6 +17,16 @@ VolumeLayout read_volume_header(const std::filesystem::path& path, const std::st
                     ": volref-mpi reads bricks as sub-boxes of uncompressed samples stored in the volume's axis order; "
                     "this file has " + h.not_direct + " (rewrite it with `volref convert " + path.filename().string() +
                     " OUT.raw`)");
+    // Every rank checks that the data file holds the volume (issue 32), as `volref render` does, not only
+    // its own brick: a short file, or one longer than the dims say (NIfTI aside: bytes after its image are
+    // ignored, docs/formats.md), is an error on every rank.
+    const std::uint64_t size = io::check_input_file(h.data, h.data_where);
+    const std::uint64_t voxels = std::uint64_t(h.dims[0]) * std::uint64_t(h.dims[1]) * std::uint64_t(h.dims[2]);
+    const std::uint64_t need = voxels * std::uint64_t(scalar_type_size(h.type));
+    const std::uint64_t found = size < h.offset ? 0 : size - h.offset;
+    if (found < need) throw Error(io::truncated_message(h.data_where, std::size_t(need), std::size_t(found)));
+    if (found > need && volume_format(path, format) != "nifti")
+        throw Error(io::too_long_message(h.data_where, std::size_t(need), std::to_string(found)));
     return h;
 }
 

@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/Error.h"
+#include "core/io/InputFile.h"
 
 namespace volref::compare {
 
@@ -38,6 +39,7 @@ std::string ComparedImage::description() const {
 
 ComparedImage read_compared_image(const std::filesystem::path& path, const std::optional<glm::dvec4>& background) {
     const std::string name = path.string();
+    io::check_input_file(path, name);  // a FIFO or /dev/zero is refused before OpenImageIO opens it
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);  // give the stored values; we premultiply in double
     auto in = OIIO::ImageInput::open(name, &config);

@@ -15,6 +15,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
+#include "core/io/InputFile.h"
 #include "core/explain/Explain.h"
 #include "core/explain/PixelTrace.h"
 #include "core/grid/Volume.h"
@@ -145,8 +146,7 @@ Scene scene_of(const Options& o) {
 
 // --points FILE: a header line, then "x,y,z" per line (blank lines skipped).
 std::vector<glm::dvec3> read_points(const std::string& file) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) throw Error("--points: " + file + ": not a regular file");
+    io::check_whole_file(file, "--points: " + file);
     std::ifstream in(file);
     if (!in) throw Error("--points: " + file + ": cannot be read");
     std::vector<glm::dvec3> out;

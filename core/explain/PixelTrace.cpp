@@ -9,7 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
+#include "core/scene/JsonReader.h"
 #include "core/explain/NumberFormat.h"
 #include "core/render/PreparedScene.h"
 
@@ -105,6 +108,14 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.ray = scene.pixel_ray(x, y);
     t.intervals = scene.intervals(t.ray);
     t.step = v.step;
+    {  // issue 32: every sample is kept (and printed): counted against the memory limit before the march
+        double samples = 0.0;
+        for (const Interval& i : t.intervals) samples += std::ceil(i.length() / t.step) + 1.0;
+        const double bytes = samples * double(sizeof(TracedSample) + conventions::kTraceBytesPerSampleOutput);
+        check_memory(bytes >= 0x1p62 ? std::size_t(1) << 62 : std::size_t(bytes),
+                     "trace: " + std::to_string(std::llround(std::min(samples, 0x1p62))) + " samples of pixel (" +
+                         std::to_string(x) + ", " + std::to_string(y) + ") at render.step " + json_reader::format_number(t.step));
+    }
     t.unit_distance = v.classifier->unit_distance();
     t.projection = r.projection;
     t.order = r.order;

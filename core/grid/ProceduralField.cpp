@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 
 namespace volref {
@@ -77,12 +78,15 @@ void fill_field(const FieldSpec& field, Volume& v, const std::array<std::int64_t
     const Volume& grid = v;
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, v.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
         for (std::int64_t k = r.begin(); k != r.end(); ++k)
-            for (std::int64_t j = 0; j < grid.dims[1]; ++j)
+            for (std::int64_t j = 0; j < grid.dims[1]; ++j) {
+                if (cancel_requested()) return;  // SIGINT / SIGTERM: polled per row, thrown below
                 for (std::int64_t i = 0; i < grid.dims[0]; ++i) {
                     const std::int64_t gi = i + lo[0], gj = j + lo[1], gk = k + lo[2];
                     out[grid.index(i, j, k)] = field_value(field, whole, position(gi, gj, gk), gi, gj, gk);
                 }
+            }
     });
+    throw_if_cancelled();
 }
 
 }  // namespace

@@ -26,8 +26,10 @@
 
 #include <zlib.h>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/grid/Volume.h"
+#include "core/io/InputFile.h"
 
 namespace volref::io {
 
@@ -56,10 +58,9 @@ inline std::string quoted(std::string_view text, std::size_t max_len = 64) {
 using FileHandle = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
 
 // `path` opened for reading; a directory, a missing or an unreadable file is an Error.
+// A FIFO, a device or a socket is refused by type before it is opened (InputFile.h).
 inline FileHandle open_for_reading(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw Error(path.string() + ": cannot read file: it is a directory");
+    check_input_file(path, path.string());
     FileHandle f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
     return f;
@@ -67,11 +68,10 @@ inline FileHandle open_for_reading(const std::filesystem::path& path) {
 
 // The whole contents of the file at `path`.
 inline std::string read_file_bytes(const std::filesystem::path& path) {
+    const std::uint64_t size = check_whole_file(path, path.string());  // a regular file that fits in memory
     FileHandle f = open_for_reading(path);
     std::string bytes;
-    std::error_code ec;
-    const auto size_hint = std::filesystem::file_size(path, ec);
-    if (!ec) bytes.reserve(static_cast<std::size_t>(size_hint));
+    bytes.reserve(static_cast<std::size_t>(size));
     std::vector<char> chunk(std::size_t(1) << 16);
     for (;;) {
         const std::size_t n = std::fread(chunk.data(), 1, chunk.size(), f.get());
@@ -145,6 +145,7 @@ inline Inflated inflate_stream(std::string_view in, std::uint64_t skip, std::siz
         const std::size_t in_pos = static_cast<std::size_t>(zs.next_in - in_base);
         if (zs.avail_in == 0) zs.avail_in = static_cast<uInt>(std::min(kPiece, in.size() - in_pos));
 
+        throw_if_cancelled();  // SIGINT / SIGTERM while inflating (each piece)
         const int ret = inflate(&zs, Z_NO_FLUSH);
         const std::size_t produced = room - zs.avail_out;
         if (skipping)
@@ -292,6 +293,7 @@ inline std::vector<double> decode_ascii_samples(std::string_view text, ScalarTyp
         while (i < text.size() && !is_space(text[i])) ++i;
         if (i == start) break;
         if (values.size() == count) throw Error(too_long_message(where, count, "more", "values"));
+        if (cancel_polled(std::int64_t(values.size()))) throw_if_cancelled();  // SIGINT / SIGTERM while reading
         const std::string_view word = text.substr(start, i - start);
         const std::string at = where + (first_line > 0 ? ": line " + std::to_string(line) : std::string()) +
                                ": ascii sample " + std::to_string(values.size()) + ": ";
@@ -448,6 +450,7 @@ inline std::size_t inflate_into(ByteSource& in, std::uint64_t skip, char* dst, s
         zs.next_out = out;
         zs.avail_out = static_cast<uInt>(want);
         refill();
+        throw_if_cancelled();  // SIGINT / SIGTERM while inflating (each piece)
         const int ret = inflate(&zs, Z_NO_FLUSH);
         const std::size_t produced = want - zs.avail_out;
         if (skipping)

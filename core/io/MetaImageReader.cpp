@@ -101,6 +101,25 @@ public:
             if (const Field* f = find(k)) return f;
         return nullptr;
     }
+    // The first of the synonyms `keys` present; each other one present must say the same (`same` compares
+    // two fields), or the header contradicts itself: an error naming both lines (issue 32).
+    template <class Same>
+    const Field* find_agreeing(std::initializer_list<const char*> keys, Same same) const {
+        const Field* first = nullptr;
+        for (const char* k : keys) {
+            const Field* f = find(k);
+            if (!f) continue;
+            if (!first) {
+                first = f;
+            } else if (!same(*first, *f)) {
+                const Field* a = first->line < f->line ? first : f;
+                const Field* b = a == first ? f : first;
+                throw Error(where_ + ": line " + std::to_string(b->line) + ": " + b->key + " = " + io::quoted(b->value) +
+                            " contradicts " + a->key + " = " + io::quoted(a->value) + " on line " + std::to_string(a->line));
+            }
+        }
+        return first;
+    }
     const Field& require(const char* lower_key, const char* name) const {
         const Field* f = find(lower_key);
         if (!f) throw Error(where_ + ": missing required key '" + name + "'");
@@ -203,15 +222,20 @@ ParsedMetaImage parse_metaimage(const std::filesystem::path& path, const std::st
     p.type = element_type(fields);
     if (const Field* f = fields.find("elementnumberofchannels"); f && fields.integer(*f, 1) != 1)
         fields.fail(*f, "only 1 channel is supported, got " + io::quoted(f->value));
-    if (const Field* f = fields.find_any({"elementspacing", "elementsize"})) {
+    auto same_numbers = [&](std::size_t count) {
+        return [&fields, count](const Field& a, const Field& b) {
+            return fields.numbers(a, count, false) == fields.numbers(b, count, false);
+        };
+    };
+    if (const Field* f = fields.find_agreeing({"elementspacing", "elementsize"}, same_numbers(n))) {
         const auto s = fields.numbers(*f, n, true);
         for (std::size_t a = 0; a < n; ++a) volume.spacing[int(a)] = s[a];
     }
-    if (const Field* f = fields.find_any({"offset", "position", "origin"})) {
+    if (const Field* f = fields.find_agreeing({"offset", "position", "origin"}, same_numbers(n))) {
         const auto o = fields.numbers(*f, n, false);
         for (std::size_t a = 0; a < n; ++a) volume.origin[int(a)] = o[a];
     }
-    if (const Field* f = fields.find_any({"transformmatrix", "rotation", "orientation"})) {
+    if (const Field* f = fields.find_agreeing({"transformmatrix", "rotation", "orientation"}, same_numbers(n * n))) {
         const auto m = fields.numbers(*f, n * n, false);
         for (std::size_t r = 0; r < n; ++r)
             for (std::size_t c = 0; c < n; ++c)
@@ -221,7 +245,9 @@ ParsedMetaImage parse_metaimage(const std::filesystem::path& path, const std::st
     }
     if (const Field* f = fields.find("binarydata"); f && !fields.boolean(*f))
         fields.fail(*f, "ASCII MetaImage data (BinaryData = False) is not supported");
-    if (const Field* f = fields.find_any({"binarydatabyteordermsb", "elementbyteordermsb"})) p.msb = fields.boolean(*f);
+    if (const Field* f = fields.find_agreeing({"binarydatabyteordermsb", "elementbyteordermsb"},
+                                              [&](const Field& a, const Field& b) { return fields.boolean(a) == fields.boolean(b); }))
+        p.msb = fields.boolean(*f);
     if (const Field* f = fields.find("compresseddata")) p.compressed = fields.boolean(*f);
     if (const Field* f = fields.find("compresseddatasize")) p.compressed_size = fields.integer(*f, 0);
     if (const Field* f = fields.find("headersize")) p.header_size = fields.integer(*f, -1);

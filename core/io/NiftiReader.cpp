@@ -78,6 +78,13 @@ NiftiVersion check_header_bytes(const std::filesystem::path& path, const std::st
 struct RawFields {
     std::array<std::int64_t, 8> dim{};
     int datatype = 0;
+    // As stored (nifti_clib replaces a pixdim of 0 by 1 and a vox_offset below the header by its end;
+    // volref checks the values the file holds, issue 32).
+    std::array<double, 8> pixdim{};
+    double vox_offset = 0.0, scl_slope = 0.0, scl_inter = 0.0;
+    bool single_file = true;  // magic n+1 / n+2 (the image follows the header in the same file)
+    int qform_code = 0;
+    std::array<double, 6> quatern{};  // quatern_b, c, d, qoffset_x, y, z
 };
 
 RawFields read_raw_fields(const std::filesystem::path& path, const NiftiVersion& v, const std::string& where) {
@@ -95,10 +102,26 @@ RawFields read_raw_fields(const std::filesystem::path& path, const NiftiVersion&
         const auto* h = static_cast<const nifti_2_header*>(raw);
         for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
         f.datatype = h->datatype;
+        for (int i = 0; i < 8; ++i) f.pixdim[std::size_t(i)] = h->pixdim[i];
+        f.vox_offset = double(h->vox_offset);
+        f.scl_slope = h->scl_slope;
+        f.scl_inter = h->scl_inter;
+        f.single_file = h->magic[1] == '+';
+        f.qform_code = h->qform_code;
+        f.quatern = {double(h->quatern_b), double(h->quatern_c), double(h->quatern_d), double(h->qoffset_x),
+                     double(h->qoffset_y), double(h->qoffset_z)};
     } else {
         const auto* h = static_cast<const nifti_1_header*>(raw);
         for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
         f.datatype = h->datatype;
+        for (int i = 0; i < 8; ++i) f.pixdim[std::size_t(i)] = h->pixdim[i];
+        f.vox_offset = h->vox_offset;
+        f.scl_slope = h->scl_slope;
+        f.scl_inter = h->scl_inter;
+        f.single_file = h->magic[1] == '+';
+        f.qform_code = h->qform_code;
+        f.quatern = {double(h->quatern_b), double(h->quatern_c), double(h->quatern_d), double(h->qoffset_x),
+                     double(h->qoffset_y), double(h->qoffset_z)};
     }
     return f;
 }
@@ -136,20 +159,31 @@ struct Orientation {
     std::string source = "pixdim";
 };
 
-Orientation orientation(const nifti_image& nim, const std::string& where) {
+Orientation orientation(const nifti_image& nim, const std::array<double, 8>& raw_pixdim, int version,
+                        const std::string& where) {
     Orientation o;
     const bool use_sform = nim.sform_code > 0;
     const bool use_qform = !use_sform && nim.qform_code > 0;
     for (int c = 0; c < 3; ++c) {
-        const double p = nim.pixdim[c + 1];
-        if (!use_sform && !(std::isfinite(p) && p != 0.0))
-            throw Error(where + ": pixdim[" + std::to_string(c + 1) + "] must be finite and non-zero, got " +
-                        std::to_string(p));
+        const double p = raw_pixdim[std::size_t(c + 1)];  // as stored: nifti_clib reads 0 as 1
+        if (!use_sform && !(std::isfinite(p) && p != 0.0)) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%g", p);
+            throw Error(where + ": pixdim[" + std::to_string(c + 1) + "] (byte " +
+                        std::to_string((version == 1 ? 76 + 4 * (c + 1) : 104 + 8 * (c + 1))) +
+                        ") must be finite and non-zero, got " + buf);
+        }
         o.spacing[c] = std::fabs(p);
     }
     if (!use_sform && !use_qform) return o;  // NIfTI's method 1: index times pixdim, no origin
     const nifti_dmat44& m = use_sform ? nim.sto_xyz : nim.qto_xyz;
     o.source = use_sform ? "sform" : "qform";
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(m.m[r][c]))
+                throw Error(where + ": the " + o.source + " holds a non-finite number (" +
+                            (use_sform ? std::string("srow_") + char('x' + r) + "[" + std::to_string(c) + "]"
+                                       : std::string("quatern/qoffset")) + ")");
     std::array<bool, 3> taken{false, false, false};
     for (int c = 0; c < 3; ++c) {
         int best = 0;
@@ -229,16 +263,39 @@ ParsedNifti parse_nifti(const std::filesystem::path& path, bool limited) {
     p.file_dims = {raw.dim[1], ndim >= 2 ? raw.dim[2] : 1, ndim >= 3 ? raw.dim[3] : 1};
     p.count = limited ? checked_voxel_count(p.file_dims, where, scalar_type_size(p.type))
                       : checked_voxel_count_unlimited(p.file_dims, where, scalar_type_size(p.type));
-    p.o = orientation(*nim, where);
+    if (raw.qform_code > 0)  // nifti_clib turns a NaN quaternion into some rotation: refuse it as stored
+        for (std::size_t i = 0; i < 6; ++i)
+            if (!std::isfinite(raw.quatern[i])) {
+                static const char* const kNames[6] = {"quatern_b", "quatern_c", "quatern_d", "qoffset_x", "qoffset_y", "qoffset_z"};
+                const int byte = (version.version == 1 ? 256 : 352) + int(i) * (version.version == 1 ? 4 : 8);
+                throw Error(where + ": " + kNames[i] + " (byte " + std::to_string(byte) +
+                            ") must be a finite number (the qform is in use: qform_code > 0)");
+            }
+    p.o = orientation(*nim, raw.pixdim, version.version, where);
 
-    // The image bytes: in the same file after vox_offset (.nii), or in the .img file.
+    // The image bytes: in the same file after vox_offset (.nii), or in the .img file. vox_offset as
+    // stored (nifti_clib moves one inside the header to the header's end): a whole number >= 0, in a
+    // single file not inside the header, and within the image file.
     p.image_path = nim->iname ? std::filesystem::path(nim->iname) : path;
-    if (nim->iname_offset < 0) throw Error(where + ": vox_offset must be >= 0");
-    p.offset = static_cast<std::uint64_t>(nim->iname_offset);
+    const std::string vox_at = where + ": vox_offset (byte " + (version.version == 1 ? "108" : "168") + ") ";
+    char vox_text[64];
+    std::snprintf(vox_text, sizeof vox_text, "%.17g", raw.vox_offset);
+    if (!(std::isfinite(raw.vox_offset) && raw.vox_offset >= 0.0 && raw.vox_offset == std::floor(raw.vox_offset)))
+        throw Error(vox_at + "must be a whole number >= 0, got " + vox_text);
+    if (raw.single_file && raw.vox_offset < double(version.header_size))
+        throw Error(vox_at + "is " + vox_text + ": inside the " + std::to_string(version.header_size) +
+                    "-byte header (the image must follow it)");
+    if (raw.vox_offset > 0x1p62) throw Error(vox_at + "is " + vox_text + ": beyond any file");
+    p.offset = static_cast<std::uint64_t>(raw.vox_offset);
     // nifti_clib's MSB_FIRST (2) is defined only inside the library.
     p.order = nim->byteorder == 2 ? std::endian::big : std::endian::little;
-    p.slope = nim->scl_slope;
-    p.inter = nim->scl_inter;
+    p.slope = raw.scl_slope;  // as stored: nifti_clib drops a non-finite slope silently
+    p.inter = raw.scl_inter;
+    const std::string scl_at = version.version == 1 ? "112" : "176", inter_at = version.version == 1 ? "116" : "184";
+    if (!std::isfinite(p.slope))
+        throw Error(where + ": scl_slope (byte " + scl_at + ") must be a finite number (0: no scaling), got " + std::to_string(p.slope));
+    if (p.slope != 0.0 && !std::isfinite(p.inter))
+        throw Error(where + ": scl_inter (byte " + inter_at + ") must be a finite number, got " + std::to_string(p.inter));
     return p;
 }
 

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
 #include "core/io/VolumeLayout.h"
@@ -510,6 +511,7 @@ std::vector<double> parse_ascii(std::string_view region, std::int64_t byte_skip,
         while (i < region.size() && !is_space(region[i])) ++i;
         if (i == start) break;
         if (values.size() == count) throw Error(io::too_long_message(where, count, "more", "values"));
+        if (cancel_polled(std::int64_t(values.size()))) throw_if_cancelled();  // SIGINT / SIGTERM while reading
         values.push_back(ascii_sample(region.substr(start, i - start), type, values.size(), where));
     }
     if (values.size() < count) throw Error(io::truncated_message(where, count, values.size(), "values"));

@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "core/io/ByteDecoding.h"
 #include "core/io/VolumeLayout.h"
+#include "core/scene/JsonReader.h"
 
 namespace volref {
 
@@ -151,15 +152,9 @@ Sidecar read_sidecar(const std::filesystem::path& sidecar_path, const std::strin
     } catch (const Error& e) {
         throw Error(std::string(e.what()) + " (the JSON sidecar describing " + data_where + ")");
     }
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::exception& e) {
-        std::string what = e.what();
-        for (char& c : what)
-            if (c == '\n' || c == '\r') c = ' ';
-        throw Error(where + ": invalid JSON: " + what);
-    }
+    // The scene's strict parser: a key given twice, a NUL byte, nesting beyond kMaxJsonDepth or a number
+    // beyond a double is an error naming it (issue 32), not the last value silently.
+    const json doc = json_reader::parse_json(text, where + ": invalid JSON");
     return parse_sidecar(doc, SidecarReader(where));
 }
 

@@ -1,9 +1,13 @@
 #include "core/io/VolumeReader.h"
 
+#include <cstdio>
+#include <cmath>
 #include <algorithm>
 #include <string>
 
 #include "core/Error.h"
+#include "core/io/InputFile.h"
+#include "core/Conventions.h"
 #include "core/io/ByteDecoding.h"
 #include "core/io/DenReader.h"
 #include "core/io/MetaImageReader.h"
@@ -57,8 +61,9 @@ std::string volume_format(const std::filesystem::path& path, const std::string& 
     throw Error(path.string() + ": unknown volume format " + io::quoted(format) + " (expected " + kFormats + ")");
 }
 
-Volume read_volume(const std::filesystem::path& path, const std::string& format) {
-    const std::string chosen = volume_format(path, format);
+namespace {
+
+Volume read_by_format(const std::filesystem::path& path, const std::string& chosen) {
     if (chosen == "nrrd") return read_nrrd(path);
     if (chosen == "raw") return read_raw_volume(path);
     if (chosen == "nifti") return read_nifti(path);
@@ -66,6 +71,44 @@ Volume read_volume(const std::filesystem::path& path, const std::string& format)
     if (chosen == "vtk") return read_vtk_legacy(path);
     if (chosen == "vti") return read_vti(path);
     return read_den(path);
+}
+
+}  // namespace
+
+Volume read_volume(const std::filesystem::path& path, const std::string& format) {
+    io::check_input_file(path, path.string());  // a FIFO or a device: refused by type, before its name is read
+    const std::string chosen = volume_format(path, format);
+    Volume v = read_by_format(path, chosen);
+    // issue 32: the grid a header describes lies within volref's number range (conventions::kMaxMagnitude),
+    // like every number of a scene file, so that no ray parameter or position overflows.
+    // the header fields that give them, by format, for the message
+    const char* spacing_field = chosen == "nrrd" ? "space directions / spacings" : chosen == "metaimage" ? "ElementSpacing"
+                              : chosen == "nifti" ? "pixdim / sform / qform" : chosen == "vtk" ? "SPACING"
+                              : chosen == "vti" ? "Spacing" : chosen == "raw" ? "the sidecar's spacing" : "the header's spacing";
+    const char* origin_field = chosen == "nrrd" ? "space origin" : chosen == "metaimage" ? "Offset / Origin / Position"
+                             : chosen == "nifti" ? "sform / qform offset" : chosen == "vtk" ? "ORIGIN"
+                             : chosen == "vti" ? "Origin" : chosen == "raw" ? "the sidecar's origin" : "the header's origin";
+    char buf[64];
+    for (int a = 0; a < 3; ++a) {
+        const double s = v.spacing[a], o = v.origin[a];
+        if (!(s >= conventions::kMinMagnitude && s <= conventions::kMaxMagnitude)) {
+            std::snprintf(buf, sizeof buf, "%.6g", s);
+            throw Error(path.string() + ": " + spacing_field + ": axis " + std::to_string(a) + " has a spacing of " + buf +
+                        ", beyond volref's range (a magnitude in [1e-100, 1e100])");
+        }
+        if (!(std::fabs(o) <= conventions::kMaxMagnitude)) {
+            std::snprintf(buf, sizeof buf, "%.6g", o);
+            throw Error(path.string() + ": " + origin_field + ": axis " + std::to_string(a) + " has an origin of " + buf +
+                        ", beyond volref's range (|x| <= 1e100)");
+        }
+        const double extent = s * double(std::max<std::int64_t>(v.dims[std::size_t(a)] - 1, 1));
+        if (!(std::fabs(o) + extent <= conventions::kMaxMagnitude)) {
+            std::snprintf(buf, sizeof buf, "%.6g", std::fabs(o) + extent);
+            throw Error(path.string() + ": " + spacing_field + ", " + origin_field + ": the grid reaches " + std::string(buf) +
+                        " along axis " + std::to_string(a) + ", beyond volref's range (|x| <= 1e100)");
+        }
+    }
+    return v;
 }
 
 std::uint64_t trailing_samples_offset(const VolumeLayout& layout, std::uint64_t base, std::uint64_t bytes) {

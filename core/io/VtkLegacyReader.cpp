@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <map>
 #include <string>
 #include <string_view>
 
@@ -144,9 +145,15 @@ Volume read_vtk_legacy(const std::filesystem::path& path) {
     bool have_dims = false;
     std::int64_t point_count = -1;
     std::size_t dims_line = 0;
+    std::map<std::string, std::size_t> seen;  // each keyword once: a header that says two things is an error
     for (;;) {
         const std::string_view w = words.next("DIMENSIONS, SPACING, ORIGIN or POINT_DATA");
         const std::string key = upper(w);
+        const std::string slot = key == "ASPECT_RATIO" ? "SPACING" : key;  // synonyms
+        if (const auto it = seen.find(slot); it != seen.end())
+            words.fail(slot + " given twice" + (key != slot ? " (as " + key + ")" : std::string()) + " (first on line " +
+                       std::to_string(it->second) + ")");
+        seen[slot] = words.line();
         if (key == "DIMENSIONS") {
             for (int a = 0; a < 3; ++a)
                 volume.dims[std::size_t(a)] = words.integer("DIMENSIONS", 1);

@@ -2,6 +2,7 @@
 
 #include "transfer/TransferFunction.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -275,6 +276,14 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
     geometry.commit();
     world_box(transform ? &*transform : nullptr, lo, hi, view_lo, view_hi);
+    // issue 32: the samples one ray may take here, before any ray is cast (conventions::kMaxSamplesPerRay):
+    // no interval inside the volume's world box is longer than its diagonal.
+    if (const double diagonal = glm::length(view_hi - view_lo); !(diagonal / step <= conventions::kMaxSamplesPerRay)) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "a step of %.6g world units takes %.3g samples along %s's diagonal of %.6g (at most 2^32 per ray)",
+                      step, diagonal / step, key.c_str(), diagonal);
+        throw Error(std::string("render.step: ") + buf);
+    }
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;

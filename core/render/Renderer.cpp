@@ -23,6 +23,7 @@
 #include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/camera/Camera.h"
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/Integrator.h"
@@ -156,6 +157,9 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         // Step doubling: the image at h, and its error estimate from the image at h / 2.
         RenderOptions single = options;
         single.error_estimate = false;
+        // issue 32: the coarse image is held while the fine one is rendered, and the result is a third:
+        // both renders count two more images against the memory limit (PreparedVolume's check).
+        const HeldMemory images(2 * std::size_t(scene.image.width) * std::size_t(scene.image.height) * 6 * sizeof(double));
         const Image coarse = render_scene(scene, single, stats);
         Scene half = scene;
         half.render.step *= 0.5;
@@ -232,6 +236,20 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     if (stats) stats->frames_s.push_back(std::chrono::duration<double>(Clock::now() - frame_start).count());
     }
     if (stats && options.count_samples) stats->sample_positions = count_sample_positions(prepared, scene, arena);
+    // issue 32: a NaN the scene did not ask for never leaves as a result. A scene asks for NaN in two ways:
+    // a fault pixel (the mirrored program does not finish: fault channel 1), and the vtk-js profile, which
+    // reproduces vtk.js's own (C / A) A, NaN where a ray accumulates A = 0 (its samples below the 0.001 cut-off; conventions
+    // section 9). Any other NaN is refused here, before an image is written, with the first pixel named.
+    if (scene.render.profile != ProfileId::VtkJs)
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            if (prepared.writes_fault() && image.at(x, y, fault_channel) != 0.0) continue;
+            for (std::size_t c = 0; c < 4; ++c)
+                if (std::isnan(image.at(x, y, c)))
+                    throw Error("render: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                                ") came out NaN although the scene asks for no NaN (a volref bug: please report it with "
+                                "the scene); no image written");
+        }
     return image;
 }
 

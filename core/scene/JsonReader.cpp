@@ -72,7 +72,13 @@ public:
     bool boolean(bool v) override { return add(Json(v)) != nullptr; }
     bool number_integer(number_integer_t v) override { return add(Json(v)) != nullptr; }
     bool number_unsigned(number_unsigned_t v) override { return add(Json(v)) != nullptr; }
-    bool number_float(number_float_t v, const string_t&) override { return add(Json(v)) != nullptr; }
+    bool number_float(number_float_t v, const string_t& text) override {
+        // issue 32: 0 or a magnitude in [kMinMagnitude, kMaxMagnitude] (conventions.md, "Extreme numbers")
+        if (v != 0.0 && !(std::fabs(v) <= conventions::kMaxMagnitude && std::fabs(v) >= conventions::kMinMagnitude))
+            ctx_.fail(pending_path(), "the number " + text + " is beyond volref's range (0, or a magnitude in [1e-100, 1e100]: "
+                                      "products of two such numbers stay finite doubles)");
+        return add(Json(v)) != nullptr;
+    }
     bool string(string_t& v) override { return add(Json(std::move(v))) != nullptr; }
     bool binary(binary_t& v) override { return add(Json::binary(std::move(v))) != nullptr; }
 
@@ -218,8 +224,17 @@ std::string display_path(std::string_view path) {
 
 // ---- parsing ----
 
+namespace {
+// JSON is text: a NUL byte (and whatever follows it) is an error naming its byte (issue 32).
+void refuse_nul(const std::string& text, const std::string& name) {
+    if (const auto at = text.find('\0'); at != std::string::npos)
+        throw Error(name + ": byte " + std::to_string(at) + ": a NUL byte (a JSON document is text)");
+}
+}  // namespace
+
 std::optional<Json> try_parse_json(const std::string& text, const std::string& name,
                                    const std::string& base_path) {
+    refuse_nul(text, name);
     const Context ctx(name);
     Json root;
     StrictSax sax(root, text, ctx, base_path);
@@ -228,6 +243,7 @@ std::optional<Json> try_parse_json(const std::string& text, const std::string& n
 }
 
 Json parse_json(const std::string& text, const std::string& name, const std::string& base_path) {
+    refuse_nul(text, name);
     const Context ctx(name);
     Json root;
     StrictSax sax(root, text, ctx, base_path);

@@ -180,6 +180,11 @@ struct ProfileOptions {
     // mip_correction false are conventions `volref compare --fit --scene` tries.
     double jitter = 1.0;
     bool fixed_normal = false, flip_normal = false, ray_box_domain = false, mip_correction = true;
+    // vtk-js (issue 28, part 5): the rasteriser's sub-pixel precision. vtk.js takes each pixel's ray from
+    // the varying interpolated over its proxy quad, whose corners the rasteriser snaps to 1 / 2^bits of a
+    // pixel: 4 (the default) is SwiftShader's (vk::SUBPIXEL_PRECISION_BITS), what the check runs; 0: no
+    // snapping, each ray through its pixel centre.
+    int subpixel_bits = 4;
     double intensity = 1.0;       // glsl-basic: seed 002's K, the sample's alpha is K times the opacity
     // vtk-gpu, glsl-basic, cuda-curvilinear (issues 17, 27; core/integrate/profiles/TextureUnit.h, conventions
     // section 9, "The texture unit"): the profile's linearly filtered texture reads, exact (llvmpipe) or

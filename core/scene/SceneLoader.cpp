@@ -22,6 +22,7 @@
 #include "core/Angles.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/io/InputFile.h"
 #include "core/scene/JsonReader.h"
 
 namespace volref {
@@ -137,15 +138,16 @@ double max_abs(const glm::dvec3& v) { return std::max({std::fabs(v.x), std::fabs
 
 bool all_finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// Relative paths are relative to the scene file's folder; stored absolute (weakly canonical).
+// Relative paths are relative to the scene file's folder; stored absolute and lexically normal, a symbolic
+// link kept as written (its name gives the format, and messages name what the scene names; issue 32).
 fs::path resolve_file(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     const std::string s = read_string(v, path, ctx);
     if (s.empty()) ctx.fail(path, "expected a file path, got \"\"");
     fs::path p(s);
     if (p.is_relative()) p = base_dir / p;
     std::error_code ec;
-    fs::path canonical = fs::weakly_canonical(p, ec);
-    return ec ? p.lexically_normal() : canonical;
+    const fs::path absolute = fs::absolute(p, ec);
+    return (ec ? p : absolute).lexically_normal();
 }
 
 // A non-zero direction, normalised (scaled first, so that tiny or huge components do not under- or
@@ -815,12 +817,13 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                      {"vtk-js", ProfileId::VtkJs}});
     if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
         ObjectReader po(*o, r.path("profile_options"), ctx);
-        po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction"});
+        po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction", "subpixel_bits"});
         s.profile_options.jitter = po.number("jitter", 1.0, Range::closed(0.01, 1.0));
         s.profile_options.fixed_normal = po.boolean("fixed_normal", false);
         s.profile_options.flip_normal = po.boolean("flip_normal", false);
         s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, {{"texel", false}, {"domain", true}});
         s.profile_options.mip_correction = po.boolean("mip_correction", true);
+        s.profile_options.subpixel_bits = int(po.integer("subpixel_bits", 4, Range::closed(0, 23)));
     } else if (const Json* o = r.find("profile_options")) {
         if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic && s.profile != ProfileId::VtkGpu)
             r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu and vtk-js profiles have options");
@@ -869,7 +872,13 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
 std::string read_text(const fs::path& path, const Context& ctx) {
     std::error_code ec;
     if (!fs::exists(path, ec)) ctx.fail_plain("cannot read the scene file: no such file");
-    if (fs::is_directory(path, ec)) ctx.fail_plain("cannot read the scene file: it is a directory");
+    if (const std::string problem = io::input_file_problem(path); !problem.empty())
+        ctx.fail_plain("cannot read the scene file: " + problem);  // a FIFO or a device: refused by type
+    try {
+        io::check_whole_file(path, "the scene file");
+    } catch (const Error& e) {
+        ctx.fail_plain(e.what());
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) ctx.fail_plain(std::string("cannot open the scene file: ") + std::strerror(errno));
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -388,14 +388,16 @@ if a.mode == "memory":
     check_equal("big", scene, 4, extra=["--max-memory", "1536K"])
 
 if a.mode == "failed":
-    # 16 x 16 x 64 u8, split along z; the file holds 40 of the 64 slices: the last brick's rank fails.
+    # 16 x 16 x 64 u8, split along z; the file holds 40 of the 64 slices. Every rank checks the file's size
+    # before reading its brick (issue 32: a rank once read only its own brick and a short file could pass),
+    # so all refuse it; one error line comes out.
     path = write_raw("short", [16, 16, 64], "B", lambda i, j, k: (i + j + k) % 200, truncate_to=16 * 16 * 40)
     scene = write_scene("short", raw_scene(path))
     out = os.path.join(a.work, "short.exr")
     r = mpirun(2, ["render", scene, "-o", out])
     lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
     # mpirun -q: stderr is that one line and nothing else (no line per rank, no launcher notice).
-    if r.returncode == 0 or len(lines) != 1 or "short.raw: the file ends before this rank's brick" not in lines[0] \
+    if r.returncode == 0 or len(lines) != 1 or "short.raw: truncated: expected 16384 bytes of data, found 10240" not in lines[0] \
             or r.stderr.strip().splitlines() != lines or os.path.exists(out):
         failures.append("truncated brick: expected exit != 0, one error line, no image; got %d, %r, image %s"
                         % (r.returncode, r.stderr, os.path.exists(out)))

@@ -351,9 +351,27 @@ def test_explain_with_a_dict_scene_equals_the_file(tmp_path):
 
 # ---- errors: volref.Error, one line, nothing written ------------------------------------------------
 
+def self_referencing_scene(ok_volume):
+    d = {"volume": ok_volume}
+    d["description"] = d  # issue 32: a dict that contains itself once recursed until the stack overflowed
+    return d
+
+
+def deep_list_scene(ok_volume, depth=200000):
+    deep = []
+    for _ in range(depth):
+        deep = [deep]
+    return {"volume": ok_volume, "description": deep}
+
+
 def bad_inputs():
     ok_volume = {"source": np.zeros((4, 5, 6), np.float32), "transfer": {"opacity": [[0, 0], [1, 1]]}}
     return [
+        ("self reference", lambda: volref.render(self_referencing_scene(ok_volume)), "contains itself"),
+        ("deep list", lambda: volref.render(deep_list_scene(ok_volume)), "nested deeper than 256"),
+        ("extreme number", lambda: volref.render({"volume": ok_volume, "render": {"step": 1e-300}}),
+         "scene: render.step: the number 1e-300 is beyond volref's range"),
+        ("device scene", lambda: volref.render("/dev/zero"), "it is a character device"),
         ("unknown key", lambda: volref.render({"volume": ok_volume, "bogus": 1}), "scene: bogus: unknown key"),
         ("missing key", lambda: volref.render({"image": {"width": 8}}), "scene: volume: required"),
         ("missing file", lambda: volref.render({"volume": {"source": "no-such-volume.nrrd"}}), "no-such-volume.nrrd"),

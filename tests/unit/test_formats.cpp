@@ -12,9 +12,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -28,6 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 using volref::ScalarType;
 using volref::Volume;
@@ -676,3 +679,97 @@ TEST_F(Formats, ExplicitFormatOverridesTheExtension) {
 }
 
 }  // namespace
+
+// ======================= issue 32: what a header says, as stored, and once =======================
+
+// NIfTI values as the file holds them (nifti_clib would read pixdim 0 as 1 and a vox_offset inside the
+// header as its end): each refused naming its field and byte.
+TEST_F(Formats, NiftiHeaderFieldsAsStored) {
+    const auto le = std::endian::little;
+    const std::string data(12, 'x');
+    const std::string h = nifti1_header({3, 2, 2}, 2, 8, le);
+    std::string bad = h;
+    put<float>(bad, 80, 0.0f, le);  // pixdim[1]
+    EXPECT_THAT(read_error(write("p0.nii", bad + std::string(4, '\0') + data)),
+                HasSubstr("pixdim[1] (byte 80) must be finite and non-zero, got 0"));
+    bad = h;
+    put<float>(bad, 80, std::numeric_limits<float>::quiet_NaN(), le);
+    EXPECT_THAT(read_error(write("pn.nii", bad + std::string(4, '\0') + data)), HasSubstr("pixdim[1] (byte 80)"));
+    for (float off : {10.0f, 1e30f, 352.5f}) {
+        bad = h;
+        put<float>(bad, 108, off, le);  // vox_offset
+        const std::string m = read_error(write("v.nii", bad + std::string(4, '\0') + data));
+        EXPECT_THAT(m, HasSubstr("vox_offset (byte 108)")) << off;
+    }
+    bad = h;
+    put<float>(bad, 112, std::numeric_limits<float>::quiet_NaN(), le);  // scl_slope
+    EXPECT_THAT(read_error(write("s.nii", bad + std::string(4, '\0') + data)), HasSubstr("scl_slope (byte 112)"));
+    bad = h;
+    put<float>(bad, 112, 2.0f, le);
+    put<float>(bad, 116, std::numeric_limits<float>::infinity(), le);  // scl_inter
+    EXPECT_THAT(read_error(write("i.nii", bad + std::string(4, '\0') + data)), HasSubstr("scl_inter (byte 116)"));
+    bad = h;
+    set_sform(bad, {{{1, 0, 0, 0}, {0, std::numeric_limits<float>::quiet_NaN(), 0, 0}, {0, 0, 1, 0}}}, le);
+    const std::string m = read_error(write("f.nii", bad + std::string(4, '\0') + data));
+    EXPECT_THAT(m, HasSubstr("non-finite number (srow_y[1])"));
+    EXPECT_THAT(m, Not(HasSubstr("oblique")));
+    // NIfTI-2: a negative vox_offset (int64 at byte 168)
+    std::string h2(540, '\0');
+    put<std::int32_t>(h2, 0, 540, le);
+    h2.replace(4, 8, std::string("n+2\0\r\n\x1a\n", 8));
+    put<std::int16_t>(h2, 12, 2, le);
+    put<std::int16_t>(h2, 14, 8, le);
+    const std::int64_t dim[8] = {3, 2, 2, 1, 1, 1, 1, 1};
+    for (int i = 0; i < 8; ++i) put<std::int64_t>(h2, 16 + 8 * std::size_t(i), dim[i], le);
+    for (int i = 0; i < 8; ++i) put<double>(h2, 104 + 8 * std::size_t(i), 1.0, le);
+    put<std::int64_t>(h2, 168, -5, le);
+    EXPECT_THAT(read_error(write("n2.nii", h2 + std::string(4, '\0') + "abcd")), HasSubstr("vox_offset (byte 168) must be a whole number >= 0, got -5"));
+    put<std::int64_t>(h2, 168, 544, le);
+    EXPECT_NO_THROW(volref::read_volume(write("n2ok.nii", h2 + std::string(4, '\0') + "abcd")));
+}
+
+// A header that says one thing twice, or two things, is an error naming both (issue 32).
+TEST_F(Formats, HeadersThatContradictThemselves) {
+    const std::string mha = "NDims = 1\nDimSize = 2\nElementType = MET_UCHAR\n";
+    EXPECT_THAT(read_error(write("o.mha", mha + "Offset = 1\nOrigin = 2\nElementDataFile = LOCAL\nab")),
+                HasSubstr("line 5: Origin = '2' contradicts Offset = '1' on line 4"));
+    EXPECT_THAT(read_error(write("r.mha", mha + "TransformMatrix = 1\nRotation = -1\nElementDataFile = LOCAL\nab")),
+                HasSubstr("contradicts TransformMatrix"));
+    EXPECT_THAT(read_error(write("b.mha", mha + "ElementByteOrderMSB = True\nBinaryDataByteOrderMSB = False\nElementDataFile = LOCAL\nab")),
+                HasSubstr("contradicts ElementByteOrderMSB"));
+    // the same value under both names is one statement
+    EXPECT_NO_THROW(volref::read_volume(write("s.mha", mha + "Offset = 1\nPosition = 1\nElementDataFile = LOCAL\nab")));
+    const std::string vtk = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 1 1\n";
+    EXPECT_THAT(read_error(write("d.vtk", vtk + "DIMENSIONS 2 1 1\nPOINT_DATA 2\nSCALARS s unsigned_char 1\nLOOKUP_TABLE default\n1 2\n")),
+                HasSubstr("DIMENSIONS given twice (first on line 5)"));
+    EXPECT_THAT(read_error(write("s.vtk", vtk + "SPACING 1 1 1\nASPECT_RATIO 2 2 2\nPOINT_DATA 2\nSCALARS s unsigned_char 1\nLOOKUP_TABLE default\n1 2\n")),
+                HasSubstr("SPACING given twice (as ASPECT_RATIO) (first on line 6)"));
+    // a sidecar with "type" twice, or bytes after a NUL
+    write("v.raw", "ab");
+    write("v.raw.json", R"({"dims": [2, 1, 1], "type": "u8", "type": "u16"})");
+    EXPECT_THAT(read_error(dir_ / "v.raw"), HasSubstr("type: duplicate key"));
+    write("v.raw.json", std::string(R"({"dims": [2, 1, 1], "type": "u8"})") + '\0' + "garbage");
+    const std::string m = read_error(dir_ / "v.raw");
+    EXPECT_THAT(m, HasSubstr("v.raw.json"));
+    EXPECT_THAT(m, HasSubstr("NUL byte"));
+}
+
+// Special files are refused by type before they are opened (reading a FIFO without a writer would block).
+TEST_F(Formats, SpecialFilesAreRefusedByType) {
+    const fs::path fifo = dir_ / "v.nrrd";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_THAT(read_error(fifo), HasSubstr("it is a FIFO"));
+    write("h.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 1 1\nencoding: raw\ndata file: v.nrrd\n\n");
+    try {
+        volref::read_volume(dir_ / "h.nhdr");
+        ADD_FAILURE();
+    } catch (const volref::Error& e) {
+        EXPECT_THAT(e.what(), HasSubstr("it is a FIFO"));
+    }
+    try {
+        volref::read_volume("/dev/zero", "raw");
+        ADD_FAILURE();
+    } catch (const volref::Error& e) {
+        EXPECT_THAT(e.what(), HasSubstr("/dev/zero: cannot read file: it is a character device"));
+    }
+}

@@ -383,7 +383,10 @@ TEST(SceneLoaderFull, EnumValues) {
 
 TEST(SceneLoaderFull, LightsAndBounds) {
     EXPECT_TRUE(parse(scene_with(R"("lights": [])")).lights.empty());  // [] means no lights
-    const Scene s = parse(scene_with(R"("lights": [{}, {"type": "directional", "direction": [1e-300, 0, 0]}])"));
+    // the smallest magnitude a number may have (issue 32: 0 or [1e-100, 1e100]) normalises exactly
+    const Scene s = parse(scene_with(R"("lights": [{}, {"type": "directional", "direction": [1e-100, 0, 0]}])"));
+    EXPECT_TRUE(fails_with(scene_with(R"("lights": [{}, {"type": "directional", "direction": [1e-300, 0, 0]}])"),
+                           "lights[1].direction[0]", "the number 1e-300 is beyond volref's range"));
     ASSERT_EQ(s.lights.size(), 2u);
     EXPECT_EQ(s.lights[0].type, LightSpec::Type::Headlight);  // type defaults to headlight
     expect_vec(s.lights[1].direction, 1, 0, 0);
@@ -923,10 +926,11 @@ TEST(SceneLoaderErrors, CameraDegeneracies) {
                            "non-zero"));
     EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "up": [0, 0, -2]})"), "camera.up",
                            "parallel"));
-    EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "eye": [0, 0, 1e-200], "up": [0, 0, 1e200]})"),
+    EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "eye": [0, 0, 1e-100], "up": [0, 0, 1e100]})"),
                            "camera.up", "parallel"));
+    // issue 32: beyond [1e-100, 1e100] a number is refused where it stands (target - eye no longer overflows)
     EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "eye": [0, 0, -1e308], "target": [0, 0, 1e308]})"),
-                           "camera.target", "overflows"));
+                           "camera.eye[2]", "the number -1e308 is beyond volref's range"));
     EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "fov_y": 180})"), "camera.fov_y",
                            "expected a number in (0, 180), got 180"));
     EXPECT_TRUE(fails_with(scene_with(R"("camera": {"type": "perspective", "fov_y": 0})"), "camera.fov_y", "(0, 180)"));

@@ -165,3 +165,29 @@ TEST(VtkJsProfile, SceneOptionsAndErrors) {
         EXPECT_NE(std::string(e.what()).find("node range"), std::string::npos) << e.what();
     }
 }
+
+// The pixel's ray as the rasteriser interpolates it over vtk.js's snapped proxy quad (issue 28, part 5).
+// One orthographic pixel, height 0.01, eye x = 3.5005 over the texel box [-0.5, 7.5]: the quad spans
+// window x [-399.55, 400.45], snapped to 1/16: [-399.5625, 400.4375], so the pixel centre 0.5 gets the
+// varying of -399.55 + 400.0625 * 800 / 800 = 0.5125: the ray at x = 3.5005 + 0.0125 * 0.01 = 3.500625.
+// f = x, MIP: the pixel reads the table at the ray's x. subpixel_bits 0: through the pixel centre.
+TEST(VtkJsProfile, RayThroughTheSnappedProxyQuad) {
+    auto scene = [](double eye_x, int bits) {
+        Scene s = field_scene(linear_field({1, 0, 0, 0}, {8, 8, 8}));
+        s.volume().transfer.color = {{0, 1, 1, 1}, {8, 1, 1, 1}};
+        s.volume().transfer.opacity = {{0, 0}, {8, 0.8}};
+        s.camera = ortho_down_z(eye_x, 3.5, 20.0, 0.01);
+        s.image.width = s.image.height = 1;
+        s.render.projection = Projection::Mip;
+        s.render.step = 0.5;
+        s.render.step_units = StepUnits::World;
+        s.render.profile = ProfileId::VtkJs;
+        s.render.profile_options.subpixel_bits = bits;
+        return s;
+    };
+    const double snapped = pixel(scene(3.5005, 4)).a;
+    EXPECT_NEAR(snapped, pixel(scene(3.500625, 0)).a, 1e-12);
+    EXPECT_GT(std::abs(snapped - pixel(scene(3.5005, 0)).a), 1e-6);
+    // A quad whose corners lie on the grid (eye x = 3.5: [-399.5, 400.5]) leaves the ray at the centre.
+    EXPECT_NEAR(pixel(scene(3.5, 4)).a, pixel(scene(3.5, 0)).a, 1e-12);
+}

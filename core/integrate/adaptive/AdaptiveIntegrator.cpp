@@ -7,6 +7,7 @@
 #include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/CellCubic.h"
@@ -78,6 +79,7 @@ void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<do
     out.clear();
     if (!cut_cells_) {  // beam space: the fixed integrator's segment ends
         const std::int64_t n = segment_count(iv, ctx_.step);
+        check_memory(std::size_t(n + 1) * sizeof(double), "render.step: the adaptive integrator's cuts of one interval");
         out.push_back(iv.t0);
         for (std::int64_t k = 0; k < n; ++k) out.push_back(segment(iv, ctx_.step, k, n).t1);
         if (shell_grid_) sampled_shell_cuts(ray, out);

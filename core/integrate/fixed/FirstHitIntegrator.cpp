@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "core/Conventions.h"
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/CellCubic.h"
@@ -82,7 +83,7 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
             hit = ta;
             break;
         }
-        for (std::int64_t k = 0; k < n && !hit; ++k) {
+        for (std::int64_t k = 0; k < n && !hit && !cancel_polled(k); ++k) {
             const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
             hit = bracket_crossing(g, trilinear_, ray, ta, ga, tb, gb, iso, iv.length());
             ta = tb;

@@ -23,6 +23,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/Cancellation.h"
+#include "core/Conventions.h"
 #include "core/camera/Ray.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/sample/MacrocellGrid.h"
@@ -77,8 +79,13 @@ public:
         maximum_ = maximum;
     }
 
-    // The next segment to visit; false after the last.
+    // The next segment to visit; false after the last, or once SIGINT / SIGTERM is requested (polled every
+    // conventions::kCancellationPollSamples segments: the render is then abandoned, Cancellation.h).
     bool next(Segment& s) {
+        if (++polled_ >= conventions::kCancellationPollSamples) {
+            polled_ = 0;
+            if (cancel_requested()) return false;
+        }
         if (k_ >= end_ && !advance()) return false;
         s = segment((*intervals_)[iv_], step_, k_, n_);
         ++k_;
@@ -92,12 +99,17 @@ public:
         const Interval* iv;
         std::int64_t k, end, n;
     };
+    // A run is at most kMaxRun segments (a longer one comes as several, the same segments in the same
+    // order), so that cancellation is polled between runs.
     bool next_run(Run& r) {
+        if (cancel_requested()) return false;
         if (k_ >= end_ && !advance()) return false;
-        r = {&(*intervals_)[iv_], k_, end_, n_};
-        k_ = end_;
+        const std::int64_t end = end_ - k_ > kMaxRun ? k_ + kMaxRun : end_;
+        r = {&(*intervals_)[iv_], k_, end, n_};
+        k_ = end;
         return true;
     }
+    static constexpr std::int64_t kMaxRun = 16 * conventions::kCancellationPollSamples;
 
 private:
     static constexpr std::int64_t kMinVisitedRun = 16;
@@ -174,6 +186,7 @@ private:
     double step_ = 1.0;
     std::size_t iv_ = 0;
     std::int64_t k_ = 0, n_ = 0, end_ = 0;  // segments [k_, end_) are to be visited
+    std::int64_t polled_ = 0;               // segments since cancellation was last polled
 };
 
 }  // namespace volref

@@ -5,6 +5,7 @@
 #include <limits>
 #include <tuple>
 
+#include "core/Cancellation.h"
 #include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/march/CompensatedSum.h"
@@ -199,7 +200,7 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         bool done = false;
         for (const Piece& p : ps) {
             const std::int64_t n = segment_count(p.span, step_);
-            for (std::int64_t k = 0; k < n && !done; ++k) {
+            for (std::int64_t k = 0; k < n && !done && !cancel_polled(k); ++k) {
                 const MixedSegment m = mix(p.present, segment(p.span, step_, k, n));
                 if (!m.opaque && !(m.tau > 0.0)) continue;
                 add(acc, m);
@@ -212,7 +213,7 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         BackToFront<Scalar> acc;
         for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
             const std::int64_t n = segment_count(it->span, step_);
-            for (std::int64_t k = n - 1; k >= 0; --k) {
+            for (std::int64_t k = n - 1; k >= 0 && !cancel_polled(n - 1 - k); --k) {
                 const MixedSegment m = mix(it->present, segment(it->span, step_, k, n));
                 if (m.opaque || m.tau > 0.0) add(acc, m);
             }

@@ -11,6 +11,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
@@ -361,13 +362,13 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
         span.t1 = intervals.back().t1;
         const double n = from_entry_count(span, h, 0.0);
         for (double k = 0.0; k < n; k += 1.0)
-            if (!fn(span.t1 - k * h, h)) return;
+            if (cancel_polled(std::int64_t(k)) || !fn(span.t1 - k * h, h)) return;
         return;
     }
     for (const Interval& iv : intervals) {
         const double n = from_entry_count(iv, h, p_.first);
         for (double k = 0.0; k < n; k += 1.0)
-            if (!fn(from_entry_sample(iv, h, p_.first, k), h)) return;
+            if (cancel_polled(std::int64_t(k)) || !fn(from_entry_sample(iv, h, p_.first, k), h)) return;
     }
 }
 

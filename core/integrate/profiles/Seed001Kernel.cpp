@@ -13,6 +13,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/grid/Volume.h"
 #include "core/integrate/profiles/TextureUnit.h"
@@ -360,6 +361,7 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
         std::array<float, 4> sum{0.0f, 0.0f, 0.0f, 0.0f};
         float max_val = 0.0f;
         for (float s = sp.out_abs; s >= in; s -= f_.step) {
+            if (cancel_polled(px.samples)) break;  // SIGINT / SIGTERM: the render is abandoned
             const F3 point = along(O, s, V);
             const float sample = sample_at(point);
             const bool used = sample >= f_.iso;

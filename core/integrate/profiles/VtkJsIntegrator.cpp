@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
@@ -87,7 +89,45 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
 
     switch (scene.camera.type) {
         case CameraSpec::Type::Perspective:
-        case CameraSpec::Type::Orthographic: forward_ = glm::normalize(scene.camera.target - scene.camera.eye); break;
+        case CameraSpec::Type::Orthographic:
+            forward_ = glm::normalize(scene.camera.target - scene.camera.eye);
+            // The proxy quad (issue 28, part 5): the window rectangle of the texel box's corners (VolumeMapper.js
+            // setCameraShaderParameters: boundsDC of getBounds(), the spatial extent, whatever ray_box says).
+            // The camera basis and projection as core/camera/Camera.cpp builds the pixel rays.
+            if (o.subpixel_bits > 0) {
+                orthographic_ = scene.camera.type == CameraSpec::Type::Orthographic;
+                eye_ = scene.camera.eye;
+                right_ = glm::normalize(glm::cross(forward_, scene.camera.up));
+                up_ = glm::cross(right_, forward_);
+                tan_half_fov_ = std::tan(scene.camera.fov_y * std::numbers::pi / 360.0);
+                half_height_ = scene.camera.height / 2.0;
+                image_ = glm::dvec2(double(scene.image.width), double(scene.image.height));
+                aspect_ = image_.x / image_.y;
+                const glm::dvec3 lo = domain_lo_ - half, hi = domain_hi_ + half;
+                quad_lo_ = glm::dvec2(std::numeric_limits<double>::infinity());
+                quad_hi_ = -quad_lo_;
+                snap_ = true;
+                for (int k = 0; k < 8; ++k) {
+                    const glm::dvec3 c = glm::dvec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - eye_;
+                    const double z = glm::dot(c, forward_);
+                    // A corner at or behind the eye's plane: vtk.js's quad is then unbounded; not mirrored
+                    // (the rays stay at the pixel centres).
+                    if (!orthographic_ && !(z > 0.0)) snap_ = false;
+                    const double sx = orthographic_ ? half_height_ * aspect_ : z * tan_half_fov_ * aspect_;
+                    const double sy = orthographic_ ? half_height_ : z * tan_half_fov_;
+                    const glm::dvec2 w = 0.5 * (glm::dvec2(glm::dot(c, right_) / sx, glm::dot(c, up_) / sy) + 1.0) * image_;
+                    quad_lo_ = glm::min(quad_lo_, w);
+                    quad_hi_ = glm::max(quad_hi_, w);
+                }
+                // RoundInt of the fixed-point position: to nearest, ties to even.
+                const double f = std::ldexp(1.0, o.subpixel_bits);
+                for (int a = 0; a < 2; ++a) {
+                    snapped_lo_[a] = std::nearbyint(quad_lo_[a] * f) / f;
+                    snapped_hi_[a] = std::nearbyint(quad_hi_[a] * f) / f;
+                    if (!(snapped_hi_[a] > snapped_lo_[a])) snap_ = false;  // no fragments: nothing to mirror
+                }
+            }
+            break;
         case CameraSpec::Type::Matrices:
             forward_ = -glm::normalize(glm::dvec3(scene.camera.view[0][2], scene.camera.view[1][2], scene.camera.view[2][2]));
             break;
@@ -150,6 +190,39 @@ bool VtkJsIntegrator::box(const Ray& ray, double& t0, double& t1) const {
     return t1 > t0 && t1 > 0.0;
 }
 
+// The ray vtk.js casts through the pixel whose centre `ray` passes through (issue 28, part 5): the
+// rasteriser interpolates vertexVCVSOutput (the quad's corners unprojected onto the near plane,
+// vtkVolumeVS.glsl) over the quad as snapped to its sub-pixel grid (SwiftShader SetupRoutine: the plane
+// equations are set up from the fixed-point corners X, Y and the corners' own varyings). Per axis the
+// pixel at window position p gets the varying of lo + (p - snap(lo)) (hi - lo) / (snap(hi) - snap(lo));
+// the fragment shader casts from that point (normalize(vertexVCVSOutput) in perspective, -z in parallel
+// projection). Same line as the ray through that window point from the eye (or the eye's plane).
+Ray VtkJsIntegrator::rasterised(const Ray& ray) const {
+    glm::dvec2 ndc;
+    if (orthographic_) {
+        const glm::dvec3 c = ray.origin - eye_;
+        ndc = glm::dvec2(glm::dot(c, right_) / (half_height_ * aspect_), glm::dot(c, up_) / half_height_);
+    } else {
+        const double z = glm::dot(ray.direction, forward_);
+        ndc = glm::dvec2(glm::dot(ray.direction, right_) / (z * tan_half_fov_ * aspect_),
+                         glm::dot(ray.direction, up_) / (z * tan_half_fov_));
+    }
+    for (int a = 0; a < 2; ++a) {
+        const double p = 0.5 * (ndc[a] + 1.0) * image_[a];
+        const double u = quad_lo_[a] + (p - snapped_lo_[a]) * (quad_hi_[a] - quad_lo_[a]) / (snapped_hi_[a] - snapped_lo_[a]);
+        ndc[a] = 2.0 * u / image_[a] - 1.0;
+    }
+    Ray r;
+    if (orthographic_) {
+        r.origin = eye_ + (ndc.x * half_height_ * aspect_) * right_ + (ndc.y * half_height_) * up_;
+        r.direction = forward_;
+    } else {
+        r.origin = ray.origin;
+        r.direction = glm::normalize(forward_ + (ndc.x * tan_half_fov_ * aspect_) * right_ + (ndc.y * tan_half_fov_) * up_);
+    }
+    return r;
+}
+
 // getColorForDependentComponents (one component): the tables, the drop below EPSILON = 0.001, then
 // applyAllLightning -> applySurfaceShadowLighting when the scene is shaded.
 VtkJsIntegrator::Sample VtkJsIntegrator::color_at(const glm::dvec3& x, const glm::dvec3& ray_dir) const {
@@ -203,6 +276,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
     Ray ray = ray_in;
     const double dl = glm::length(ray.direction);
     ray.direction /= dl;  // t below in world units along a unit direction
+    if (snap_) ray = rasterised(ray);
     double t0 = 0.0, t1 = 0.0;
     if (!box(ray, t0, t1)) return out;  // the fragment is discarded: the background stays
     const double h = step_;
@@ -247,6 +321,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         double travelled = j;
         bool stopped = false;
         while (travelled + 1.0 < R) {
+            if (cancel_polled(std::int64_t(travelled))) break;  // SIGINT / SIGTERM: the render is abandoned
             const double t = t0 + travelled * h;
             const Sample s = color_at(ray.at(t), d);
             add(s, s.alpha);
@@ -281,6 +356,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
     if (R > 1.0) {
         double travelled = j;
         while (travelled + 1.0 < R) {
+            if (cancel_polled(std::int64_t(travelled))) break;
             const double v = value(ray.at(t0 + travelled * h));
             if (better(v, best)) best = v;
             record(t0 + travelled * h, 0.0, glm::dvec4(0.0));

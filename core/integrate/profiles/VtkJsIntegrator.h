@@ -3,6 +3,13 @@
 // npm @kitware/vtk.js) reproduced as shipped, in double arithmetic, from the scene volref renders.
 // docs/conventions.md section 9, "vtk-js", states every formula with the vtk.js lines it follows; in
 // short (h the step in world units, l the opacity unit distance, n the dims, s the spacing):
+//   - each pixel's ray is the one vtk.js's rasteriser interpolates (issue 28, part 5): vtk.js draws a
+//     screen-space quad over the window rectangle of the texel box's 8 projected corners
+//     (VolumeMapper.js boundsDC, vtkVolumeVS.glsl) and takes the ray origin and direction from the
+//     varying vertexVCVSOutput; the rasteriser snaps the quad's corners to 1 / 2^b of a pixel
+//     (profile_options.subpixel_bits b, 4 as SwiftShader) but interpolates the corners' unsnapped
+//     values, so the ray of the pixel at window position p (per axis) passes through
+//     lo + (p - snap(lo)) (hi - lo) / (snap(hi) - snap(lo)), up to 2^-(b+1) pixel from the centre;
 //   - the ray box is the texel box [o - s/2, o + (n - 1/2) s] (ImageData.getSpatialExtent inflates the
 //     extent by 0.5); positions outside the domain read it clamped (CLAMP_TO_EDGE);
 //   - R = (t_exit - t_entry) / h steps; a first sample at the entry with alpha 1 - (1 - a)^j (j the jitter,
@@ -54,6 +61,7 @@ private:
     Sample color_at(const glm::dvec3& x, const glm::dvec3& ray_dir) const;
     glm::dvec3 shade(const glm::dvec3& c, const glm::dvec3& x, const glm::dvec3& ray_dir) const;
     bool box(const Ray& ray, double& t0, double& t1) const;
+    Ray rasterised(const Ray& ray) const;  // the pixel's ray as the snapped proxy quad interpolates it
 
     template <class Rec>
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
@@ -67,6 +75,12 @@ private:
     std::vector<double> opacity_table_;      // corrected for the step (as uploaded)
     std::vector<double> opacity_raw_table_;  // uncorrected (mip_correction false)
     bool flip_normal_ = false;
+    // The camera as vtk.js's proxy quad sees it (perspective or orthographic scene cameras only), and the
+    // quad's window rectangle per axis (x right, y up, in pixels), unsnapped and snapped.
+    bool snap_ = false, orthographic_ = false;
+    glm::dvec3 eye_{0.0}, right_{0.0}, up_{0.0};
+    double tan_half_fov_ = 0.0, half_height_ = 0.0, aspect_ = 1.0;
+    glm::dvec2 image_{1.0}, quad_lo_{0.0}, quad_hi_{0.0}, snapped_lo_{0.0}, snapped_hi_{0.0};
 };
 
 }  // namespace volref

@@ -97,32 +97,22 @@ RawFields read_raw_fields(const std::filesystem::path& path, const NiftiVersion&
     const std::int32_t size_field = nver == 2 ? static_cast<const nifti_2_header*>(raw)->sizeof_hdr
                                               : static_cast<const nifti_1_header*>(raw)->sizeof_hdr;
     if (size_field != (nver == 2 ? 540 : 348)) swap_nifti_header(raw, nver);
+    // The same field names in both versions (NIfTI-2 widens them to 64 bits).
     RawFields f;
-    if (nver == 2) {
-        const auto* h = static_cast<const nifti_2_header*>(raw);
-        for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
+    auto copy = [&f](const auto* h) {
+        for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = std::int64_t(h->dim[i]);
         f.datatype = h->datatype;
-        for (int i = 0; i < 8; ++i) f.pixdim[std::size_t(i)] = h->pixdim[i];
+        for (int i = 0; i < 8; ++i) f.pixdim[std::size_t(i)] = double(h->pixdim[i]);
         f.vox_offset = double(h->vox_offset);
-        f.scl_slope = h->scl_slope;
-        f.scl_inter = h->scl_inter;
+        f.scl_slope = double(h->scl_slope);
+        f.scl_inter = double(h->scl_inter);
         f.single_file = h->magic[1] == '+';
         f.qform_code = h->qform_code;
         f.quatern = {double(h->quatern_b), double(h->quatern_c), double(h->quatern_d), double(h->qoffset_x),
                      double(h->qoffset_y), double(h->qoffset_z)};
-    } else {
-        const auto* h = static_cast<const nifti_1_header*>(raw);
-        for (int i = 0; i < 8; ++i) f.dim[std::size_t(i)] = h->dim[i];
-        f.datatype = h->datatype;
-        for (int i = 0; i < 8; ++i) f.pixdim[std::size_t(i)] = h->pixdim[i];
-        f.vox_offset = h->vox_offset;
-        f.scl_slope = h->scl_slope;
-        f.scl_inter = h->scl_inter;
-        f.single_file = h->magic[1] == '+';
-        f.qform_code = h->qform_code;
-        f.quatern = {double(h->quatern_b), double(h->quatern_c), double(h->quatern_d), double(h->qoffset_x),
-                     double(h->qoffset_y), double(h->qoffset_z)};
-    }
+    };
+    if (nver == 2) copy(static_cast<const nifti_2_header*>(raw));
+    else copy(static_cast<const nifti_1_header*>(raw));
     return f;
 }
 

@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -60,6 +61,27 @@ double chord_sample(int k) {
     if (angle < 0.0) angle += 360.0;
     if (4.0 * r > 3.0 || angle / 45.0 > 7.0) return 0.0;
     return std::clamp(4.0 * r - 0.5, 0.0, 3.0) / 3.0;
+}
+
+// A random cylinder (`dims` cells of uniform values, 300 degrees, 24 segments) seen from a random
+// perspective eye, 8 x 8 pixels, composite or x-ray, through the cuda-curvilinear profile with `options`.
+Scene random_cylinder_scene(std::mt19937_64& g, std::array<int, 3> dims, bool xray, const std::string& options) {
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    std::string values;
+    for (int k = 0; k < dims[0] * dims[1] * dims[2]; ++k) values += (values.empty() ? "" : ", ") + std::to_string(U(g));
+    const double th = 6.283185307179586 * U(g), ph = 0.4 + 0.8 * U(g);
+    char eye[128], dim[64];
+    std::snprintf(eye, sizeof eye, "[%.17g, %.17g, %.17g]", 4.0 * std::cos(th) * std::sin(ph), 0.5 + 4.0 * std::cos(ph),
+                  4.0 * std::sin(th) * std::sin(ph));
+    std::snprintf(dim, sizeof dim, "[%d, %d, %d]", dims[0], dims[1], dims[2]);
+    const std::string json = R"({"volume": {"source": {"field": "cells", "dims": )" + std::string(dim) + R"(, "values": [)" + values + R"(]},
+           "bounds": {"type": "cylindrical", "center": [0, 0, 0], "radius": [0, 1], "angle": [0, 300], "height": [0, 1], "tessellate": 24},
+           "transfer": {"color": [[0, 1, 0.2, 0], [1, 0, 0.5, 1]], "opacity": [[0, 0.05], [0.5, 0.4], [1, 0.9]]}},
+          "camera": {"type": "perspective", "eye": )" + std::string(eye) + R"(, "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40},
+          "image": {"width": 8, "height": 8},
+          "render": {"projection": ")" + std::string(xray ? "xray" : "composite") + R"(", "step": 0.05, "step_units": "world",
+                     "profile": "cuda-curvilinear", "profile_options": {"iso_threshold": 0.1, "density": 0.7)" + options + "}}}";
+    return parse_scene(json, ".", "t");
 }
 
 }  // namespace
@@ -172,23 +194,9 @@ TEST(Seed001Kernel, ErrorsNameTheKey) {
 // h100 one, on random cylinders and perspective views (8 x 8 pixels), composite and x-ray.
 TEST(Seed001Kernel, BandHoldsTheOtherUnit) {
     std::mt19937_64 g(28);
-    std::uniform_real_distribution<double> U(0.0, 1.0);
     double used = 0.0;
     for (int trial = 0; trial < 6; ++trial) {
-        std::string values;
-        for (int k = 0; k < 4 * 6 * 3; ++k) values += (values.empty() ? "" : ", ") + std::to_string(U(g));
-        const double th = 6.283185307179586 * U(g), ph = 0.4 + 0.8 * U(g);
-        char eye[128];
-        std::snprintf(eye, sizeof eye, "[%.17g, %.17g, %.17g]", 4.0 * std::cos(th) * std::sin(ph), 0.5 + 4.0 * std::cos(ph),
-                      4.0 * std::sin(th) * std::sin(ph));
-        const std::string json = R"({"volume": {"source": {"field": "cells", "dims": [4, 6, 3], "values": [)" + values + R"(]},
-               "bounds": {"type": "cylindrical", "center": [0, 0, 0], "radius": [0, 1], "angle": [0, 300], "height": [0, 1], "tessellate": 24},
-               "transfer": {"color": [[0, 1, 0.2, 0], [1, 0, 0.5, 1]], "opacity": [[0, 0.05], [0.5, 0.4], [1, 0.9]]}},
-              "camera": {"type": "perspective", "eye": )" + std::string(eye) + R"(, "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40},
-              "image": {"width": 8, "height": 8},
-              "render": {"projection": ")" + std::string(trial % 2 ? "xray" : "composite") + R"(", "step": 0.05, "step_units": "world",
-                         "profile": "cuda-curvilinear", "profile_options": {"iso_threshold": 0.1, "density": 0.7}}})";
-        Scene s = parse_scene(json, ".", "t");
+        Scene s = random_cylinder_scene(g, {4, 6, 3}, trial % 2 == 1, "");
         s.render.profile_options.texture_unit = ProfileOptions::TextureUnit::H100;
         s.render.profile_options.texture_band = true;
         const Image h = render_scene(s, {1, false});
@@ -300,23 +308,9 @@ TEST(Seed001Kernel, TricubicChordByHand) {
 // The band holds the tri-cubic kernel through the other unit (BandHoldsTheOtherUnit's scenes).
 TEST(Seed001Kernel, TricubicBandHoldsTheOtherUnit) {
     std::mt19937_64 g(281);
-    std::uniform_real_distribution<double> U(0.0, 1.0);
     double used = 0.0;
     for (int trial = 0; trial < 4; ++trial) {
-        std::string values;
-        for (int k = 0; k < 5 * 6 * 4; ++k) values += (values.empty() ? "" : ", ") + std::to_string(U(g));
-        const double th = 6.283185307179586 * U(g), ph = 0.4 + 0.8 * U(g);
-        char eye[128];
-        std::snprintf(eye, sizeof eye, "[%.17g, %.17g, %.17g]", 4.0 * std::cos(th) * std::sin(ph), 0.5 + 4.0 * std::cos(ph),
-                      4.0 * std::sin(th) * std::sin(ph));
-        const std::string json = R"({"volume": {"source": {"field": "cells", "dims": [5, 6, 4], "values": [)" + values + R"(]},
-               "bounds": {"type": "cylindrical", "center": [0, 0, 0], "radius": [0, 1], "angle": [0, 300], "height": [0, 1], "tessellate": 24},
-               "transfer": {"color": [[0, 1, 0.2, 0], [1, 0, 0.5, 1]], "opacity": [[0, 0.05], [0.5, 0.4], [1, 0.9]]}},
-              "camera": {"type": "perspective", "eye": )" + std::string(eye) + R"(, "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40},
-              "image": {"width": 8, "height": 8},
-              "render": {"projection": ")" + std::string(trial % 2 ? "xray" : "composite") + R"(", "step": 0.05, "step_units": "world",
-                         "profile": "cuda-curvilinear", "profile_options": {"iso_threshold": 0.1, "density": 0.7, "tricubic": true}}})";
-        Scene s = parse_scene(json, ".", "t");
+        Scene s = random_cylinder_scene(g, {5, 6, 4}, trial % 2 == 1, R"(, "tricubic": true)");
         s.render.profile_options.texture_unit = ProfileOptions::TextureUnit::H100;
         s.render.profile_options.texture_band = true;
         const Image h = render_scene(s, {1, false});

@@ -223,6 +223,16 @@ Ray VtkJsIntegrator::rasterised(const Ray& ray) const {
     return r;
 }
 
+namespace {
+
+// GLSL pow(x, e) in the shader as SwiftShader evaluates it (issue 28, part 5): exp2(e log2(x)) with
+// log2(0) = -127, so pow(0, e) = 2^(-127 e) and not 0: a sample whose table opacity is exactly 1 counts
+// 1 - 2^(-127 e) for a fraction e of a step (measured: e = 0.00262 gives 0.206 where pow would give 1).
+// For x > 0 the correctly rounded pow (SwiftShader's is within a few float ulps of it).
+double glsl_pow(double x, double e) { return x > 0.0 ? std::pow(x, e) : std::exp2(-127.0 * e); }
+
+}  // namespace
+
 // getColorForDependentComponents (one component): the tables, the drop below EPSILON = 0.001, then
 // applyAllLightning -> applySurfaceShadowLighting when the scene is shaded.
 VtkJsIntegrator::Sample VtkJsIntegrator::color_at(const glm::dvec3& x, const glm::dvec3& ray_dir) const {
@@ -304,7 +314,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         const glm::dvec3 d = ray.direction;
         Sample first = color_at(ray.at(t0), d);
         if (R <= 1.0) {  // "handle very thin volumes": the entry sample alone, alpha for R steps
-            const double a = 1.0 - std::pow(1.0 - first.alpha, R);
+            const double a = 1.0 - glsl_pow(1.0 - first.alpha, R);
             out.rgba = glm::dvec4(first.color * a, a);
             record(t0, a, out.rgba);
             return out;
@@ -316,7 +326,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
             acc.add(true, false, 0.0, a, c);
         };
         auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
-        add(first, 1.0 - std::pow(1.0 - first.alpha, j));  // the first sample counts for `jitter` of a step
+        add(first, 1.0 - glsl_pow(1.0 - first.alpha, j));  // the first sample counts for `jitter` of a step
         record(t0, acc.alpha(), accumulated());
         double travelled = j;
         bool stopped = false;
@@ -336,7 +346,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         }
         if (!stopped && acc.alpha() < 0.99 && R - travelled > 0.0) {  // the exit sample, for the remaining fraction
             const Sample s = color_at(ray.at(t1), d);
-            const double a = 1.0 - std::pow(1.0 - s.alpha, R - travelled);
+            const double a = 1.0 - glsl_pow(1.0 - s.alpha, R - travelled);
             add(s, a);
             record(t1, a, accumulated());
         }

@@ -6,10 +6,8 @@
 // A beam-space output carries its shell in the header as the key/value pair
 //   volref_bounds:={"type": "cylindrical", ...}
 // (the scene's volume.bounds object), which `--to cartesian` reads back when --shell is absent.
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <optional>
@@ -131,14 +129,11 @@ std::string shell_json(const BoundsSpec& s) {
 }
 
 std::string read_text_file(const fs::path& path, const std::string& why) {
-    if (const std::string problem = io::input_file_problem(path); !problem.empty())
-        throw Error(path.string() + ": cannot read file: " + problem + why);
-    io::check_whole_file(path, path.string());
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot read file: " + std::strerror(errno) + why);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    try {
+        return io::read_file_bytes(path);  // a regular file that fits the memory limit
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + why);
+    }
 }
 
 // The value of key `key` in a NRRD header (unescaped), or "" when absent or not a NRRD file.

@@ -5,7 +5,6 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
@@ -107,12 +106,7 @@ private:
 }  // namespace
 
 TriangleMesh read_ply_mesh(const std::string& path) {
-    io::check_whole_file(path, path);
-    std::ifstream file(path, std::ios::binary);
-    if (!file) throw Error(path + ": cannot read the PLY file");
-    std::ostringstream ss;
-    ss << file.rdbuf();
-    const std::string bytes = ss.str();
+    const std::string bytes = io::read_file_bytes(path);  // a regular file that fits the memory limit
 
     // Header.
     auto fail = [&](int line, const std::string& why) {

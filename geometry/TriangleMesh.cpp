@@ -84,8 +84,6 @@ void check_obj_text(const std::string& path, std::string_view text) {
                     throw Error(where + "face vertex index " + io::quoted(idx) + " is not one of the " + std::to_string(vertices) +
                                 " vertices defined before it");
             }
-        } else if (tokens[0] == "mtllib" || tokens[0] == "usemtl") {
-            continue;  // materials are not read (no file besides the OBJ is opened)
         }
     }
 }

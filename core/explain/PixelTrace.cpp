@@ -14,6 +14,7 @@
 #include "core/MemoryLimit.h"
 #include "core/scene/JsonReader.h"
 #include "core/explain/NumberFormat.h"
+#include "core/integrate/march/SamplePlacement.h"
 #include "core/render/PreparedScene.h"
 
 namespace volref::explain {
@@ -110,7 +111,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.step = v.step;
     {  // issue 32: every sample is kept (and printed): counted against the memory limit before the march
         double samples = 0.0;
-        for (const Interval& i : t.intervals) samples += std::ceil(i.length() / t.step) + 1.0;
+        for (const Interval& i : t.intervals) samples += double(segment_count(i, t.step)) + 1.0;  // + the exit (profiles)
         const double bytes = samples * double(sizeof(TracedSample) + conventions::kTraceBytesPerSampleOutput);
         check_memory(bytes >= 0x1p62 ? std::size_t(1) << 62 : std::size_t(bytes),
                      "trace: " + std::to_string(std::llround(std::min(samples, 0x1p62))) + " samples of pixel (" +

@@ -66,21 +66,7 @@ inline FileHandle open_for_reading(const std::filesystem::path& path) {
     return f;
 }
 
-// The whole contents of the file at `path`.
-inline std::string read_file_bytes(const std::filesystem::path& path) {
-    const std::uint64_t size = check_whole_file(path, path.string());  // a regular file that fits in memory
-    FileHandle f = open_for_reading(path);
-    std::string bytes;
-    bytes.reserve(static_cast<std::size_t>(size));
-    std::vector<char> chunk(std::size_t(1) << 16);
-    for (;;) {
-        const std::size_t n = std::fread(chunk.data(), 1, chunk.size(), f.get());
-        bytes.append(chunk.data(), n);
-        if (n < chunk.size()) break;
-    }
-    if (std::ferror(f.get())) throw Error(path.string() + ": cannot read file: " + std::strerror(errno));
-    return bytes;
-}
+// read_file_bytes (the whole contents of a file): InputFile.h.
 
 // The first `limit` bytes of the file at `path` (all of it when it is no longer); `whole` tells
 // whether that is the whole file.

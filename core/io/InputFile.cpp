@@ -3,7 +3,10 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <memory>
+#include <vector>
 
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
@@ -34,6 +37,23 @@ std::uint64_t check_whole_file(const std::filesystem::path& path, const std::str
     const std::uint64_t size = check_input_file(path, where);
     check_memory(size > SIZE_MAX ? SIZE_MAX : std::size_t(size), where + ": reading the file");
     return size;
+}
+
+std::string read_file_bytes(const std::filesystem::path& path, const std::string& where_given) {
+    const std::string where = where_given.empty() ? path.string() : where_given;
+    const std::uint64_t size = check_whole_file(path, where);  // a regular file that fits in memory
+    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+    if (!f) throw Error(where + ": cannot read file: " + std::strerror(errno));
+    std::string bytes;
+    bytes.reserve(static_cast<std::size_t>(size));
+    std::vector<char> chunk(std::size_t(1) << 16);
+    for (;;) {
+        const std::size_t n = std::fread(chunk.data(), 1, chunk.size(), f.get());
+        bytes.append(chunk.data(), n);
+        if (n < chunk.size()) break;
+    }
+    if (std::ferror(f.get())) throw Error(where + ": cannot read file: " + std::strerror(errno));
+    return bytes;
 }
 
 }  // namespace volref::io

@@ -21,4 +21,8 @@ std::uint64_t check_input_file(const std::filesystem::path& path, const std::str
 // Error "<where>: reading the file: needs N, more than the memory limit".
 std::uint64_t check_whole_file(const std::filesystem::path& path, const std::string& where);
 
+// The whole contents of the file at `path`, after check_whole_file; errors start with `where` (the path
+// when empty).
+std::string read_file_bytes(const std::filesystem::path& path, const std::string& where = "");
+
 }  // namespace volref::io

@@ -240,16 +240,17 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     // a fault pixel (the mirrored program does not finish: fault channel 1), and the vtk-js profile, which
     // reproduces vtk.js's own (C / A) A, NaN where a ray accumulates A = 0 (its samples below the 0.001 cut-off; conventions
     // section 9). Any other NaN is refused here, before an image is written, with the first pixel named.
-    if (scene.render.profile != ProfileId::VtkJs)
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            if (prepared.writes_fault() && image.at(x, y, fault_channel) != 0.0) continue;
-            for (std::size_t c = 0; c < 4; ++c)
-                if (std::isnan(image.at(x, y, c)))
-                    throw Error("render: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
-                                ") came out NaN although the scene asks for no NaN (a volref bug: please report it with "
-                                "the scene); no image written");
-        }
+    if (scene.render.profile != ProfileId::VtkJs) {
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                if (prepared.writes_fault() && image.at(x, y, fault_channel) != 0.0) continue;
+                for (std::size_t c = 0; c < 4; ++c)
+                    if (std::isnan(image.at(x, y, c)))
+                        throw Error("render: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                                    ") came out NaN although the scene asks for no NaN (a volref bug: please report it "
+                                    "with the scene); no image written");
+            }
+    }
     return image;
 }
 

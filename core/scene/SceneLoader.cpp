@@ -7,11 +7,8 @@
 
 #include <algorithm>
 #include <iostream>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <iterator>
 #include <system_error>
 
@@ -875,15 +872,10 @@ std::string read_text(const fs::path& path, const Context& ctx) {
     if (const std::string problem = io::input_file_problem(path); !problem.empty())
         ctx.fail_plain("cannot read the scene file: " + problem);  // a FIFO or a device: refused by type
     try {
-        io::check_whole_file(path, "the scene file");
+        return io::read_file_bytes(path, "the scene file");
     } catch (const Error& e) {
         ctx.fail_plain(e.what());
     }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) ctx.fail_plain(std::string("cannot open the scene file: ") + std::strerror(errno));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) ctx.fail_plain("error while reading the scene file");
-    return text;
 }
 
 fs::path absolute_dir(const fs::path& dir) { return dir.empty() ? fs::current_path() : fs::absolute(dir); }

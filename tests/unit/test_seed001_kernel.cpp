@@ -44,6 +44,16 @@ std::string chord_scene(const std::string& projection, const std::string& option
                          "profile_options": {)" + options + "}}}";
 }
 
+// The error a scene's render throws ("" when it renders).
+std::string error_of(const std::string& json) {
+    try {
+        render_scene(parse_scene(json, ".", "t"), {1, false});
+    } catch (const Error& e) {
+        return std::string(e.what());
+    }
+    return std::string();
+}
+
 glm::dvec4 render_json(const std::string& json) { return rgba(render_scene(parse_scene(json, ".", "test"), {1, false}), 0, 0); }
 
 // The chord by hand. The host's triangles: 64 segments per turn, vertices at angles 5.625 k degrees
@@ -170,14 +180,6 @@ TEST(Seed001Kernel, CompareLeavesFaultsOut) {
 
 // The loader and the kernel's refusals name the key.
 TEST(Seed001Kernel, ErrorsNameTheKey) {
-    auto error_of = [](const std::string& json) {
-        try {
-            render_scene(parse_scene(json, ".", "t"), {1, false});
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-        return std::string();
-    };
     std::string m = error_of(chord_scene("composite", R"("kernel": "fast")"));
     EXPECT_NE(m.find("render.profile_options.kernel"), std::string::npos) << m;
     // a shell the seed cannot describe (radius from 0.2): the float32 kernel refuses, "double" renders it
@@ -337,14 +339,6 @@ TEST(Seed001Kernel, TricubicBandHoldsTheOtherUnit) {
 }
 
 TEST(Seed001Kernel, TricubicRefusalsNameTheKey) {
-    auto error_of = [](const std::string& json) {
-        try {
-            render_scene(parse_scene(json, ".", "t"), {1, false});
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-        return std::string();
-    };
     // the double kernel reads exactly: the h100 unit with it is refused
     std::string m = error_of(chord_scene("composite", R"("tricubic": true, "kernel": "double", "texture_unit": "h100")"));
     EXPECT_NE(m.find("render.profile_options.tricubic"), std::string::npos) << m;

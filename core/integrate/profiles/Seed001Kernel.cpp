@@ -246,17 +246,14 @@ float Seed001Kernel::sample_at(const F3& p) const {
 
 // tex3D(dataTex, x, y, z): unnormalised coordinates, clamped to the edge, the unsigned shorts read as q / 65535.
 float Seed001Kernel::fetch(const F3& tex) const {
+    if (!h100_) return static_cast<float>(exact_fetch({double(tex[0]), double(tex[1]), double(tex[2])}));
     const tu::Fetch3d fe = tu::locate_3d({double(tex[0]), double(tex[1]), double(tex[2])}, f_.dims);
     std::array<std::uint16_t, 8> q;
     for (int c = 0; c < 8; ++c) {
         const auto i = fe.corner_index(c);
         q[std::size_t(c)] = f_.data[std::size_t(i[0] + f_.dims[0] * (i[1] + f_.dims[1] * i[2]))];
     }
-    if (h100_) return tu::filter_unorm16(fe.w.data(), q.data(), 8);
-    const std::array<double, 8> e = tu::exact_weights(fe.axis);
-    double v = 0.0;
-    for (int c = 0; c < 8; ++c) v += e[std::size_t(c)] * (double(q[std::size_t(c)]) / 65535.0);
-    return static_cast<float>(v);
+    return tu::filter_unorm16(fe.w.data(), q.data(), 8);
 }
 
 double Seed001Kernel::exact_fetch(const std::array<double, 3>& tex) const {

@@ -29,6 +29,7 @@ int run_render(const RenderArgs& args) {
     const auto start = std::chrono::steady_clock::now();
     RenderStats stats;
     const Image image = render_scene(scene, options, &stats);
+    for (const std::string& w : stats.warnings) std::fprintf(stderr, "volref: warning: %s\n", w.c_str());
     if (stats.non_finite_voxels > 0)
         std::fprintf(stderr, "volref: warning: %zu non-finite voxels (NaN or Inf), rendered as transparent\n",
                      stats.non_finite_voxels);

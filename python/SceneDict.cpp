@@ -1,5 +1,7 @@
 #include "python/SceneDict.h"
 
+#include "core/integrate/profiles/Profile.h"
+
 #include "core/explain/PixelTrace.h"
 
 #include <glm/mat4x4.hpp>
@@ -238,6 +240,12 @@ json render_json(const RenderSpec& r) {
     j["integrator"] = r.integrator == IntegrationMethod::Adaptive ? "adaptive" : "fixed";
     j["tolerance"] = r.tolerance;
     j["profile"] = profile_name(r.profile);
+    const ProfileRules& rules = r.profile_rules;
+    if (!rules.empty()) {  // issue 29: every rule of the resolved profile (texture_unit and arithmetic where the scene set them)
+        j["profile"] = profile_rules_json(resolve_profile(r));
+        if (rules.texture_unit) j["profile"]["texture_unit"] = *rules.texture_unit == ProfileOptions::TextureUnit::H100 ? "h100" : "exact";
+        if (rules.arithmetic) j["profile"]["arithmetic"] = *rules.arithmetic == ProfileRules::Arithmetic::Float32 ? "float32" : "double";
+    }
     if (r.profile == ProfileId::CudaCurvilinear)
         j["profile_options"] = {{"density", r.profile_options.density},
                                 {"transfer_scale", r.profile_options.transfer_scale},
@@ -246,12 +254,12 @@ json render_json(const RenderSpec& r) {
     if (r.profile == ProfileId::GlslBasic) j["profile_options"] = {{"intensity", r.profile_options.intensity}};
     if (r.profile == ProfileId::CudaCurvilinear || r.profile == ProfileId::GlslBasic || r.profile == ProfileId::VtkGpu) {
         // issue 17: listed when not the defaults
-        if (r.profile_options.texture_unit == ProfileOptions::TextureUnit::H100)
+        if (r.profile_options.texture_unit == ProfileOptions::TextureUnit::H100 && !rules.texture_unit)
             j["profile_options"]["texture_unit"] = "h100";
         if (r.profile_options.texture_band) j["profile_options"]["texture_band"] = true;
         if (r.profile_options.data_unorm16) j["profile_options"]["texture_format"] = "unorm16";
     }
-    if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.kernel == ProfileOptions::Kernel::Double)
+    if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.kernel == ProfileOptions::Kernel::Double && !rules.arithmetic)
         j["profile_options"]["kernel"] = "double";  // issue 28
     if (r.profile == ProfileId::CudaCurvilinear && r.profile_options.tricubic) j["profile_options"]["tricubic"] = true;
     if (r.profile == ProfileId::VtkJs)  // issue 22

@@ -206,6 +206,8 @@ RenderResult render(py::object scene, py::object threads, py::object overrides, 
         return 0;
     });
     RenderResult result{image, in->resolved(), stats.non_finite_voxels};
+    for (const std::string& w : stats.warnings)
+        if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
     if (stats.non_finite_voxels > 0)
         PyErr_WarnEx(PyExc_RuntimeWarning,
                      (std::to_string(stats.non_finite_voxels) + " non-finite voxels (NaN or Inf), rendered as transparent").c_str(),

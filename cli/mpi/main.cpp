@@ -92,7 +92,7 @@ bool any_error(const std::string& mine, int rank, int size) {
 // What volref-mpi does not render yet (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    if (r.profile != ProfileId::Reference)
+    if (!r.reference_integrators())
         throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];

@@ -12,8 +12,8 @@ namespace volref {
 PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) : scene(scene_) {
     if (scene.volumes.empty()) throw Error("volumes: expected at least one volume");
     const bool several = scene.volumes.size() > 1;
-    if (several && scene.render.profile != ProfileId::Reference)
-        throw Error("render.profile: only \"reference\" renders several volumes (the mirror profiles and \"fast\" render one)");
+    if (several && !scene.render.reference_integrators())
+        throw Error("render.profile: only \"reference\" (with no rules set over it) renders several volumes (the mirror and custom profiles and \"fast\" render one)");
     std::size_t held = 0;
     view_lo = glm::dvec3(std::numeric_limits<double>::infinity());
     view_hi = -view_lo;

@@ -65,7 +65,7 @@ bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, c
     if (is_shell(vs.bounds) || !sampler || !options.simd) return false;
     if (render.projection != Projection::Mip && render.projection != Projection::Minip) return false;
     if (render.integrator != IntegrationMethod::Fixed) return false;
-    if (render.profile != ProfileId::Reference && render.profile != ProfileId::Fast) return false;
+    if (!render.reference_integrators() && render.profile != ProfileId::Fast) return false;
     return sampler->interpolation() == Interpolation::Trilinear;
 }
 
@@ -95,6 +95,33 @@ int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const
     hi = glm::min(box_hi, domain_hi);
     return geometry.add_box(box_lo, box_hi, domain_lo, domain_hi);
 }
+
+namespace {
+
+// The box a profile's rays are clipped to (issue 29; Profile::RayBox): the domain, the texel box (the
+// domain grown by spacing / 2 on every side) or the profile's own box; reads outside the domain are
+// clamped to it (ProfileIntegrator::value). `warnings` gets a line when volume.bounds reaches past the
+// domain (the rays are clipped to the domain there).
+int add_profile_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const std::string& key, const Profile& profile,
+                       const Volume& volume, glm::dvec3& lo, glm::dvec3& hi, std::vector<std::string>& warnings) {
+    const glm::dvec3 grid_lo = volume.domain_min(), grid_hi = volume.domain_max();
+    if (profile.ray_box != Profile::RayBox::Domain) {
+        if (vs.bounds.type != BoundsSpec::Type::Box || vs.bounds.min || vs.bounds.max)
+            throw Error(std::string("render.profile.ray_box: the profile's ray box replaces ") + key +
+                        ".bounds (remove one of them)");
+        const bool texel = profile.ray_box == Profile::RayBox::Texel;
+        lo = texel ? grid_lo - 0.5 * volume.spacing : profile.box[0];
+        hi = texel ? grid_hi + 0.5 * volume.spacing : profile.box[1];
+        return geometry.add_box(lo, hi, lo, hi);
+    }
+    if (vs.bounds.type == BoundsSpec::Type::Box && ((vs.bounds.min && glm::any(glm::lessThan(*vs.bounds.min, grid_lo))) ||
+                                                    (vs.bounds.max && glm::any(glm::greaterThan(*vs.bounds.max, grid_hi)))))
+        warnings.push_back(key + ".bounds: reaches past the grid's domain; rays are clipped to the domain (render.profile's "
+                                 "ray_box \"texel\" or a box of its own samples beyond it, reads clamped to the domain)");
+    return add_cartesian_bounds(geometry, vs, key, grid_lo, grid_hi, lo, hi);
+}
+
+}  // namespace
 
 void world_box(const VolumeTransform* transform, const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3& world_lo,
                glm::dvec3& world_hi) {
@@ -186,8 +213,8 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     if (transform && vs.classify == VolumeSpec::Classify::Pre && classifier->needs_gradient())
         throw Error(key + ".classify: pre-classification of a transformed volume cannot use |grad f| (it would be "
                           "measured in the volume's own space); use \"post\" or a classification without gradients");
-    if (scene.render.profile != ProfileId::Reference && transform)
-        throw Error(key + ".transform: only render.profile \"reference\" renders transformed volumes");
+    if (!scene.render.reference_integrators() && transform)
+        throw Error(key + ".transform: only render.profile \"reference\" (with no rules set over it) renders transformed volumes");
     if (scene.render.profile == ProfileId::Fast) {
         // The fast profile's float packets (FastProfile.h); the integrators check the volume.
         const Projection p = scene.render.projection;
@@ -256,6 +283,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
 
     // The bounding geometry (in the volume's own space), and the box the default camera frames.
     glm::dvec3 lo, hi;
+    const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules (issue 29)
     if (shell) {
         const bool cylinder = vs.bounds.type == BoundsSpec::Type::Cylindrical;
         const auto box = cylinder ? bounding_box(vs.bounds.cylinder) : bounding_box(vs.bounds.sphere);
@@ -272,7 +300,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                                    : geometry.add_spherical_shell(vs.bounds.sphere);
         }
     } else {
-        geometry_id = add_cartesian_bounds(geometry, vs, key, volume.domain_min(), volume.domain_max(), lo, hi);
+        geometry_id = add_profile_bounds(geometry, vs, key, resolved, volume, lo, hi, warnings);
     }
     geometry.commit();
     world_box(transform ? &*transform : nullptr, lo, hi, view_lo, view_hi);
@@ -288,9 +316,9 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
-    if (scene.render.profile == ProfileId::Reference || scene.render.profile == ProfileId::Fast) {
+    if (scene.render.reference_integrators() || scene.render.profile == ProfileId::Fast) {
         integrator = make_integrator(*context);
-    } else if (const Profile& p = profile(scene.render.profile); p.renderer == Profile::Renderer::VtkFixedPoint) {
+    } else if (const Profile& p = resolved; p.renderer == Profile::Renderer::VtkFixedPoint) {
         check_profile_applies(p, *pipeline, scene.render);
         if (vs.bounds.type != BoundsSpec::Type::Box || vs.bounds.min || vs.bounds.max)
             throw Error(std::string("render.profile: \"") + p.name +
@@ -300,7 +328,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     } else if (p.renderer == Profile::Renderer::VtkJs) {  // issue 22
         integrator = std::make_unique<VtkJsIntegrator>(*context, volume, vs, scene);
     } else {
-        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds);
+        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds);  // the preset or custom rules
     }
     // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed
     // volume whose gradient is used.

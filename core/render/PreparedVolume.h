@@ -122,6 +122,8 @@ struct PreparedVolume {
     void intervals(const Ray* rays, int count, Ray* local, std::vector<Interval>* out) const;
     // The bytes this volume holds (its voxels and the derived volumes it built).
     std::size_t bytes = 0;
+    // What the set-up noticed that changes nothing but the user should know (RenderStats::warnings).
+    std::vector<std::string> warnings;
 };
 
 }  // namespace volref

@@ -179,6 +179,8 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     }
     if (stats) {
         stats->non_finite_voxels = 0;
+        stats->warnings.clear();
+        for (const auto& v : prepared.volumes) stats->warnings.insert(stats->warnings.end(), v->warnings.begin(), v->warnings.end());
         for (const auto& v : prepared.volumes)
             for (double x : v->model.volume.values)
                 if (!std::isfinite(x)) ++stats->non_finite_voxels;

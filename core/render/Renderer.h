@@ -6,6 +6,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/film/Image.h"
@@ -48,6 +49,8 @@ struct RenderStats {
     // pixel, volume and interval (segment_count, SamplePlacement.h) before skipping and termination:
     // the work of a marcher without empty-space skipping. 0 for the adaptive integrator.
     std::uint64_t sample_positions = 0;
+    // Lines the user should read (volref render prints them as "volref: warning: ..."; Python warns).
+    std::vector<std::string> warnings;
 };
 
 // `stats` (optional) receives what the render noticed (non-finite voxels).

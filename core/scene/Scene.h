@@ -212,6 +212,58 @@ struct ProfileOptions {
     bool data_unorm16 = false;
 };
 
+// render.profile written as an object (issue 29): a preset (`base`) and the rules the scene sets over it.
+// Each rule is one field of Profile (core/integrate/profiles/Profile.h, which has its formula;
+// docs/conventions.md section 9, "Profiles as data"); a rule the scene does not set is the base's.
+struct ProfileRules {
+    // Where the samples of an interval [t0, t1] lie: segment midpoints (the reference), from the entry
+    // t0 + (first + k) h, or from the exit t1 - k h.
+    enum class Placement { Midpoints, FromEntry, FromExit };
+    // From the entry or the exit: how many samples. ThroughExit: n = max(1, floor(L / h + 1 - first))
+    // (samples up to and at t1, at least one); BeforeExit: n = max(0, ceil(L / h - first)) (t < t1).
+    enum class StepCount { ThroughExit, BeforeExit };
+    // The box rays are clipped to: the grid's domain, the texel box (the domain grown by half a spacing
+    // on every side, as a texture's [0, 1] spans it) or a given box; reads outside the domain are clamped.
+    enum class RayBox { Domain, Texel, Given };
+    // What render.step_units "voxel" means: the spacing, or the extent over the sample count.
+    enum class VoxelLength { Spacing, ExtentOverSamples };
+    // How an opacity a (per unit distance l) becomes a sample's alpha: 1 - (1 - a)^(d / l) on the table's
+    // entries before filtering (Power) or on the filtered opacity (Exact), a itself (None), or
+    // 1 - exp(-a d density_scale) (Extinction).
+    enum class Correction { Power, None, Extinction, Exact };
+    // Front-to-back transmittance by optical depth (the reference), by product, by opacity sum (GPU
+    // shaders), or seed 001's back-to-front lerp.
+    enum class Compositing { OpticalDepth, Product, OpacitySum, Lerp };
+    enum class Stop { None, AlphaAbove, AlphaAtLeast, TransmittanceAtMost };
+    enum class TableCoordinate { DataRange, DataRangeTimesTransferScale };
+    enum class Arithmetic { Double, Float32 };
+
+    std::optional<Placement> placement;
+    std::optional<double> first;  // from-entry: the first sample's distance from the entry, in steps
+    std::optional<StepCount> step_count;
+    std::optional<RayBox> ray_box;
+    std::optional<std::array<glm::dvec3, 2>> box;  // RayBox::Given: min, max in the volume's space
+    std::optional<VoxelLength> step_voxel;
+    std::optional<Correction> correction;
+    std::optional<double> correction_floor;  // Power: entries with a <= floor are not corrected
+    std::optional<double> density_scale;     // Extinction
+    std::optional<Compositing> compositing;
+    std::optional<Stop> termination;
+    double termination_value = 1.0;          // the threshold of `termination`
+    std::optional<int> table_entries;        // 0: the transfer function read exactly
+    std::optional<TableCoordinate> table_coordinate;
+    std::optional<Arithmetic> arithmetic;    // float32: seed 001's kernel (render.profile_options.kernel)
+    std::optional<ProfileOptions::TextureUnit> texture_unit;  // as render.profile_options.texture_unit
+    std::optional<bool> normal_along_gradient;  // "normal": "+gradient" (true) or "-gradient"
+    std::optional<bool> forward_gradient;       // "gradient": "forward" or "central"
+    std::optional<double> gradient_offset;      // voxels
+    std::optional<double> gradient_offset_texture;  // a fraction of the domain's extent per axis
+    std::optional<bool> clamp_shaded;
+    // The keys the scene set, in the order written (messages, `volref compare --fit`, the resolved scene).
+    std::vector<std::string> keys;
+    bool empty() const { return keys.empty(); }
+};
+
 struct RenderSpec {
     Projection projection = Projection::Composite;
     CompositeOrder order = CompositeOrder::FrontToBack;
@@ -222,8 +274,12 @@ struct RenderSpec {
     double gain = 1.0;                    // xray: the line integral is multiplied by this
     IntegrationMethod integrator = IntegrationMethod::Fixed;
     double tolerance = 1e-6;              // adaptive: absolute error per channel, > 0
-    ProfileId profile = ProfileId::Reference;
+    ProfileId profile = ProfileId::Reference;  // the preset (render.profile, or its "base")
+    ProfileRules profile_rules;                // render.profile as an object: the rules set over the preset
     ProfileOptions profile_options;
+    // The reference's own integrators (and their SIMD paths, skipping, transforms, several volumes):
+    // render.profile "reference" with no rule set over it.
+    bool reference_integrators() const { return profile == ProfileId::Reference && profile_rules.empty(); }
 };
 
 struct Scene {

@@ -777,6 +777,121 @@ ImageSpec read_image(const Json& v, const std::string& path, const Context& ctx)
     return im;
 }
 
+template <class Reader>
+ProfileId read_profile_id(Reader& r, std::string_view key) {
+    return r.template choice<ProfileId>(key, ProfileId::Reference,
+                                        {{"reference", ProfileId::Reference},
+                                         {"vtk-gpu", ProfileId::VtkGpu},
+                                         {"glsl-basic", ProfileId::GlslBasic},
+                                         {"ospray", ProfileId::Ospray},
+                                         {"cuda-curvilinear", ProfileId::CudaCurvilinear},
+                                         {"vtk-cpu", ProfileId::VtkCpu},
+                                         {"fast", ProfileId::Fast},
+                                         {"vtk-js", ProfileId::VtkJs}});
+}
+
+// render.profile as an object (issue 29): each rule of Profile.h by its key (scene-format.md,
+// "render.profile"); the renderers that are not rule-driven (vtk-cpu, vtk-js, fast) take none.
+ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
+    using P = ProfileRules;
+    static constexpr std::string_view kKeys[] = {
+        "placement", "first",      "step_count",  "ray_box",  "step_voxel", "correction",    "correction_floor",
+        "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
+        "normal",    "gradient",   "gradient_offset", "clamp_shaded", "jitter"};
+    r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
+             "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
+             "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter"});
+    P out;
+    for (std::string_view k : kKeys)
+        if (r.has(k)) out.keys.emplace_back(k);
+    if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast))
+        r.fail(out.keys.front(), std::string("the \"") + std::string(base == ProfileId::VtkCpu ? "vtk-cpu" : base == ProfileId::VtkJs ? "vtk-js" : "fast") +
+                                     "\" profile is its own renderer, not a set of rules (use render.profile_options, or base \"reference\")");
+    if (r.has("placement"))
+        out.placement = r.choice<P::Placement>("placement", P::Placement::Midpoints,
+                                               {{"midpoints", P::Placement::Midpoints},
+                                                {"from-entry", P::Placement::FromEntry},
+                                                {"from-exit", P::Placement::FromExit}});
+    out.first = r.optional_number("first", Range::closed(0.0, 1e6));
+    if (r.has("step_count"))
+        out.step_count = r.choice<P::StepCount>("step_count", P::StepCount::ThroughExit,
+                                                {{"through-exit", P::StepCount::ThroughExit}, {"before-exit", P::StepCount::BeforeExit}});
+    if (const Json* b = r.find("ray_box")) {
+        if (b->is_object()) {
+            ObjectReader br(*b, r.path("ray_box"), r.context());
+            br.allow({"min", "max"});
+            const glm::dvec3 lo = read_vec3(br.required("min"), br.path("min"), r.context());
+            const glm::dvec3 hi = read_vec3(br.required("max"), br.path("max"), r.context());
+            if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) br.fail("max", "must exceed min on every axis");
+            out.ray_box = P::RayBox::Given;
+            out.box = std::array<glm::dvec3, 2>{lo, hi};
+        } else {
+            out.ray_box = r.choice<P::RayBox>("ray_box", P::RayBox::Domain,
+                                              {{"domain", P::RayBox::Domain}, {"texel", P::RayBox::Texel}});
+        }
+    }
+    if (r.has("step_voxel"))
+        out.step_voxel = r.choice<P::VoxelLength>("step_voxel", P::VoxelLength::Spacing,
+                                                  {{"spacing", P::VoxelLength::Spacing},
+                                                   {"extent-over-samples", P::VoxelLength::ExtentOverSamples}});
+    if (r.has("correction"))
+        out.correction = r.choice<P::Correction>("correction", P::Correction::Power,
+                                                 {{"pow", P::Correction::Power},
+                                                  {"exact", P::Correction::Exact},
+                                                  {"none", P::Correction::None},
+                                                  {"extinction", P::Correction::Extinction}});
+    out.correction_floor = r.optional_number("correction_floor", Range::closed(0.0, 1.0));
+    out.density_scale = r.optional_number("density_scale", Range::non_negative());
+    if (r.has("compositing"))
+        out.compositing = r.choice<P::Compositing>("compositing", P::Compositing::OpticalDepth,
+                                                   {{"optical-depth", P::Compositing::OpticalDepth},
+                                                    {"product", P::Compositing::Product},
+                                                    {"opacity-sum", P::Compositing::OpacitySum},
+                                                    {"lerp", P::Compositing::Lerp}});
+    if (const Json* t = r.find("termination")) {  // "none" or {"alpha_above" | "alpha_at_least" | "transmittance_at_most": x}
+        if (t->is_object()) {
+            ObjectReader tr(*t, r.path("termination"), r.context());
+            tr.allow({"alpha_above", "alpha_at_least", "transmittance_at_most"});
+            int n = 0;
+            for (auto [key, stop] : {std::pair{"alpha_above", P::Stop::AlphaAbove}, std::pair{"alpha_at_least", P::Stop::AlphaAtLeast},
+                                     std::pair{"transmittance_at_most", P::Stop::TransmittanceAtMost}})
+                if (tr.has(key)) {
+                    out.termination = stop;
+                    out.termination_value = tr.number(key, 1.0, Range::closed(0.0, 1.0));
+                    ++n;
+                }
+            if (n != 1) tr.fail_here("expected one of alpha_above, alpha_at_least, transmittance_at_most");
+        } else {
+            out.termination = r.choice<P::Stop>("termination", P::Stop::None, {{"none", P::Stop::None}});
+        }
+    }
+    if (r.has("table")) out.table_entries = int(r.integer("table", 0, Range::closed(0, 1 << 20)));
+    if (out.table_entries == 1) r.fail("table", "expected 0 (the transfer function read exactly) or at least 2 entries");
+    if (r.has("table_coordinate"))
+        out.table_coordinate = r.choice<P::TableCoordinate>("table_coordinate", P::TableCoordinate::DataRange,
+                                                            {{"data-range", P::TableCoordinate::DataRange},
+                                                             {"data-range-times-transfer-scale", P::TableCoordinate::DataRangeTimesTransferScale}});
+    if (r.has("texture_unit"))
+        out.texture_unit = r.choice<ProfileOptions::TextureUnit>("texture_unit", ProfileOptions::TextureUnit::Exact,
+                                                                 {{"exact", ProfileOptions::TextureUnit::Exact},
+                                                                  {"h100", ProfileOptions::TextureUnit::H100}});
+    if (r.has("arithmetic"))
+        out.arithmetic = r.choice<P::Arithmetic>("arithmetic", P::Arithmetic::Double,
+                                                 {{"double", P::Arithmetic::Double}, {"float32", P::Arithmetic::Float32}});
+    if (r.has("normal"))
+        out.normal_along_gradient = r.choice<bool>("normal", false, {{"-gradient", false}, {"+gradient", true}});
+    if (r.has("gradient"))
+        out.forward_gradient = r.choice<bool>("gradient", false, {{"central", false}, {"forward", true}});
+    out.gradient_offset = r.optional_number("gradient_offset", Range::positive());
+    out.gradient_offset_texture = r.optional_number("gradient_offset_texture", Range::left_open(0.0, 1.0));
+    if (out.gradient_offset && out.gradient_offset_texture)
+        r.fail("gradient_offset_texture", "also set as gradient_offset (voxels): set one");
+    if (r.has("clamp_shaded")) out.clamp_shaded = r.boolean("clamp_shaded", false);
+    // volref never jitters (every pixel its own deterministic ray): "off" is the only value.
+    r.choice<bool>("jitter", false, {{"off", false}});
+    return out;
+}
+
 RenderSpec read_render(const Json& v, const std::string& path, const Context& ctx) {
     ObjectReader r(v, path, ctx);
     r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
@@ -803,15 +918,14 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                                 {"midpoint", IntegrationMethod::Fixed},
                                                 {"adaptive", IntegrationMethod::Adaptive}});
     s.tolerance = r.number("tolerance", conventions::kAdaptiveDefaultTolerance, Range::positive());
-    s.profile = r.choice<ProfileId>("profile", ProfileId::Reference,
-                                    {{"reference", ProfileId::Reference},
-                                     {"vtk-gpu", ProfileId::VtkGpu},
-                                     {"glsl-basic", ProfileId::GlslBasic},
-                                     {"ospray", ProfileId::Ospray},
-                                     {"cuda-curvilinear", ProfileId::CudaCurvilinear},
-                                     {"vtk-cpu", ProfileId::VtkCpu},
-                                     {"fast", ProfileId::Fast},
-                                     {"vtk-js", ProfileId::VtkJs}});
+    // render.profile: a preset's name, or an object of rules over a preset (issue 29; read_profile_rules).
+    if (const Json* p = r.find("profile"); p && p->is_object()) {
+        ObjectReader pr(*p, r.path("profile"), ctx);
+        s.profile = read_profile_id(pr, "base");
+        s.profile_rules = read_profile_rules(pr, s.profile);
+    } else {
+        s.profile = read_profile_id(r, "profile");
+    }
     if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction", "subpixel_bits"});
@@ -844,6 +958,20 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.iso_threshold = po.number("iso_threshold", 0.0);
         s.profile_options.brightness = po.number("brightness", 1.0, Range::non_negative());
     }
+    // The rules that are render.profile_options too (issue 29): set in one place only.
+    const ProfileRules& pr = s.profile_rules;
+    const Json* po_json = r.find("profile_options");
+    if (pr.texture_unit) {
+        if (po_json && po_json->contains("texture_unit"))
+            r.fail("profile.texture_unit", "also set by render.profile_options.texture_unit (set it in one place)");
+        s.profile_options.texture_unit = *pr.texture_unit;
+    }
+    if (pr.arithmetic) {
+        if (po_json && po_json->contains("kernel"))
+            r.fail("profile.arithmetic", "also set by render.profile_options.kernel (set it in one place)");
+        s.profile_options.kernel = *pr.arithmetic == ProfileRules::Arithmetic::Float32 ? ProfileOptions::Kernel::Float32
+                                                                                      : ProfileOptions::Kernel::Double;
+    }
     s.gain = r.number("gain", 1.0, Range::positive());
     if (s.projection == Projection::FirstHit && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
     return s;
@@ -863,6 +991,16 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);
     if (const Json* v = r.find("render")) scene.render = read_render(*v, r.path("render"), ctx);
+    // issue 29: a rule the projection does not read is said, not silently dropped.
+    const bool composite = scene.render.projection == Projection::Composite;
+    const bool shaded = composite && scene.volume().shading.has_value();
+    for (const std::string& k : scene.render.profile_rules.keys) {
+        const bool compositing_rule = k == "correction" || k == "correction_floor" || k == "density_scale" || k == "compositing" || k == "termination";
+        const bool shading_rule = k == "normal" || k == "gradient" || k == "gradient_offset" || k == "gradient_offset_texture" || k == "clamp_shaded";
+        if ((compositing_rule && !composite) || (shading_rule && !shaded))
+            std::cerr << "volref: notice: render.profile." << k << ": not read by this scene ("
+                      << (compositing_rule ? "the projection does not composite" : "the scene is not a shaded composite") << ")\n";
+    }
     return scene;
 }
 

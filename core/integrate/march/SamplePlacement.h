@@ -37,6 +37,14 @@ inline Segment segment(const Interval& iv, double step, std::int64_t k, std::int
 inline double from_entry_count(const Interval& iv, double step, double first) {
     return std::max(1.0, std::floor(iv.length() / step + 1.0 - first));
 }
+// From the entry or the exit, by the step-count rule (issue 29; Profile::StepCount): ThroughExit is
+// from_entry_count; BeforeExit: n = max(0, ceil(L / h - first)), the samples with t < t1 (a shader's
+// `while (t < t_exit)`).
+template <class StepCount>
+double sample_count(const Interval& iv, double step, double first, StepCount rule) {
+    if (rule == StepCount::ThroughExit) return from_entry_count(iv, step, first);
+    return std::max(0.0, std::ceil(iv.length() / step - first));
+}
 inline double from_entry_sample(const Interval& iv, double step, double first, double k) {
     return iv.t0 + (first + k) * step;
 }

@@ -1,12 +1,22 @@
 #include "core/integrate/profiles/Profile.h"
 
+#include <nlohmann/json.hpp>
+
 #include "core/Error.h"
 
 namespace volref {
 
 namespace {
 
-Profile make_reference() { return Profile{}; }
+// The reference's conventions as rules (issue 29): what a custom profile on base "reference" starts
+// from. The reference itself renders through its own integrators (RenderSpec::reference_integrators);
+// this preset's ProfileIntegrator differs from them only in rounding and in its gradient (central
+// differences of the clamped field, not GradientField's one-sided differences at the boundary).
+Profile make_reference() {
+    Profile p;
+    p.compositing = Profile::Compositing::OpticalDepth;
+    return p;
+}
 
 // vtkGPUVolumeRayCastMapper of VTK 9.1 (its GLSL, vtkVolumeShaderComposer.h, and the opacity and
 // colour tables vtkOpenGLVolumeOpacityTable / vtkOpenGLVolumeRGBTable), as the shared spec's section 9
@@ -95,7 +105,7 @@ Profile make_cuda_curvilinear() {
     p.first = 0.0;
     p.correction = Profile::Correction::None;
     p.table_entries = 9;
-    p.compositing = Profile::Compositing::BackToFrontLerp;
+    p.compositing = Profile::Compositing::Lerp;
     p.table_coordinate = Profile::TableCoordinate::DataRangeTimesTransferScale;
     p.sample_filter = Profile::SampleFilter::AtOrAboveIsoThreshold;
     p.xray = Profile::Xray::BrightnessTimesMaximum;
@@ -132,6 +142,112 @@ const Profile& profile(ProfileId id) {
         case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
     }
     throw Error("render.profile: unknown profile");
+}
+
+const std::vector<ProfileId>& preset_ids() {
+    static const std::vector<ProfileId> ids{ProfileId::Reference, ProfileId::Fast,  ProfileId::VtkGpu,
+                                            ProfileId::VtkCpu,    ProfileId::VtkJs, ProfileId::GlslBasic,
+                                            ProfileId::Ospray,    ProfileId::CudaCurvilinear};
+    return ids;
+}
+
+namespace {
+
+std::string preset_name(ProfileId id) {
+    return id == ProfileId::Fast ? "fast" : profile(id).name;
+}
+
+}  // namespace
+
+Profile resolve_profile(const RenderSpec& render) {
+    if (render.profile == ProfileId::Fast) {
+        Profile p;
+        p.id = ProfileId::Fast;
+        p.name = "fast";
+        return p;
+    }
+    Profile p = profile(render.profile);
+    const ProfileRules& r = render.profile_rules;
+    if (r.empty()) return p;
+    p.name = std::string("custom (base ") + preset_name(render.profile) + ")";
+    if (r.placement) p.placement = *r.placement;
+    if (r.first) p.first = *r.first;
+    if (r.step_count) p.step_count = *r.step_count;
+    if (r.ray_box) p.ray_box = *r.ray_box;
+    if (r.box) p.box = *r.box;
+    if (r.step_voxel) p.voxel_length = *r.step_voxel;
+    if (r.correction) p.correction = *r.correction;
+    if (r.correction_floor) p.correction_floor = *r.correction_floor;
+    if (r.density_scale) p.density_scale = *r.density_scale;
+    if (r.compositing) p.compositing = *r.compositing;
+    if (r.termination) {
+        p.termination = Termination{};
+        switch (*r.termination) {
+            case ProfileRules::Stop::None: break;
+            case ProfileRules::Stop::AlphaAbove:
+                p.termination.test_alpha_above = true;
+                p.termination.alpha_above = r.termination_value;
+                break;
+            case ProfileRules::Stop::AlphaAtLeast:
+                p.termination.test_alpha_at_least = true;
+                p.termination.alpha_at_least = r.termination_value;
+                break;
+            case ProfileRules::Stop::TransmittanceAtMost:
+                p.termination.test_transmittance = true;
+                p.termination.transmittance_at_most = r.termination_value;
+                break;
+        }
+    }
+    if (r.table_entries) p.table_entries = *r.table_entries;
+    if (r.table_coordinate) p.table_coordinate = *r.table_coordinate;
+    if (r.normal_along_gradient) p.normal_along_gradient = *r.normal_along_gradient;
+    if (r.forward_gradient) p.forward_gradient = *r.forward_gradient;
+    if (r.gradient_offset) {
+        p.gradient_offset = *r.gradient_offset;
+        p.gradient_offset_texture = 0.0;
+    }
+    if (r.gradient_offset_texture) {
+        p.gradient_offset_texture = *r.gradient_offset_texture;
+        p.gradient_offset = 0.0;
+    }
+    if (r.clamp_shaded) p.clamp_shaded = *r.clamp_shaded;
+    return p;
+}
+
+nlohmann::json profile_rules_json(const Profile& p) {
+    using nlohmann::json;
+    json j;
+    j["base"] = preset_name(p.id);
+    if (p.renderer != Profile::Renderer::RayCaster || p.id == ProfileId::Fast) return j;
+    static const char* const placement[] = {"midpoints", "from-entry", "from-exit"};
+    static const char* const correction[] = {"pow", "none", "extinction", "exact"};
+    static const char* const compositing[] = {"optical-depth", "product", "opacity-sum", "lerp"};
+    j["placement"] = placement[int(p.placement)];
+    j["first"] = p.first;
+    j["step_count"] = p.step_count == Profile::StepCount::ThroughExit ? "through-exit" : "before-exit";
+    if (p.ray_box == Profile::RayBox::Given)
+        j["ray_box"] = {{"min", {p.box[0].x, p.box[0].y, p.box[0].z}}, {"max", {p.box[1].x, p.box[1].y, p.box[1].z}}};
+    else
+        j["ray_box"] = p.ray_box == Profile::RayBox::Domain ? "domain" : "texel";
+    j["step_voxel"] = p.voxel_length == Profile::VoxelLength::Spacing ? "spacing" : "extent-over-samples";
+    j["correction"] = correction[int(p.correction)];
+    j["correction_floor"] = p.correction_floor;
+    j["density_scale"] = p.density_scale;
+    j["compositing"] = compositing[int(p.compositing)];
+    const Termination& t = p.termination;
+    if (t.test_alpha_above) j["termination"] = {{"alpha_above", t.alpha_above}};
+    else if (t.test_alpha_at_least) j["termination"] = {{"alpha_at_least", t.alpha_at_least}};
+    else if (t.test_transmittance) j["termination"] = {{"transmittance_at_most", t.transmittance_at_most}};
+    else j["termination"] = "none";
+    j["table"] = p.table_entries;
+    j["table_coordinate"] = p.table_coordinate == Profile::TableCoordinate::DataRange ? "data-range" : "data-range-times-transfer-scale";
+    j["normal"] = p.normal_along_gradient ? "+gradient" : "-gradient";
+    j["gradient"] = p.forward_gradient ? "forward" : "central";
+    if (p.gradient_offset_texture > 0.0) j["gradient_offset_texture"] = p.gradient_offset_texture;
+    else j["gradient_offset"] = p.gradient_offset;
+    j["clamp_shaded"] = p.clamp_shaded;
+    j["jitter"] = "off";
+    return j;
 }
 
 }  // namespace volref

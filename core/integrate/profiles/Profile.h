@@ -6,7 +6,12 @@
 // renderer (ProfileIntegrator, or VtkFixedPointRenderer for VTK's fixed-point mapper). Every number here is one renderer's
 // convention, with its source; docs/conventions.md section 9 gives the formulas.
 #pragma once
+#include <array>
 #include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "core/integrate/march/Accumulators.h"
 #include "core/scene/Scene.h"
@@ -15,7 +20,7 @@ namespace volref {
 
 struct Profile {
     ProfileId id = ProfileId::Reference;
-    const char* name = "reference";
+    std::string name = "reference";
 
     // Which renderer reads the rest: a ray caster over the scene's rays (ProfileIntegrator), or VTK's
     // image-space fixed-point caster (VtkFixedPointRenderer.h: its own internal image, 15-bit fixed
@@ -36,24 +41,29 @@ struct Profile {
 
     // --- sample placement -------------------------------------------------------------------------
     // Where the samples of one interval [t0, t1] (length L, step h) lie.
-    enum class Placement {
-        // The reference: segments of h, sampled at their midpoints, weighted by their lengths.
-        Midpoints,
-        // t0 + (first + k) h for k = 0 .. n-1, n = max(1, floor(L / h + 1 - first)) (at least one
-        // sample, even when the chord is shorter than first * h; VTK's GPU shader samples before it
-        // tests the exit). Positions past t1 read the texture clamped to the domain.
-        FromEntry,
-        // Seed 001 (cuda-curvilinear, issue 17): `for (s = outAbs; s >= inAbs; s -= step)` over one span
-        // [inAbs, outAbs] = [the first interval's t0, the last one's t1]: t1 - k h for k = 0 .. floor(L / h),
-        // back to front; samples in the gaps between intervals read the field as value() says.
-        FromExit,
-    };
+    // Midpoints (the reference): segments of h, sampled at their midpoints, weighted by their lengths.
+    // FromEntry: t0 + (first + k) h for k = 0 .. n-1, n by `step_count`. Positions past t1 read the
+    //   texture clamped to the domain.
+    // FromExit: seed 001 (cuda-curvilinear, issue 17): `for (s = outAbs; s >= inAbs; s -= step)` over one
+    //   span [inAbs, outAbs] = [the first interval's t0, the last one's t1]: t1 - k h for k = 0 .. n - 1
+    //   (first = 0), back to front; samples in the gaps between intervals read the field as value() says.
+    using Placement = ProfileRules::Placement;
     Placement placement = Placement::Midpoints;
     double first = 0.0;  // FromEntry: the first sample's distance from the entry, in steps
+    // FromEntry, FromExit: ThroughExit: n = max(1, floor(L / h + 1 - first)) (at least one sample, even
+    // when the chord is shorter than first * h; VTK's GPU shader samples before it tests the exit);
+    // BeforeExit: n = max(0, ceil(L / h - first)) (a shader's `while (t < t_exit)`).
+    using StepCount = ProfileRules::StepCount;
+    StepCount step_count = StepCount::ThroughExit;
+    // The box rays are clipped to (PreparedVolume): the domain [origin, origin + (n - 1) spacing], the
+    // texel box (the domain grown by spacing / 2 on every side: a texture's [0, 1]), or `box`.
+    using RayBox = ProfileRules::RayBox;
+    RayBox ray_box = RayBox::Domain;
+    std::array<glm::dvec3, 2> box{};  // RayBox::Given, in the volume's space
     // What render.step_units "voxel" means: the grid spacing (the reference), or size / n (the extent
     // over the sample count: the step is multiplied by (n - 1) / n, n the dims of the grid's axis of
     // smallest spacing (Cartesian) or the largest dims (shells)).
-    enum class VoxelLength { Spacing, ExtentOverSamples };
+    using VoxelLength = ProfileRules::VoxelLength;
     VoxelLength voxel_length = VoxelLength::Spacing;
 
     // --- classification ---------------------------------------------------------------------------
@@ -62,10 +72,9 @@ struct Profile {
     // with linear filtering at texel position u N - 0.5 (clamped to the edge texels, as an OpenGL
     // texture with GL_LINEAR and CLAMP_TO_EDGE does), u by the table coordinate rule.
     int table_entries = 0;
-    enum class TableCoordinate {
-        DataRange,                  // u = s = (v - min) / (max - min)
-        DataRangeTimesTransferScale,  // u = clamp(s * render.profile_options.transfer_scale, 0, 1)
-    };
+    // DataRange: u = s = (v - min) / (max - min); DataRangeTimesTransferScale:
+    // u = clamp(s * render.profile_options.transfer_scale, 0, 1).
+    using TableCoordinate = ProfileRules::TableCoordinate;
     TableCoordinate table_coordinate = TableCoordinate::DataRange;
     // Which samples are composited: all, or those with s >= render.profile_options.iso_threshold.
     enum class SampleFilter { All, AtOrAboveIsoThreshold };
@@ -80,25 +89,25 @@ struct Profile {
 
     // --- opacity correction -----------------------------------------------------------------------
     // How a transfer-function opacity a (per unit distance l) becomes the alpha of one sample.
-    enum class Correction {
-        Power,       // alpha = 1 - (1 - a)^(h / l) applied to the table entries with a > floor (VTK GPU)
-        None,        // alpha = a (per-sample opacity, a textbook shader)
-        Extinction,  // alpha = 1 - exp(-a h density_scale) (OSPRay: a is an extinction coefficient)
-    };
+    // Power:      alpha = 1 - (1 - a)^(d / l) (d the length the sample stands for), applied to the table
+    //             entries with a > floor before filtering (VTK GPU), or to a when there is no table;
+    // Exact:      the same formula applied to the sample's own (filtered) opacity a, a > floor;
+    // None:       alpha = a (per-sample opacity, a textbook shader);
+    // Extinction: alpha = 1 - exp(-a d density_scale) (OSPRay: a is an extinction coefficient).
+    using Correction = ProfileRules::Correction;
     Correction correction = Correction::Power;
     double correction_floor = 0.0;  // Power: entries with a <= floor are left as they are
     double density_scale = 1.0;     // Extinction
 
     // --- compositing and termination (march/Accumulators.h) -----------------------------------------
-    enum class Compositing {
-        // Front to back, premultiplied: C += (1 - A) alpha c, A += (1 - A) alpha (the opacity-sum
-        // rule), stopping by `termination` after every sample.
-        FrontToBackOpacitySum,
-        // Seed 001: back to front, sum = lerp(sum, (c, a), a density) on R, G, B, A (density:
-        // render.profile_options.density); no termination.
-        BackToFrontLerp,
-    };
-    Compositing compositing = Compositing::FrontToBackOpacitySum;
+    // Front to back, premultiplied, C += T alpha c with the transmittance T kept by the rule
+    // (march/Accumulators.h, TransmittanceRule): OpticalDepth (tau += -log1p(-alpha), T = exp(-tau): the
+    // reference), Product (T *= 1 - alpha), OpacitySum (A += (1 - A) alpha, T = 1 - A: GPU shaders);
+    // stopping by `termination` after every sample, and at an opaque sample (alpha = 1).
+    // Lerp: seed 001: back to front, sum = lerp(sum, (c, a), a density) on R, G, B, A (density:
+    // render.profile_options.density); no termination.
+    using Compositing = ProfileRules::Compositing;
+    Compositing compositing = Compositing::OpacitySum;
     // When a front-to-back ray stops: A > alpha_above (VTK GPU: 1 - 1/255), A >= alpha_at_least (a
     // textbook shader: 1; OSPRay: T <= 0.001, i.e. A >= 0.999).
     Termination termination{};
@@ -127,7 +136,19 @@ struct Profile {
     Xray xray = Xray::LineIntegral;
 };
 
-// The profile a scene names (render.profile).
+// The preset a scene names (render.profile, or its "base").
 const Profile& profile(ProfileId id);
+
+// The profile a scene renders with (issue 29): the preset render.profile names with the scene's rules
+// (render.profile as an object) set over it; `name` says "custom (base ...)" when a rule is set.
+Profile resolve_profile(const RenderSpec& render);
+
+// Every rule of a ray-casting profile as render.profile's object holds it ("base" the preset's name),
+// for volref.profiles() and the resolved scene; the image-space renderers (vtk-cpu, vtk-js) and "fast"
+// give {"base": name} alone.
+nlohmann::json profile_rules_json(const Profile& p);
+
+// The presets, in the order `volref info` lists them.
+const std::vector<ProfileId>& preset_ids();
 
 }  // namespace volref

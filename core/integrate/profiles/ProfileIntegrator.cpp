@@ -70,8 +70,8 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     normalized_coordinates_ = p_.id != ProfileId::CudaCurvilinear;
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_) {
         const std::string key = band_ ? "render.profile_options.texture_band" : "render.profile_options.texture_unit";
-        if (p_.id != ProfileId::VtkGpu && p_.id != ProfileId::GlslBasic && p_.id != ProfileId::CudaCurvilinear)
-            throw Error(key + ": only the vtk-gpu, glsl-basic and cuda-curvilinear profiles model a texture unit");
+        if (p_.id == ProfileId::Ospray || (p_.id == ProfileId::Reference && ctx.render.profile_rules.empty()))
+            throw Error(key + ": only the vtk-gpu, glsl-basic and cuda-curvilinear profiles and custom ones (render.profile's texture_unit) model a texture unit");
         if (!shell_) {
             cartesian_ = cartesian;
             if (!cartesian_ || &ctx.pipeline.sampler() != static_cast<const FieldSampler*>(cartesian_) ||
@@ -105,6 +105,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
             throw Error("render.profile_options.tricubic: with kernel \"double\" (or a projection other than composite and x-ray) the cubic reads exactly; the h100 unit and texture_band need kernel \"float32\"");
         tricubic_ = true;
     }
+    check_rules(ctx.render, cartesian != nullptr);
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
                                                : p_.gradient_offset * volume.spacing;
     const auto [vmin, vmax] = volume.value_range();
@@ -127,11 +128,34 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
 
 ProfileIntegrator::~ProfileIntegrator() = default;
 
+// A rule this integrator cannot honour is an error naming it (issue 29): never ignored.
+void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) const {
+    const ProfileRules& r = render.profile_rules;
+    auto fail = [](const std::string& key, const std::string& why) { throw Error("render.profile." + key + ": " + why); };
+    if (r.arithmetic == ProfileRules::Arithmetic::Float32 && !kernel_)
+        fail("arithmetic", "float32 is implemented by seed 001's kernel only (base \"cuda-curvilinear\" on a shell, composite or "
+                           "x-ray); a profile computes in double, which matches a float32 renderer to its rounding (docs/gpu-quick-start.md)");
+    if (kernel_)
+        for (const std::string& k : r.keys)
+            if (k != "arithmetic" && k != "texture_unit")
+                fail(k, "seed 001's float32 kernel runs the program's own loop, whose rules are fixed (set render.profile.arithmetic "
+                        "\"double\" to render with other rules)");
+    if (r.first && p_.placement != Profile::Placement::FromEntry) fail("first", "the first sample's offset applies to placement \"from-entry\"");
+    if (r.step_count && p_.placement == Profile::Placement::Midpoints)
+        fail("step_count", "applies to the placements \"from-entry\" and \"from-exit\" (midpoints: segment_count, conventions section 4)");
+    if (r.ray_box && *r.ray_box != ProfileRules::RayBox::Domain && !cartesian) fail("ray_box", "a texel or given box needs a Cartesian grid");
+    if (p_.compositing == Profile::Compositing::Lerp && r.termination && *r.termination != ProfileRules::Stop::None)
+        fail("termination", "lerp compositing runs back to front and has no termination");
+    if (band_ && p_.correction == Profile::Correction::Exact && p_.table_entries > 1)
+        throw Error("render.profile_options.texture_band: the band is derived for tables whose entries are corrected (correction \"pow\"), not \"exact\"");
+}
+
 double ProfileIntegrator::alpha(double a, double d) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
     a = std::clamp(a, 0.0, 1.0);
     switch (p_.correction) {
-        case Profile::Correction::Power: return a > p_.correction_floor ? opacity_for_length(a, d, l) : a;
+        case Profile::Correction::Power:
+        case Profile::Correction::Exact: return a > p_.correction_floor ? opacity_for_length(a, d, l) : a;
         case Profile::Correction::None: return a;
         case Profile::Correction::Extinction: return -std::expm1(-a * d * p_.density_scale);
     }
@@ -321,7 +345,9 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
         const glm::dvec4& e1 = table_[std::size_t(r.i1)];
         out.color = glm::dvec3(channel(e0.r, e1.r), channel(e0.g, e1.g), channel(e0.b, e1.b));
         out.opacity = channel(e0.a, e1.a);
-        out.alpha = channel(table_alpha_[std::size_t(r.i0)], table_alpha_[std::size_t(r.i1)]);
+        out.alpha = p_.correction == Profile::Correction::Power
+                        ? channel(table_alpha_[std::size_t(r.i0)], table_alpha_[std::size_t(r.i1)])
+                        : alpha(out.opacity, d);
         return out;
     }
     const double pos = std::clamp(u * double(n) - 0.5, 0.0, double(n - 1));
@@ -334,7 +360,10 @@ ProfileIntegrator::Lookup ProfileIntegrator::lookup(double v, double d) const {
     const glm::dvec4 e = table_[std::size_t(i)] + w * (table_[std::size_t(i) + 1] - table_[std::size_t(i)]);
     out.color = glm::dvec3(e);
     out.opacity = e.a;
-    out.alpha = table_alpha_[std::size_t(i)] + w * (table_alpha_[std::size_t(i) + 1] - table_alpha_[std::size_t(i)]);
+    // Power corrects the entries (VTK: then filtered); the other rules correct the filtered opacity.
+    out.alpha = p_.correction == Profile::Correction::Power
+                    ? table_alpha_[std::size_t(i)] + w * (table_alpha_[std::size_t(i) + 1] - table_alpha_[std::size_t(i)])
+                    : alpha(out.opacity, d);
     return out;
 }
 
@@ -360,13 +389,13 @@ void ProfileIntegrator::for_each_sample(const std::vector<Interval>& intervals, 
         if (intervals.empty()) return;
         Interval span = intervals.front();
         span.t1 = intervals.back().t1;
-        const double n = from_entry_count(span, h, 0.0);
+        const double n = sample_count(span, h, 0.0, p_.step_count);
         for (double k = 0.0; k < n; k += 1.0)
             if (cancel_polled(std::int64_t(k)) || !fn(span.t1 - k * h, h)) return;
         return;
     }
     for (const Interval& iv : intervals) {
-        const double n = from_entry_count(iv, h, p_.first);
+        const double n = sample_count(iv, h, p_.first, p_.step_count);
         for (double k = 0.0; k < n; k += 1.0)
             if (cancel_polled(std::int64_t(k)) || !fn(from_entry_sample(iv, h, p_.first, k), h)) return;
     }
@@ -539,7 +568,7 @@ ProfileIntegrator::Box ProfileIntegrator::sample_range(double vlo, double vhi, d
     // Which values the sample is used for: composite() skips v < value_cutoff; composite_lerp() skips s < iso.
     double cut = -std::numeric_limits<double>::infinity();
     if (p_.value_cutoff > cut) cut = p_.value_cutoff;
-    const bool lerp = p_.compositing == Profile::Compositing::BackToFrontLerp;
+    const bool lerp = p_.compositing == Profile::Compositing::Lerp;
     if (lerp && p_.sample_filter == Profile::SampleFilter::AtOrAboveIsoThreshold) cut = lo_ + o.iso_threshold * width_;
     const bool never = vhi < cut, always = !(vlo < cut);
     Box b{};
@@ -649,7 +678,7 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
     });
     switch (ctx_.render.projection) {
         case Projection::Composite:
-            if (p_.compositing == Profile::Compositing::BackToFrontLerp) {
+            if (p_.compositing == Profile::Compositing::Lerp) {
                 // sum = sum (1 - w) + col w per channel, w = opacity density, col = (rgb, opacity)
                 Iv sum[4] = {};
                 const bool reverse = p_.placement != Profile::Placement::FromExit;
@@ -761,10 +790,23 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
 
 template <class Rec>
 PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
-    if (p_.compositing == Profile::Compositing::BackToFrontLerp) return composite_lerp(ray, intervals, rec);
-    // A GPU shader's compositing: A += (1 - A) alpha, C += (1 - A) alpha c (march/Accumulators.h),
-    // stopping as the profile says after every sample.
-    FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
+    switch (p_.compositing) {
+        case Profile::Compositing::Lerp: return composite_lerp(ray, intervals, rec);
+        case Profile::Compositing::OpticalDepth:
+            return composite_front_to_back<TransmittanceRule::OpticalDepthSum>(ray, intervals, rec);
+        case Profile::Compositing::Product: return composite_front_to_back<TransmittanceRule::Product>(ray, intervals, rec);
+        case Profile::Compositing::OpacitySum: break;
+    }
+    return composite_front_to_back<TransmittanceRule::OpacitySum>(ray, intervals, rec);
+}
+
+// Front to back (march/Accumulators.h), the transmittance kept by rule R: a GPU shader's opacity sum
+// A += (1 - A) alpha, C += (1 - A) alpha c, the product T *= 1 - alpha, or the reference's optical
+// depth; stopping as the profile says after every sample, and at an opaque sample (alpha >= 1).
+template <TransmittanceRule R, class Rec>
+PixelValue ProfileIntegrator::composite_front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    FrontToBack<Scalar, R> acc;
+    bool opaque = false;
     const Shader* shader = ctx_.pipeline.shader();
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
@@ -791,7 +833,12 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
                 if (p_.clamp_shaded) c = glm::clamp(c, 0.0, 1.0);
             }
             const double cc[3] = {c.r, c.g, c.b};
-            acc.add(true, false, 0.0, k.alpha, cc);
+            if constexpr (R == TransmittanceRule::OpacitySum) {
+                acc.add(true, false, 0.0, k.alpha, cc);
+            } else {  // an opaque sample ends the ray (its optical depth is infinite)
+                opaque = k.alpha >= 1.0;
+                acc.add(true, opaque, opaque ? 0.0 : -std::log1p(-k.alpha), std::min(k.alpha, 1.0), cc);
+            }
             if constexpr (Rec::kOn) r.sample.color = c;
         } else if constexpr (Rec::kOn) {
             r.sample.color = k.color;
@@ -808,7 +855,10 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        return !acc.stops(true, p_.termination);
+        if constexpr (R == TransmittanceRule::OpacitySum) return !acc.stops(true, p_.termination);
+        const Termination& term = p_.termination;
+        return !(opaque || acc.stops(true, term) ||
+                 (term.test_transmittance && acc.transmittance() <= term.transmittance_at_most));
     });
     PixelValue out;
     out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());

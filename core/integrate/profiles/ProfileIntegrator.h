@@ -65,6 +65,7 @@ private:
     // fn(t, d): a sample at ray parameter t standing for length d; returns false to stop.
     template <class Fn>
     void for_each_sample(const std::vector<Interval>& intervals, Fn&& fn) const;
+    void check_rules(const RenderSpec& render, bool cartesian) const;
     double value(const glm::dvec3& x) const;
     double seed_shell_value(const glm::dvec3& x) const;  // Profile::seed_shell_reads
     // A texture fetch under render.profile_options.texture_unit (TextureUnit.h): the value the unit
@@ -96,6 +97,8 @@ private:
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <TransmittanceRule R, class Rec>
+    PixelValue composite_front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>
     PixelValue composite_lerp(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>
@@ -103,7 +106,7 @@ private:
     template <class Rec>
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals, bool mean, Rec& rec) const;
 
-    const Profile& p_;
+    const Profile p_;  // the preset with the scene's rules (resolve_profile)
     const Volume* volume_ = nullptr;          // seed_shell_reads: the beam-space data
     const ShellGrid* shell_ = nullptr;        // seed_shell_reads: its grid (null on Cartesian grids)
     glm::dvec3 domain_lo_, domain_hi_;

@@ -12,6 +12,7 @@
 #include "cli/CompareCommand.h"
 #include "core/Error.h"
 #include "core/compare/ComparedImage.h"
+#include "core/compare/ConventionSearch.h"
 #include "core/compare/Fits.h"
 #include "core/compare/HeatMap.h"
 #include "core/compare/ImageMetrics.h"
@@ -118,8 +119,31 @@ int run_compare(const CompareArgs& args) {
     std::optional<glm::dvec4> background;
     if (!args.background.empty()) background = parse_background(args.background);
 
+    if (!args.scene.empty() && !args.fit) throw Error("--scene: only with --fit");
+    if (args.b.empty() && args.scene.empty()) throw Error("b: required (image B), unless --fit --scene SCENE renders it");
     ComparedImage a = read_compared_image(args.a, background);
-    ComparedImage b = read_compared_image(args.b, background);
+    std::optional<Scene> scene;
+    if (!args.scene.empty()) scene = load_scene(args.scene);
+    ComparedImage b;
+    if (!args.b.empty()) {
+        b = read_compared_image(args.b, background);
+    } else {  // issue 29: B is the scene rendered, composited as read_compared_image composites an EXR
+        b.path = args.scene.string() + " (rendered)";
+        const Image im = render_scene(*scene);
+        b.rgba = Image(im.width, im.height, {"R", "G", "B", "A"});
+        const std::size_t C = im.channels.size();
+        for (std::size_t p = 0; p < std::size_t(im.width) * std::size_t(im.height); ++p) {
+            for (std::size_t c = 0; c < 4; ++c) b.rgba.pixels[p * 4 + c] = im.pixels[p * C + c];
+            for (std::size_t c = 4; c < C; ++c)
+                if (im.channels[c] == "error") b.error.push_back(im.pixels[p * C + c]);
+            if (background) {
+                const glm::dvec4 bg = *background;
+                const double t = 1.0 - b.rgba.pixels[p * 4 + 3];
+                for (std::size_t c = 0; c < 3; ++c) b.rgba.pixels[p * 4 + c] += t * bg.a * bg[int(c)];
+                b.rgba.pixels[p * 4 + 3] += t * bg.a;
+            }
+        }
+    }
     if (a.rgba.width != b.rgba.width || a.rgba.height != b.rgba.height)
         throw Error(args.a.string() + " is " + std::to_string(a.rgba.width) + "x" + std::to_string(a.rgba.height) +
                     " but " + args.b.string() + " is " + std::to_string(b.rgba.width) + "x" +
@@ -133,17 +157,27 @@ int run_compare(const CompareArgs& args) {
     const ImageMetrics m = measure_difference(a.rgba, b.rgba, tolerance);
     const bool within = m.overall.over == 0;
 
-    double scale = 0.0;
-    if (!args.heatmap.empty()) {
-        scale = args.heatmap_scale > 0.0 ? args.heatmap_scale : m.overall.max_abs;
-        if (std::isnan(scale)) scale = 0.0;
-        write_heatmap(max_abs_difference_map(a.rgba, b.rgba), a.rgba.width, a.rgba.height, scale, args.heatmap);
-    }
-    if (!args.scene.empty() && !args.fit) throw Error("--scene: only with --fit");
     std::optional<DifferenceExplanation> fit;
     if (args.fit)
         fit = explain_difference(a.rgba, b.rgba,
                                  args.scene.empty() ? std::vector<ConventionVariant>{} : convention_variants(args.scene, background));
+    // issue 29: the rules of the scene's profile and the image models that explain A (ConventionSearch.h)
+    std::optional<SearchResult> search;
+    if (scene) {
+        SearchOptions so;
+        so.tolerance = args.tolerance > 0.0 ? args.tolerance : -1.0;
+        so.background = background;
+        search = search_conventions(a, *scene, so);
+    }
+    double scale = 0.0;
+    if (!args.heatmap.empty()) {  // with a search: the residual its best set leaves (the unexplained pixels)
+        const std::vector<double> map = search ? search->residual : max_abs_difference_map(a.rgba, b.rgba);
+        double largest = 0.0;
+        for (double x : map) largest = std::max(largest, x);
+        scale = args.heatmap_scale > 0.0 ? args.heatmap_scale : (search ? largest : m.overall.max_abs);
+        if (std::isnan(scale)) scale = 0.0;
+        write_heatmap(map, a.rgba.width, a.rgba.height, scale, args.heatmap);
+    }
 
     if (args.json) {
         nlohmann::json j;
@@ -174,6 +208,10 @@ int run_compare(const CompareArgs& args) {
                                      {"note", f.note},
                                      {"parameters", f.parameters}};
             j["fit"]["verdict"] = fit->verdict;
+        }
+        if (search) {  // {"explained", "rules", "unexplained_pixels", "residual_max", ...} at the top level
+            const nlohmann::json sj = search->to_json();
+            for (auto it = sj.begin(); it != sj.end(); ++it) j[it.key()] = it.value();
         }
         std::printf("%s\n", j.dump(2).c_str());
     } else {
@@ -213,6 +251,11 @@ int run_compare(const CompareArgs& args) {
                                 number(f.rgba_after, "%.4e").c_str());
             }
             std::printf("%s\n", fit->verdict.c_str());
+        }
+        if (search) {
+            std::printf("convention search: %zu sets rendered (rules of render.profile, image models); tolerance %s per channel\n",
+                        search->tried.size(), number(search->tolerance).c_str());
+            std::printf("%s\n", search->verdict.c_str());
         }
         std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
     }

@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
         "compare", "Compare two images: max abs, mean abs, RMSE, PSNR, SSIM, pixels over a tolerance; exit 0 within "
                    "tolerance, 1 not, 2 usage or input errors (docs/compare.md)");
     cmp->add_option("a", compare.a, "Image A (any format OpenImageIO reads; e.g. volref's EXR)")->required();
-    cmp->add_option("b", compare.b, "Image B, the same size")->required();
+    cmp->add_option("b", compare.b, "Image B, the same size (optional with --scene: B is then the scene rendered)");
     cmp->add_option("--tolerance", compare.tolerance, "Absolute tolerance per channel (default 0)")
         ->check(CLI::NonNegativeNumber);
     cmp->add_flag("--tolerance-from-error", compare.tolerance_from_error,
@@ -97,8 +97,9 @@ int main(int argc, char** argv) {
     cmp->add_flag("--fit", compare.fit, "Fit a gain, an opacity exponent and a sub-pixel shift; name the likely cause");
     cmp->add_flag("--json", compare.json, "Print the report as JSON");
     cmp->add_option("--scene", compare.scene,
-                    "With --fit: the scene B was rendered from; B is re-rendered with a flipped normal, a ray box half a "
-                    "voxel larger or smaller and MIP opacity correction changed, and each is fitted (vtk-js profile)");
+                    "With --fit: the scene A is a render of (B: volref's render of it); the scene is re-rendered with its "
+                    "profile's rules changed, one and then two at a time, and under image models (flip, premultiplication, "
+                    "BGRA, sRGB), naming the set that explains A (docs/compare.md, \"Convention search\")");
 
     volref::cli::InfoArgs info;
     CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");

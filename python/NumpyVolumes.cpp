@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <pybind11/numpy.h>
 
+#include "core/MemoryLimit.h"
+
 #include "core/Error.h"
 
 namespace py = pybind11;
@@ -17,25 +19,6 @@ namespace py = pybind11;
 namespace volref::python {
 
 namespace fs = std::filesystem;
-
-TempDir::~TempDir() {
-    if (path_.empty()) return;
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-}
-
-const fs::path& TempDir::path() {
-    if (!path_.empty()) return path_;
-    std::error_code ec;
-    const fs::path base = fs::temp_directory_path(ec);
-    if (ec) throw Error("cannot find a temporary folder for the numpy volumes: " + ec.message() + " (set TMPDIR)");
-    std::string pattern = (base / "volref-py-XXXXXX").string();
-    if (!::mkdtemp(pattern.data()))
-        throw Error(base.string() + ": cannot create a temporary folder for the numpy volumes: " + std::strerror(errno) +
-                    " (set TMPDIR)");
-    path_ = pattern;
-    return path_;
-}
 
 bool is_ndarray(py::handle h) { return py::isinstance<py::array>(h); }
 
@@ -55,7 +38,7 @@ std::string volref_type(const py::dtype& dt) {
 
 }  // namespace
 
-void write_numpy_volume(py::handle handle, const std::string& key, const fs::path& file) {
+std::shared_ptr<const Volume> numpy_volume(py::handle handle, const std::string& key) {
     if (!is_ndarray(handle)) throw Error(key + ": expected a 3-D numpy array");
     py::array array = py::reinterpret_borrow<py::array>(handle);
     if (array.ndim() != 3)
@@ -71,44 +54,28 @@ void write_numpy_volume(py::handle handle, const std::string& key, const fs::pat
     if (nx < 1 || ny < 1 || nz < 1)
         throw Error(key + ": the array is empty (shape (" + std::to_string(nz) + ", " + std::to_string(ny) + ", " +
                     std::to_string(nx) + "))");
-    // Byte order: '>' big-endian, '<' little, '=' native, '|' not applicable (1 byte).
+    // Native byte order and C order (x fastest), as VoxelArray stores its values: numpy converts any
+    // other byte order or layout (a transposed view, a slice with steps, Fortran order) first.
     const char order = dt.attr("byteorder").cast<std::string>().at(0);
-    const bool big = order == '>' || (order == '=' && std::endian::native == std::endian::big);
-    // C order (x fastest) is written as it is; any other layout (a transposed view, a slice with
-    // steps, Fortran order) is first copied into C order by numpy.
+    const bool swapped = order == '>' ? std::endian::native == std::endian::little : order == '<' && std::endian::native == std::endian::big;
+    if (swapped) array = array.attr("astype")(dt.attr("newbyteorder")("=")).cast<py::array>();
     if (!(array.flags() & py::array::c_style))
         array = py::module_::import("numpy").attr("ascontiguousarray")(array).cast<py::array>();
-
-    nlohmann::json sidecar;
-    sidecar["dims"] = {nx, ny, nz};
-    sidecar["type"] = type;
-    sidecar["endian"] = big ? "big" : "little";
-    const std::string sidecar_text = sidecar.dump();
-    const char* data = static_cast<const char*>(array.data());
-    const std::size_t bytes = std::size_t(array.nbytes());
-
-    std::string failure;
-    {
-        py::gil_scoped_release release;  // `array` stays referenced (and so unchanged) by this frame
-        auto write = [&](const fs::path& path, const char* p, std::size_t n) {
-            std::FILE* f = std::fopen(path.c_str(), "wb");
-            if (!f) return std::string(std::strerror(errno));
-            const std::size_t written = n ? std::fwrite(p, 1, n, f) : 0;
-            const int err = written == n ? 0 : errno;
-            if (std::fclose(f) != 0 && err == 0) return std::string(std::strerror(errno));
-            if (written != n) return std::string(err ? std::strerror(err) : "short write");
-            return std::string();
-        };
-        failure = write(file, data, bytes);
-        if (failure.empty()) {
-            fs::path side = file;
-            side += ".json";
-            failure = write(side, sidecar_text.data(), sidecar_text.size());
-        }
-    }
-    if (!failure.empty())
-        throw Error(key + ": cannot write the numpy array to the temporary file " + file.string() + ": " + failure +
-                    " (set TMPDIR to a folder with room)");
+    static const std::pair<const char*, ScalarType> kTypes[] = {{"u8", ScalarType::U8},   {"i8", ScalarType::I8},
+                                                                {"u16", ScalarType::U16}, {"i16", ScalarType::I16},
+                                                                {"u32", ScalarType::U32}, {"i32", ScalarType::I32},
+                                                                {"f32", ScalarType::F32}, {"f64", ScalarType::F64}};
+    ScalarType st = ScalarType::F64;
+    for (const auto& [name, t] : kTypes)
+        if (type == name) st = t;
+    const std::size_t count = std::size_t(nx) * std::size_t(ny) * std::size_t(nz);
+    check_memory(std::size_t(array.nbytes()), key + ": the numpy volume's copy");
+    auto v = std::make_shared<Volume>();
+    v->dims = {nx, ny, nz};
+    v->type = st;
+    v->values = VoxelArray(st, count);
+    std::memcpy(v->values.raw(), array.data(), std::size_t(array.nbytes()));
+    return v;
 }
 
 }  // namespace volref::python

@@ -6,11 +6,12 @@
 // anything else (complex, bool, int64, float16, object, ...) is refused with a volref::Error naming
 // the scene key. NaN and infinite values are allowed (rendered transparent, docs/accuracy.md).
 //
-// The core reads volumes from files or procedural fields only, so an array is written once to a raw
-// file with its JSON sidecar (docs/formats.md) in a private temporary folder, the scene points at it,
-// and volref's raw reader reads it as it reads any raw file; the folder is removed when the call
-// returns (TempDir).
+// The array is copied once into a Volume (core/grid/Volume.h) in its own type, and the scene's volume
+// holds it in memory (VolumeSourceSpec::memory, issue 29): no file is written or read.
 #pragma once
+#include <memory>
+
+#include "core/grid/Volume.h"
 #include <filesystem>
 #include <string>
 
@@ -18,27 +19,12 @@
 
 namespace volref::python {
 
-// A private folder under std::filesystem::temp_directory_path() ($TMPDIR, else /tmp), created on first
-// use and removed with everything in it by the destructor.
-class TempDir {
-public:
-    TempDir() = default;
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    ~TempDir();
-    const std::filesystem::path& path();  // creates it; throws volref::Error if it cannot
-    bool created() const { return !path_.empty(); }
-
-private:
-    std::filesystem::path path_;
-};
-
 // True for a numpy.ndarray.
 bool is_ndarray(pybind11::handle h);
 
-// Checks `array` (a numpy.ndarray) and writes it as `file` (raw samples) + `file`.json (sidecar).
-// `key` names the scene key in messages, e.g. "scene: volume.source". Holds the GIL on entry; releases
-// it while writing the bytes. Throws volref::Error.
-void write_numpy_volume(pybind11::handle array, const std::string& key, const std::filesystem::path& file);
+// Checks `array` (a numpy.ndarray) and copies it into a Volume (dims nx, ny, nz; origin 0, spacing 1:
+// the scene's origin and spacing apply). `key` names the scene key in messages, e.g. "scene:
+// volume.source". Holds the GIL. Throws volref::Error.
+std::shared_ptr<const Volume> numpy_volume(pybind11::handle array, const std::string& key);
 
 }  // namespace volref::python

@@ -170,12 +170,12 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
             const std::string key = py::isinstance<py::str>(item.first) ? item.first.cast<std::string>() : "";
             if (key == "source" && is_ndarray(item.second)) {
                 const std::string source = child(path, "source");
-                const fs::path file = in->temp->path() / ("volume" + std::to_string(in->arrays.size()) + ".raw");
-                write_numpy_volume(item.second, "scene: " + source, file);
-                std::error_code ec;
-                const fs::path canonical = fs::weakly_canonical(file, ec);
-                in->arrays.push_back({(ec ? file : canonical).string(), py::reinterpret_borrow<py::object>(item.second), source});
-                j["source"] = {{"file", in->arrays.back().file}, {"format", "raw"}};
+                // In memory (issue 29): the source names a file that is never opened; the parsed scene's
+                // volume then holds the array's copy (VolumeSourceSpec::memory).
+                const std::string name = "numpy-volume-" + std::to_string(in->arrays.size()) + ".raw";
+                in->arrays.push_back({name, py::reinterpret_borrow<py::object>(item.second), source,
+                                      numpy_volume(item.second, "scene: " + source)});
+                j["source"] = {{"file", name}, {"format", "raw"}};
             } else {
                 if (key.empty())
                     throw Error("scene: " + path + ": keys must be strings, got " + std::string(py::repr(item.first)));
@@ -208,6 +208,12 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
     } catch (const Error& e) {
         throw Error(in->rewrite(e.what()));
     }
+    for (VolumeSpec& vs : in->scene.volumes)
+        for (SceneInput::Array& a : in->arrays)
+            if (vs.source.file && vs.source.file->filename() == a.file) {
+                vs.source.memory = a.volume;
+                a.file = vs.source.file->string();  // as the resolved scene and messages write it
+            }
     return in;
 }
 

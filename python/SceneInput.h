@@ -27,17 +27,18 @@ struct SceneInput {
     Scene scene;
     bool from_file = false;  // given as a path (volref explain can then take it as it is)
     std::string file;        // that path
-    // The numpy volumes: each temporary file, the array and the scene key it came from.
+    // The numpy volumes: the name the scene's source holds (VolumeSourceSpec::file; no such file exists),
+    // the array, the scene key it came from and its copy in memory (VolumeSourceSpec::memory).
     struct Array {
         std::string file;
         pybind11::object array;
         std::string key;  // "volume.source", "volumes[1].source"
+        std::shared_ptr<const Volume> volume;
     };
     std::vector<Array> arrays;
-    std::unique_ptr<TempDir> temp = std::make_unique<TempDir>();
 
-    // `message` with each temporary file's path replaced by the scene key of its array, so that an
-    // error reading it names the key ("scene: volume.source (numpy array): ...").
+    // `message` with each numpy volume's name replaced by the scene key of its array, so that an
+    // error about it names the key ("scene: volume.source (numpy array): ...").
     std::string rewrite(const std::string& message) const;
     // The resolved scene (SceneDict.h) as a Python dict, with each numpy volume's "source" the array
     // itself (instead of its temporary file). Needs the GIL.

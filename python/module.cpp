@@ -26,6 +26,8 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/compare/ComparedImage.h"
+#include "core/compare/ConventionSearch.h"
+#include "core/compare/HeatMap.h"
 #include "core/compare/ImageMetrics.h"
 #include "core/compare/MetricsJson.h"
 #include "core/compare/Tolerance.h"
@@ -34,6 +36,8 @@
 #include "core/explain/NumberFormat.h"
 #include "core/explain/PixelTrace.h"
 #include "core/film/Image.h"
+#include "core/film/ImageWriter.h"
+#include "core/integrate/profiles/Profile.h"
 #include "core/render/PreparedScene.h"
 #include "core/render/PreparedVolume.h"
 #include "core/render/Renderer.h"
@@ -327,6 +331,19 @@ std::pair<py::object, py::object> pair_of(py::handle v) {
     return {py::reinterpret_borrow<py::object>(v), py::reinterpret_borrow<py::object>(v)};
 }
 
+// (r, g, b, a) in [0, 1], or None.
+std::optional<glm::dvec4> background_of(py::handle background_arg) {
+    if (background_arg.is_none()) return std::nullopt;
+    std::vector<double> v;
+    try {
+        v = background_arg.cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+    }
+    if (v.size() != 4 || !std::all_of(v.begin(), v.end(), [](double x) { return x >= 0.0 && x <= 1.0; }))
+        throw Error("background: expected (r, g, b, a), four numbers in [0, 1]");
+    return glm::dvec4(v[0], v[1], v[2], v[3]);
+}
+
 py::object compare_images(py::object a_arg, py::object b_arg, py::object tolerance, py::object error,
                           py::object quantization, py::object background_arg, py::object max_memory) {
     const MemoryScope memory(max_memory);
@@ -338,17 +355,7 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
         if (!std::isfinite(absolute) || absolute < 0.0)
             throw Error("tolerance: expected a number >= 0, got " + std::string(py::repr(tolerance)));
     }
-    std::optional<glm::dvec4> background;
-    if (!background_arg.is_none()) {
-        std::vector<double> v;
-        try {
-            v = background_arg.cast<std::vector<double>>();
-        } catch (const py::cast_error&) {
-        }
-        if (v.size() != 4 || !std::all_of(v.begin(), v.end(), [](double x) { return x >= 0.0 && x <= 1.0; }))
-            throw Error("background: expected (r, g, b, a), four numbers in [0, 1]");
-        background = glm::dvec4(v[0], v[1], v[2], v[3]);
-    }
+    const std::optional<glm::dvec4> background = background_of(background_arg);
     // quantization: None, bits for both numpy inputs, or (bits_a, bits_b) with None for "from the input".
     const auto [qa, qb] = pair_of(quantization);
     // error: None/False, True (each input's own `error` channel), or arrays: one for both, or (error_a, error_b).
@@ -398,6 +405,147 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     return json_loads(j.dump());
 }
 
+// ---- fit, heatmap, write_image, profiles (issue 29) -------------------------------------------
+
+// A (height, width) float64 array of `values` (row 0 on top).
+py::array_t<double> image_plane(const std::vector<double>& values, int width, int height) {
+    py::array_t<double> out({py::ssize_t(height), py::ssize_t(width)});
+    std::copy(values.begin(), values.end(), out.mutable_data());
+    return out;
+}
+
+py::object fit_conventions(py::object image, py::object scene, py::object tolerance, py::object threads, py::object overrides,
+                           py::object background_arg, py::object heatmap) {
+    compare::SearchOptions so;
+    if (!tolerance.is_none()) {
+        so.tolerance = tolerance.cast<double>();
+        if (!std::isfinite(so.tolerance) || so.tolerance < 0.0)
+            throw Error("tolerance: expected a number >= 0, got " + std::string(py::repr(tolerance)));
+    }
+    if (!threads.is_none()) so.threads = threads.cast<int>();
+    so.background = background_of(background_arg);
+    std::filesystem::path heatmap_path;
+    if (!heatmap.is_none()) {
+        heatmap_path = py::module_::import("os").attr("fspath")(heatmap).cast<std::string>();
+        compare::check_heatmap_path(heatmap_path);
+    }
+    compare::ComparedImage g = compared_input(image, "image", py::none(), so.background);
+    const std::unique_ptr<SceneInput> in = read_scene_input(scene, overrides);
+    compare::SearchResult r;
+    {
+        py::gil_scoped_release release;
+        r = compare::search_conventions(g, in->scene, so);
+        if (!heatmap_path.empty()) {
+            double largest = 0.0;
+            for (double x : r.residual) largest = std::max(largest, x);
+            compare::write_heatmap(r.residual, r.width, r.height, largest, heatmap_path);
+        }
+    }
+    py::object d = json_loads(r.to_json().dump());
+    d["residual"] = image_plane(r.residual, r.width, r.height);
+    return d;
+}
+
+py::array_t<double> heatmap_of(py::object a_arg, py::object b_arg, py::object path, py::object scale) {
+    const compare::ComparedImage a = compared_input(a_arg, "a", py::none(), std::nullopt);
+    const compare::ComparedImage b = compared_input(b_arg, "b", py::none(), std::nullopt);
+    if (a.rgba.width != b.rgba.width || a.rgba.height != b.rgba.height)
+        throw Error("b: the images differ in size (" + std::to_string(a.rgba.width) + "x" + std::to_string(a.rgba.height) + " and " +
+                    std::to_string(b.rgba.width) + "x" + std::to_string(b.rgba.height) + ")");
+    const std::vector<double> map = compare::max_abs_difference_map(a.rgba, b.rgba);
+    if (!path.is_none()) {
+        const std::filesystem::path p = py::module_::import("os").attr("fspath")(path).cast<std::string>();
+        compare::check_heatmap_path(p);
+        double s = 0.0;
+        if (!scale.is_none()) {
+            s = scale.cast<double>();
+            if (!std::isfinite(s) || s < 0.0) throw Error("scale: expected a number >= 0");
+        }
+        if (s == 0.0)
+            for (double x : map)
+                if (std::isfinite(x)) s = std::max(s, x);
+        compare::write_heatmap(map, a.rgba.width, a.rgba.height, s, p);
+    }
+    return image_plane(map, a.rgba.width, a.rgba.height);
+}
+
+// An image to write: a RenderResult (every channel) or a numpy array (height, width, 4 or 3) of
+// premultiplied linear RGBA (3: alpha 1).
+Image image_of(py::handle v, const char* name) {
+    if (py::isinstance<RenderResult>(v)) return *v.cast<const RenderResult&>().image;
+    if (!py::isinstance<py::array>(v))
+        throw Error(std::string(name) + ": expected a volref render or a numpy array (height, width, 4), got a " + type_name(v));
+    const py::array_t<double, py::array::forcecast> a(py::reinterpret_borrow<py::array>(v));
+    if (a.ndim() != 3 || (a.shape(2) != 4 && a.shape(2) != 3) || a.shape(0) < 1 || a.shape(1) < 1)
+        throw Error(std::string(name) + ": expected a numpy array of shape (height, width, 4) (premultiplied RGBA) or (height, width, 3)");
+    const auto q = a.unchecked<3>();
+    Image im(int(a.shape(1)), int(a.shape(0)), {"R", "G", "B", "A"});
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x)
+            for (int c = 0; c < 4; ++c) im.at(x, y, std::size_t(c)) = c < a.shape(2) ? q(y, x, c) : 1.0;
+    return im;
+}
+
+void write_image_file(py::object path, py::object image, py::object background_arg) {
+    const std::filesystem::path p = py::module_::import("os").attr("fspath")(path).cast<std::string>();
+    const Image im = image_of(image, "image");
+    const glm::dvec4 bg = background_of(background_arg).value_or(glm::dvec4(0.0));
+    check_output_path(p);
+    py::gil_scoped_release release;
+    write_image(im, p, bg);
+}
+
+py::object profiles_dict() {
+    nlohmann::json j = nlohmann::json::object();
+    for (ProfileId id : preset_ids()) {
+        RenderSpec r;
+        r.profile = id;
+        const nlohmann::json rules = profile_rules_json(resolve_profile(r));
+        j[rules["base"].get<std::string>()] = rules;
+    }
+    return json_loads(j.dump());
+}
+
+// PNG bytes of the image composited over its scene's background (as volref render writes PNG):
+// IHDR, one IDAT (Python's zlib) and IEND, 8-bit RGBA, non-interlaced.
+py::bytes png_bytes(const RenderResult& r) {
+    const Image& im = *r.image;
+    glm::dvec4 bg(0.0);
+    try {
+        const py::list b = r.scene["image"]["background"];
+        for (int c = 0; c < 4; ++c) bg[c] = b[std::size_t(c)].cast<double>();
+    } catch (const std::exception&) {
+    }
+    std::string raw;
+    raw.reserve(std::size_t(im.height) * (1 + 4 * std::size_t(im.width)));
+    for (int y = 0; y < im.height; ++y) {
+        raw.push_back(0);  // filter: none
+        for (int x = 0; x < im.width; ++x) {
+            double c[4];
+            for (int k = 0; k < 4; ++k) c[k] = im.at(x, y, std::size_t(k));
+            for (int k = 0; k < 3; ++k) c[k] += (1.0 - c[3]) * bg.a * bg[k];
+            c[3] += (1.0 - c[3]) * bg.a;
+            for (int k = 0; k < 4; ++k) {
+                const double v = k < 3 ? (c[3] > 0.0 ? c[k] / c[3] : 0.0) : c[3];
+                const double q = std::round(std::clamp(std::isfinite(v) ? v : 0.0, 0.0, 1.0) * 255.0);
+                raw.push_back(char(static_cast<unsigned char>(q)));
+            }
+        }
+    }
+    const py::module_ zlib = py::module_::import("zlib");
+    auto be32 = [](std::uint32_t v) {
+        return std::string{char(v >> 24), char((v >> 16) & 255), char((v >> 8) & 255), char(v & 255)};
+    };
+    auto chunk = [&](const std::string& type, const std::string& data) {
+        const std::string td = type + data;
+        const auto crc = zlib.attr("crc32")(py::bytes(td)).cast<std::uint32_t>();
+        return be32(std::uint32_t(data.size())) + td + be32(crc);
+    };
+    const std::string ihdr = be32(std::uint32_t(im.width)) + be32(std::uint32_t(im.height)) + std::string{8, 6, 0, 0, 0};
+    const std::string idat = zlib.attr("compress")(py::bytes(raw)).cast<std::string>();
+    return py::bytes(std::string("\x89PNG\r\n\x1a\n") + chunk("IHDR", ihdr) + chunk("IDAT", idat) + chunk("IEND", ""));
+}
+
 // ---- trace ------------------------------------------------------------------------------------
 
 std::array<int, 2> pixel_of(py::handle pixel, int width, int height, const char* name = "pixel") {
@@ -428,7 +576,7 @@ py::array trace_array(const explain::PixelTrace& t) {
     const std::vector<std::string> names = explain::trace_csv_header(t);
     std::ostringstream csv;
     explain::write_trace_csv(t, csv);
-    auto is_int = [](const std::string& n) { return n == "sample" || n == "cell_i" || n == "cell_j" || n == "cell_k"; };
+    auto is_int = [](const std::string& n) { return n == "sample" || n == "interval" || n == "segment" || n == "cell_i" || n == "cell_j" || n == "cell_k"; };
     py::list fields;
     for (const std::string& n : names) fields.append(py::make_tuple(n, is_int(n) ? "<i8" : "<f8"));
     const py::dtype dtype = py::module_::import("numpy").attr("dtype")(fields);
@@ -711,6 +859,7 @@ one float64 buffer, row 0 at the top.)doc")
                       "absolute; a numpy volume's source is the array)")
         .def_readonly("non_finite_voxels", &RenderResult::non_finite_voxels,
                       "the number of NaN or infinite voxels (rendered transparent; a RuntimeWarning says so)")
+        .def("_repr_png_", &png_bytes, "PNG bytes of the image over its scene's background (Jupyter shows it)")
         .def("__repr__", [](const RenderResult& r) {
             std::string ch;
             for (const std::string& c : r.image->channels) ch += (ch.empty() ? "" : ",") + c;
@@ -764,6 +913,42 @@ Arguments:
 Returns {"a", "b", "width", "height", "tolerance", "channels": {"R": {...}, ...}, "overall": {"max_abs",
 "mean_abs", "rmse", "psnr_db", "ssim", "pixels_over", "fraction_over"}, "pixels", "pixels_over",
 "non_finite": {"a", "b", "disagree"}, "fraction_over", "within_tolerance"}; +inf PSNR and missing SSIM are None, as in the CLI's JSON.)doc");
+
+    m.def("fit", &fit_conventions, py::arg("image"), py::arg("scene"), py::kw_only(), py::arg("tolerance") = py::none(),
+          py::arg("threads") = py::none(), py::arg("overrides") = py::none(), py::arg("background") = py::none(),
+          py::arg("heatmap") = py::none(),
+          R"doc(Which conventions explain another renderer's image of a scene: `volref compare IMAGE --fit --scene SCENE`.
+
+The scene is re-rendered with its profile's rules changed (render.profile: placement, ray_box, table,
+step_voxel, correction, termination, normal, gradient, clamp_shaded), one and then two at a time, and each
+render read under the image models (vertical flip, unpremultiplied, double-premultiplied, BGRA,
+sRGB-encoded). A pixel is explained when every channel is within tolerance (default 1e-4) plus the
+render's error channel and the image's quantisation (docs/compare.md, "Convention search").
+
+Arguments: image (a path, numpy array (height, width, 4) of premultiplied RGBA, or a RenderResult), scene
+(as for render), tolerance, threads, overrides (as for render), background (as for compare), heatmap (a
+PNG path: the residual the best set leaves).
+Returns {"explained", "rules" (the render.profile keys that explain, {} when not explained),
+"image_model", "unexplained_pixels", "residual_max", "residual_rms", "pixels", "explained_fraction",
+"closest": {"rules", "image_model"}, "alpha_agrees_colour_differs", "verdict", "tried": [...],
+"residual": numpy (height, width)}.)doc");
+
+    m.def("heatmap", &heatmap_of, py::arg("a"), py::arg("b"), py::kw_only(), py::arg("path") = py::none(),
+          py::arg("scale") = py::none(),
+          R"doc(The per-pixel max abs difference of two images over R, G, B, A, as a numpy array (height, width);
+with `path`, also written as `volref compare --heatmap` writes it (black 0 -> white `scale`, default the
+largest difference). a, b: as for compare.)doc");
+
+    m.def("write_image", &write_image_file, py::arg("path"), py::arg("image"), py::kw_only(), py::arg("background") = py::none(),
+          R"doc(Write an image as `volref render` does: .exr (linear float, premultiplied, every channel of a
+RenderResult), .png / .tif (composited over `background`, default transparent, unassociated alpha).
+image: a RenderResult or a numpy array (height, width, 4) of premultiplied linear RGBA (3: alpha 1).)doc");
+
+    m.def("profiles", &profiles_dict,
+          R"doc(The presets of render.profile and their rules, as dicts in render.profile's object form
+({"reference": {"base": "reference", "placement": "midpoints", ...}, "vtk-gpu": {...}, ...}); vtk-cpu,
+vtk-js and fast are renderers of their own ({"base": name} only). Any of these dicts, changed, is a
+valid render.profile.)doc");
 
     m.def("trace", &trace, py::arg("scene"), py::arg("pixel"), py::kw_only(), py::arg("overrides") = py::none(),
           py::arg("skipping") = true, py::arg("format") = "array", py::arg("max_memory") = py::none(),

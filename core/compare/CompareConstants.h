@@ -49,6 +49,19 @@ inline constexpr double kExplainedResidualRatio = 0.5;
 // pixels at least kMaxShiftPixels from every border (so every shifted source stays inside the image).
 inline constexpr double kMaxShiftPixels = 2.0;
 
+// (--fit --scene, volref.fit: ConventionSearch.h) A pixel is explained by a set of rules when every
+// channel of the re-rendered image is within kSearchTolerance (or --tolerance when > 0) of the other
+// renderer's, plus the render's own error channel and the image's quantisation: 1e-4 is 30x the float32
+// rounding of a 60-sample shader measured against volref (3.3e-6, tests/python/test_external_caster.py)
+// and below every convention's effect on the test scenes (>= 3.3e-4). The set explains the image when at
+// most kSearchUnexplainedFraction of its pixels stay unexplained (grazing rays, where float32 and double
+// disagree on whether a ray enters the box). The pairs are formed from the kSearchPairsOf single rules of
+// smallest RMS residual (each below the scene's own profile's); sets grow to at most kSearchMaxRules rules.
+inline constexpr double kSearchTolerance = 1e-4;
+inline constexpr double kSearchUnexplainedFraction = 1e-3;
+inline constexpr int kSearchPairsOf = 8;
+inline constexpr int kSearchMaxRules = 4;
+
 // (sweep) error = C h^p is fitted in log space, r_i = log e_i - log C - p log h_i, under the Cauchy loss
 // rho(r^2) = s^2 log(1 + r^2 / s^2) with s = kPowerLawLossScale (a factor of about e^0.1 = 1.105 in the
 // error): points far off the power law (a step too coarse for the asymptotic regime, an error at the

@@ -126,6 +126,12 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.skipping = v.macrocells != nullptr && t.projection == Projection::Composite;  // the traced mip / minip loop does not skip
     Collector collector(scene, t.samples);
     t.pixel = scene.trace_pixel(x, y, collector);
+    for (TracedSample& s : t.samples) {  // issue 29: the rows' interval and step from its entry
+        for (std::size_t i = 0; i < t.intervals.size(); ++i)
+            if (t.intervals[i].t0 <= s.record.t) s.interval = std::int64_t(i);
+        if (s.interval >= 0 && t.step > 0.0)
+            s.segment = std::int64_t(std::floor((s.record.t - t.intervals[std::size_t(s.interval)].t0) / t.step + 1e-9));
+    }
     if (t.pixel.fault) t.fault = v.integrator->fault_reason(v.volume_ray(t.ray));
     return t;
 }
@@ -147,6 +153,8 @@ std::vector<Column> columns(const PixelTrace& t) {
         c.push_back({std::move(name), std::move(f)});
     };
     add("sample", [](const TracedSample& s) { return std::to_string(s.record.index); });
+    add("interval", [](const TracedSample& s) { return std::to_string(s.interval); });
+    add("segment", [](const TracedSample& s) { return std::to_string(s.segment); });
     add("t0", [=](const TracedSample& s) { return num(s.record.t0); });
     add("t1", [=](const TracedSample& s) { return num(s.record.t1); });
     add("t", [=](const TracedSample& s) { return num(s.record.t); });
@@ -259,6 +267,8 @@ std::string trace_json(const PixelTrace& t, int indent) {
         const SampleDetail& d = r.sample;
         nlohmann::json o;
         o["sample"] = r.index;
+        o["interval"] = s.interval;
+        o["segment"] = s.segment;
         o["t0"] = jnum(r.t0);
         o["t1"] = jnum(r.t1);
         o["t"] = jnum(r.t);

@@ -53,7 +53,11 @@ constexpr int kPacketBlockHeight = kMaxPacketRays / kPacketBlockWidth;
 Volume load_volume(const VolumeSpec& spec) {
     if (const VolumeLoaderHook& hook = volume_loader_hook()) return hook(spec);  // volref-mpi: the rank's brick
     Volume v;
-    if (spec.source.field) {
+    if (spec.source.memory) {  // a numpy volume (python/NumpyVolumes.h): the scene's origin and spacing apply
+        v = *spec.source.memory;
+        if (spec.origin) v.origin = *spec.origin;
+        if (spec.spacing) v.spacing = *spec.spacing;
+    } else if (spec.source.field) {
         v = make_procedural_volume(*spec.source.field, spec.origin.value_or(glm::dvec3(0.0)),
                                    spec.spacing.value_or(glm::dvec3(1.0)));
     } else {

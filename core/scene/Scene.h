@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,9 +30,14 @@ struct FieldSpec {
     std::vector<double> values;                   // cells: nx*ny*nz values, i fastest
 };
 
+struct Volume;
+
 struct VolumeSourceSpec {
     // Exactly one of file / field is set.
     std::optional<std::filesystem::path> file;  // absolute (resolved against the scene file's folder)
+    // A volume given in memory (a numpy array, python/NumpyVolumes.h): load_volume takes it instead of
+    // reading `file`, which then only names it in messages. Not in scene files.
+    std::shared_ptr<const Volume> memory;
     std::string format;                          // "" (from the extension), "nrrd" or "raw"
     std::optional<FieldSpec> field;
 };

@@ -797,7 +797,7 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     static constexpr std::string_view kKeys[] = {
         "placement", "first",      "step_count",  "ray_box",  "step_voxel", "correction",    "correction_floor",
         "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
-        "normal",    "gradient",   "gradient_offset", "clamp_shaded", "jitter"};
+        "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded"};  // jitter "off": nothing to apply
     r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
              "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
              "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter"});
@@ -1029,6 +1029,52 @@ BoundsSpec parse_shell(const std::string& json_text, const std::string& name) {
     b.type = r.required_choice<T>("type", {{"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
     read_shell(r, b);
     return b;
+}
+
+ProfileRules parse_profile_rules(const nlohmann::json& object, ProfileId base, const std::string& name) {
+    const Context ctx(name);
+    if (!object.is_object()) ctx.fail("render.profile", "expected an object, got " + describe(object));
+    ObjectReader r(object, "render.profile", ctx);
+    return read_profile_rules(r, base);
+}
+
+nlohmann::json profile_rules_object(const ProfileRules& r) {
+    using P = ProfileRules;
+    Json j = Json::object();
+    static const char* const placement[] = {"midpoints", "from-entry", "from-exit"};
+    static const char* const correction[] = {"pow", "none", "extinction", "exact"};
+    static const char* const compositing[] = {"optical-depth", "product", "opacity-sum", "lerp"};
+    if (r.placement) j["placement"] = placement[int(*r.placement)];
+    if (r.first) j["first"] = *r.first;
+    if (r.step_count) j["step_count"] = *r.step_count == P::StepCount::ThroughExit ? "through-exit" : "before-exit";
+    if (r.ray_box == P::RayBox::Given && r.box)
+        j["ray_box"] = {{"min", {(*r.box)[0].x, (*r.box)[0].y, (*r.box)[0].z}}, {"max", {(*r.box)[1].x, (*r.box)[1].y, (*r.box)[1].z}}};
+    else if (r.ray_box)
+        j["ray_box"] = *r.ray_box == P::RayBox::Domain ? "domain" : "texel";
+    if (r.step_voxel) j["step_voxel"] = *r.step_voxel == P::VoxelLength::Spacing ? "spacing" : "extent-over-samples";
+    if (r.correction) j["correction"] = correction[int(*r.correction)];
+    if (r.correction_floor) j["correction_floor"] = *r.correction_floor;
+    if (r.density_scale) j["density_scale"] = *r.density_scale;
+    if (r.compositing) j["compositing"] = compositing[int(*r.compositing)];
+    if (r.termination) {
+        switch (*r.termination) {
+            case P::Stop::None: j["termination"] = "none"; break;
+            case P::Stop::AlphaAbove: j["termination"] = {{"alpha_above", r.termination_value}}; break;
+            case P::Stop::AlphaAtLeast: j["termination"] = {{"alpha_at_least", r.termination_value}}; break;
+            case P::Stop::TransmittanceAtMost: j["termination"] = {{"transmittance_at_most", r.termination_value}}; break;
+        }
+    }
+    if (r.table_entries) j["table"] = *r.table_entries;
+    if (r.table_coordinate)
+        j["table_coordinate"] = *r.table_coordinate == P::TableCoordinate::DataRange ? "data-range" : "data-range-times-transfer-scale";
+    if (r.texture_unit) j["texture_unit"] = *r.texture_unit == ProfileOptions::TextureUnit::H100 ? "h100" : "exact";
+    if (r.arithmetic) j["arithmetic"] = *r.arithmetic == P::Arithmetic::Float32 ? "float32" : "double";
+    if (r.normal_along_gradient) j["normal"] = *r.normal_along_gradient ? "+gradient" : "-gradient";
+    if (r.forward_gradient) j["gradient"] = *r.forward_gradient ? "forward" : "central";
+    if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
+    if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
+    if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;
+    return j;
 }
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& base_dir, const std::string& name,

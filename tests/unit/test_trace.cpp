@@ -303,7 +303,7 @@ TEST(Trace, CsvHeaderAndRows) {
     std::string header, line;
     std::getline(in, header);
     EXPECT_EQ(header,
-              "sample,t0,t1,t,length,x,y,z,u0,u1,u2,cell_i,cell_j,cell_k,local_p,local_q,local_r,value,class_r,class_g,"
+              "sample,interval,segment,t0,t1,t,length,x,y,z,u0,u1,u2,cell_i,cell_j,cell_k,local_p,local_q,local_r,value,class_r,class_g,"
               "class_b,opacity,tau,alpha,transmittance_before,transmittance_after,acc_r,acc_g,acc_b,acc_a");
     std::vector<std::vector<std::string>> rows;
     while (std::getline(in, line)) {
@@ -314,10 +314,15 @@ TEST(Trace, CsvHeaderAndRows) {
     }
     ASSERT_EQ(rows.size(), 3u);  // the lecture's three samples, back to front
     // sample 0 is the far one, at (0.8, 0.7, 0.2): f = 5.0928 (docs/explain.md works it by hand)
-    EXPECT_NEAR(std::stod(rows[0][17]), 5.0928, 1e-12);
-    EXPECT_NEAR(std::stod(rows[1][17]), 4.9875, 1e-12);
-    EXPECT_NEAR(std::stod(rows[2][17]), 4.9092, 1e-12);
-    for (const auto& row : rows) EXPECT_EQ(row.size(), 30u);
+    EXPECT_NEAR(std::stod(rows[0][19]), 5.0928, 1e-12);
+    EXPECT_NEAR(std::stod(rows[1][19]), 4.9875, 1e-12);
+    EXPECT_NEAR(std::stod(rows[2][19]), 4.9092, 1e-12);
+    for (const auto& row : rows) EXPECT_EQ(row.size(), 32u);
+    // issue 29: one interval of three segments, listed back to front: segments 2, 1, 0 of interval 0
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(rows[std::size_t(k)][1], "0");
+        EXPECT_EQ(rows[std::size_t(k)][2], std::to_string(2 - k));
+    }
 }
 
 TEST(Trace, JsonStructureOfAShadedScene) {

@@ -210,8 +210,8 @@ int run_compare(const CompareArgs& args) {
             j["fit"]["verdict"] = fit->verdict;
         }
         if (search) {  // {"explained", "rules", "unexplained_pixels", "residual_max", ...} at the top level
-            const nlohmann::json sj = search->to_json();
-            for (auto it = sj.begin(); it != sj.end(); ++it) j[it.key()] = it.value();
+            const nlohmann::json sj = search->to_json();  // compare's own "tolerance", "pixels" kept: the search's are search_*
+            for (auto it = sj.begin(); it != sj.end(); ++it) j[j.contains(it.key()) ? "search_" + it.key() : it.key()] = it.value();
         }
         std::printf("%s\n", j.dump(2).c_str());
     } else {
@@ -250,7 +250,7 @@ int run_compare(const CompareArgs& args) {
                                 number(f.residual_after, "%.4e").c_str(), number(f.rgba_before, "%.4e").c_str(),
                                 number(f.rgba_after, "%.4e").c_str());
             }
-            std::printf("%s\n", fit->verdict.c_str());
+            if (!search) std::printf("%s\n", fit->verdict.c_str());  // with --scene the search's verdict is the answer
         }
         if (search) {
             std::printf("convention search: %zu sets rendered (rules of render.profile, image models); tolerance %s per channel\n",
@@ -259,6 +259,8 @@ int run_compare(const CompareArgs& args) {
         }
         std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
     }
+    // With --scene: 0 when the search explains A (ConventionSearch.h), 1 when it does not.
+    if (search) return search->explained ? 0 : 1;
     return within ? 0 : 1;
 }
 

@@ -69,7 +69,8 @@ std::shared_ptr<const Volume> numpy_volume(py::handle handle, const std::string&
     for (const auto& [name, t] : kTypes)
         if (type == name) st = t;
     const std::size_t count = std::size_t(nx) * std::size_t(ny) * std::size_t(nz);
-    check_memory(std::size_t(array.nbytes()), key + ": the numpy volume's copy");
+    check_memory(std::size_t(array.nbytes()), key + " (numpy array): a volume of " + std::to_string(nx) + " x " + std::to_string(ny) +
+                                                  " x " + std::to_string(nz));
     auto v = std::make_shared<Volume>();
     v->dims = {nx, ny, nz};
     v->type = st;

@@ -55,11 +55,13 @@ inline constexpr double kMaxShiftPixels = 2.0;
 // rounding of a 60-sample shader measured against volref (3.3e-6, tests/python/test_external_caster.py)
 // and below every convention's effect on the test scenes (>= 3.3e-4). The set explains the image when at
 // most kSearchUnexplainedFraction of its pixels stay unexplained (grazing rays, where float32 and double
-// disagree on whether a ray enters the box). The pairs are formed from the kSearchPairsOf single rules of
-// smallest RMS residual (each below the scene's own profile's); sets grow to at most kSearchMaxRules rules.
+// disagree on whether a ray enters the box). Every pair of single rules is rendered when (pairs x pixels)
+// <= kSearchAllPairsPixels (about 250 pairs of a 256 x 256 image); above that, the pairs of the
+// kSearchPairsOf single rules of smallest RMS residual. Sets grow to at most kSearchMaxRules rules.
 inline constexpr double kSearchTolerance = 1e-4;
 inline constexpr double kSearchUnexplainedFraction = 1e-3;
 inline constexpr int kSearchPairsOf = 8;
+inline constexpr double kSearchAllPairsPixels = 16777216.0;  // 2^24
 inline constexpr int kSearchMaxRules = 4;
 
 // (sweep) error = C h^p is fitted in log space, r_i = log e_i - log C - p log h_i, under the Cauchy loss

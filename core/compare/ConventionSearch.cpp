@@ -115,7 +115,9 @@ bool ranks_before(const SearchCandidate& a, const SearchCandidate& b, long allow
         return a.residual_rms < b.residual_rms;
     }
     if (a.unexplained_pixels != b.unexplained_pixels) return a.unexplained_pixels < b.unexplained_pixels;
-    if (a.residual_rms != b.residual_rms) return a.residual_rms < b.residual_rms;
+    // RMS residuals that differ by rounding alone (a rule that changes nothing visible) count as equal.
+    const double noise = 1e-12 + 1e-9 * std::max(a.residual_rms, b.residual_rms);
+    if (std::fabs(a.residual_rms - b.residual_rms) > noise) return a.residual_rms < b.residual_rms;
     return rule_count(a) < rule_count(b);
 }
 
@@ -158,7 +160,8 @@ json SearchResult::to_json() const {
         j["tried"].push_back({{"rules", c.rules},
                               {"image_model", c.image_model},
                               {"unexplained_pixels", c.unexplained_pixels},
-                              {"residual_max", c.residual_max}});
+                              {"residual_max", c.residual_max},
+                              {"residual_rms", c.residual_rms}});
     return j;
 }
 
@@ -296,10 +299,17 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
     // set grown one rule at a time while that helps.
     // (By the RMS residual: a rule that is half of the explanation may leave as many pixels over the
     // tolerance as before while bringing every one of them closer.)
+    // Every pair when pairs x pixels is within kSearchAllPairsPixels (two rules can explain together what
+    // each alone makes worse: from-entry and the texel box); else the kSearchPairsOf singles of smallest RMS.
     std::sort(singles.begin(), singles.end(), [](const SearchCandidate& a, const SearchCandidate& b) { return a.residual_rms < b.residual_rms; });
     std::vector<SearchCandidate> helpful;
+    double pairs = 0.0;
+    for (std::size_t i = 0; i < singles.size(); ++i)
+        for (std::size_t j = i + 1; j < singles.size(); ++j)
+            if (dimension(singles[i].rules) != dimension(singles[j].rules)) pairs += 1.0;
+    const bool all_pairs = pairs * double(ev.pixels) <= kSearchAllPairsPixels;
     for (const SearchCandidate& c : singles)
-        if (c.residual_rms < base.residual_rms && helpful.size() < std::size_t(kSearchPairsOf)) helpful.push_back(c);
+        if (all_pairs || helpful.size() < std::size_t(kSearchPairsOf)) helpful.push_back(c);
     if (best.unexplained_pixels > allowed) {
         for (std::size_t i = 0; i < helpful.size(); ++i)
             for (std::size_t j = i + 1; j < helpful.size(); ++j) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/Conventions.h"
 #include "core/Error.h"
@@ -284,6 +285,19 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     // The bounding geometry (in the volume's own space), and the box the default camera frames.
     glm::dvec3 lo, hi;
     const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules (issue 29)
+    // A rule set to another value than its preset's that this scene never reads is said, not dropped.
+    if (const ProfileRules& rules = scene.render.profile_rules; !rules.empty()) {
+        const nlohmann::json base = profile_rules_json(profile(scene.render.profile)), mine = profile_rules_json(resolved);
+        const bool composite = scene.render.projection == Projection::Composite;
+        const bool shaded = composite && vs.shading.has_value();
+        for (const std::string& k : rules.keys) {
+            const bool compositing_rule = k == "correction" || k == "correction_floor" || k == "density_scale" || k == "compositing" || k == "termination";
+            const bool shading_rule = k == "normal" || k == "gradient" || k == "gradient_offset" || k == "gradient_offset_texture" || k == "clamp_shaded";
+            if (((compositing_rule && !composite) || (shading_rule && !shaded)) && base.value(k, nlohmann::json()) != mine.value(k, nlohmann::json()))
+                warnings.push_back("render.profile." + k + ": not read by this scene (" +
+                                   (compositing_rule ? "the projection does not composite" : "the scene is not a shaded composite") + ")");
+        }
+    }
     if (shell) {
         const bool cylinder = vs.bounds.type == BoundsSpec::Type::Cylindrical;
         const auto box = cylinder ? bounding_box(vs.bounds.cylinder) : bounding_box(vs.bounds.sphere);

@@ -991,16 +991,6 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);
     if (const Json* v = r.find("render")) scene.render = read_render(*v, r.path("render"), ctx);
-    // issue 29: a rule the projection does not read is said, not silently dropped.
-    const bool composite = scene.render.projection == Projection::Composite;
-    const bool shaded = composite && scene.volume().shading.has_value();
-    for (const std::string& k : scene.render.profile_rules.keys) {
-        const bool compositing_rule = k == "correction" || k == "correction_floor" || k == "density_scale" || k == "compositing" || k == "termination";
-        const bool shading_rule = k == "normal" || k == "gradient" || k == "gradient_offset" || k == "gradient_offset_texture" || k == "clamp_shaded";
-        if ((compositing_rule && !composite) || (shading_rule && !shaded))
-            std::cerr << "volref: notice: render.profile." << k << ": not read by this scene ("
-                      << (compositing_rule ? "the projection does not composite" : "the scene is not a shaded composite") << ")\n";
-    }
     return scene;
 }
 

@@ -223,8 +223,9 @@ nlohmann::json profile_rules_json(const Profile& p) {
     static const char* const correction[] = {"pow", "none", "extinction", "exact"};
     static const char* const compositing[] = {"optical-depth", "product", "opacity-sum", "lerp"};
     j["placement"] = placement[int(p.placement)];
-    j["first"] = p.first;
-    j["step_count"] = p.step_count == Profile::StepCount::ThroughExit ? "through-exit" : "before-exit";
+    if (p.placement == Profile::Placement::FromEntry) j["first"] = p.first;  // the rules a placement reads
+    if (p.placement != Profile::Placement::Midpoints)
+        j["step_count"] = p.step_count == Profile::StepCount::ThroughExit ? "through-exit" : "before-exit";
     if (p.ray_box == Profile::RayBox::Given)
         j["ray_box"] = {{"min", {p.box[0].x, p.box[0].y, p.box[0].z}}, {"max", {p.box[1].x, p.box[1].y, p.box[1].z}}};
     else

@@ -46,8 +46,7 @@ struct Evaluator {
 
     // The candidate's counts for one render under every image model; the best model kept in `out`.
     // `residual` (optional) receives the best model's per-pixel residual.
-    void evaluate(const Image& r, SearchCandidate& out, std::vector<double>* residual = nullptr,
-                  bool* alpha_agrees = nullptr) const {
+    void evaluate(const Image& r, SearchCandidate& out, std::vector<double>* residual = nullptr) const {
         std::size_t error_channel = r.channels.size();
         for (std::size_t c = 0; c < r.channels.size(); ++c)
             if (r.channels[c] == "error") error_channel = c;
@@ -93,12 +92,12 @@ struct Evaluator {
             c.residual_max = 0.0;
             for (double x : res) c.residual_max = std::max(c.residual_max, x);
             c.residual_rms = n > 0 ? std::sqrt(sum2 / double(n)) : 0.0;
+            c.alpha_unexplained = alpha_over;
             const bool better = first || c.unexplained_pixels < best.unexplained_pixels ||
                                 (c.unexplained_pixels == best.unexplained_pixels && c.residual_rms < best.residual_rms);
             if (better) {
                 best = c;
                 if (residual) *residual = std::move(res);
-                if (alpha_agrees) *alpha_agrees = alpha_over == 0 && c.unexplained_pixels > 0;
             }
             first = false;
         }
@@ -130,7 +129,7 @@ std::string SearchCandidate::describe() const {
     std::string s;
     auto add = [&](const std::string& key, const json& value) {
         if (!s.empty()) s += ", ";
-        s += key + " " + (value.is_string() ? value.get<std::string>() : value.dump());
+        s += key + " " + (value.is_string() ? value.get<std::string>() : value.is_number() ? number_text(value.get<double>()) : value.dump());
     };
     if (rules.contains("placement")) add("placement", rules["placement"]);  // then its first sample
     if (rules.contains("first")) add("first", rules["first"]);
@@ -154,6 +153,7 @@ json SearchResult::to_json() const {
     j["tolerance"] = tolerance;
     j["closest"] = {{"rules", best.rules}, {"image_model", best.image_model}};
     j["alpha_agrees_colour_differs"] = alpha_agrees;
+    if (alpha_agrees) j["alpha_explained_by"] = {{"rules", alpha_set.rules}, {"image_model", alpha_set.image_model}};
     j["verdict"] = verdict;
     j["tried"] = json::array();
     for (const SearchCandidate& c : tried)
@@ -199,10 +199,14 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     const bool shaded = composite && scene.volume().shading.has_value();
     const bool box = scene.volume().bounds.type == BoundsSpec::Type::Box && !scene.volume().bounds.min && !scene.volume().bounds.max;
     std::vector<std::vector<json>> d;
+    // (from-entry with each step count: step_count alone cannot be set over midpoints)
     d.push_back({{{"placement", "midpoints"}},
                  {{"placement", "from-entry"}, {"first", 0.0}},
                  {{"placement", "from-entry"}, {"first", 0.5}},
-                 {{"placement", "from-entry"}, {"first", 1.0}}});
+                 {{"placement", "from-entry"}, {"first", 1.0}},
+                 {{"placement", "from-entry"}, {"first", 0.0}, {"step_count", "before-exit"}},
+                 {{"placement", "from-entry"}, {"first", 0.5}, {"step_count", "before-exit"}},
+                 {{"placement", "from-entry"}, {"first", 1.0}, {"step_count", "before-exit"}}});
     d.push_back({{{"step_count", "through-exit"}}, {{"step_count", "before-exit"}}});
     if (box) d.push_back({{{"ray_box", "domain"}}, {{"ray_box", "texel"}}});
     d.push_back({{{"table", 0}}, {{"table", 256}}, {{"table", 1024}}});
@@ -344,7 +348,7 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
             for (const json& v : values) {
                 json rules = best.rules;
                 rules.erase(dim);
-                if (dim == "placement") rules.erase("first");
+                if (dim == "placement") rules.erase("first"), rules.erase("step_count");
                 rules.update(v);
                 if (rules == best.rules) continue;
                 SearchCandidate c;
@@ -360,7 +364,7 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
     {
         Scene s = with_rules(scene, best.rules);
         SearchCandidate c = best;
-        ev.evaluate(render_scene(s, ro), c, &out.residual, &out.alpha_agrees);
+        ev.evaluate(render_scene(s, ro), c, &out.residual);
     }
     out.best = best;
     out.explained = best.unexplained_pixels <= allowed;
@@ -376,7 +380,14 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
                       " pixels unexplained (residual max " + number_text(best.residual_max) +
                       "): a bug, or a convention volref does not model";
     }
-    if (out.alpha_agrees) out.verdict += "; alpha agrees, colour differs";
+    if (!out.explained) {  // the best-ranked set whose alpha is explained everywhere
+        for (const SearchCandidate& c : out.tried)
+            if (c.alpha_unexplained <= allowed && (!out.alpha_agrees || ranks_before(c, out.alpha_set, allowed))) {
+                out.alpha_agrees = true;
+                out.alpha_set = c;
+            }
+        if (out.alpha_agrees) out.verdict += "; alpha agrees, colour differs (under " + out.alpha_set.describe() + ")";
+    }
     return out;
 }
 

@@ -40,6 +40,7 @@ struct SearchCandidate {
     nlohmann::json rules = nlohmann::json::object();
     std::string image_model = "identity";
     long unexplained_pixels = 0;
+    long alpha_unexplained = 0;  // pixels whose alpha alone is over the tolerance
     double residual_max = 0.0, residual_rms = 0.0;
     std::string describe() const;  // "placement from-entry, first 0, ray_box texel (vertical flip)"
 };
@@ -50,7 +51,10 @@ struct SearchResult {
     long pixels = 0;                   // pixels compared (fault pixels left out)
     long unexplained_before = 0;       // pixels the scene's own profile leaves unexplained
     double tolerance = 0.0;            // T
-    bool alpha_agrees = false;         // every pixel's alpha explained by the best set, some colour not
+    // Not explained, but some tried set explains every pixel's alpha (`alpha_set`, the best such):
+    // "alpha agrees, colour differs".
+    bool alpha_agrees = false;
+    SearchCandidate alpha_set;
     std::vector<SearchCandidate> tried;  // every set rendered, in the order tried
     std::vector<double> residual;      // |M(R) - G| max over R, G, B, A per pixel for the best set (heat map)
     int width = 0, height = 0;

@@ -232,8 +232,8 @@ int run_compare(const CompareArgs& args) {
             std::printf("non-finite pixels: %ld in A, %ld in B, %ld disagreeing (those are over the tolerance); all left "
                         "out of the metrics and the fit\n", m.non_finite_a, m.non_finite_b, m.non_finite_disagree);
         if (!args.heatmap.empty())
-            std::printf("heat map: %s (max abs difference per pixel, 0 black -> %s white)\n",
-                        args.heatmap.string().c_str(), number(scale).c_str());
+            std::printf("heat map: %s (%s per pixel, 0 black -> %s white)\n", args.heatmap.string().c_str(),
+                        search ? "the residual the search's best set leaves" : "max abs difference", number(scale).c_str());
         if (fit) {
             for (const ModelFit& f : fit->fits) {
                 if (!f.fitted)

@@ -415,7 +415,8 @@ py::array_t<double> image_plane(const std::vector<double>& values, int width, in
 }
 
 py::object fit_conventions(py::object image, py::object scene, py::object tolerance, py::object threads, py::object overrides,
-                           py::object background_arg, py::object heatmap) {
+                           py::object background_arg, py::object heatmap, py::object max_memory) {
+    const MemoryScope memory(max_memory);
     compare::SearchOptions so;
     if (!tolerance.is_none()) {
         so.tolerance = tolerance.cast<double>();
@@ -432,15 +433,17 @@ py::object fit_conventions(py::object image, py::object scene, py::object tolera
     compare::ComparedImage g = compared_input(image, "image", py::none(), so.background);
     const std::unique_ptr<SceneInput> in = read_scene_input(scene, overrides);
     compare::SearchResult r;
-    {
-        py::gil_scoped_release release;
-        r = compare::search_conventions(g, in->scene, so);
-        if (!heatmap_path.empty()) {
-            double largest = 0.0;
-            for (double x : r.residual) largest = std::max(largest, x);
-            compare::write_heatmap(r.residual, r.width, r.height, largest, heatmap_path);
-        }
-    }
+    with_scene_messages(*in, [&] {
+        run_cancellable([&] {  // Ctrl-C stops the render in progress (as render's)
+            r = compare::search_conventions(g, in->scene, so);
+            if (!heatmap_path.empty()) {
+                double largest = 0.0;
+                for (double x : r.residual) largest = std::max(largest, x);
+                compare::write_heatmap(r.residual, r.width, r.height, largest, heatmap_path);
+            }
+        });
+        return 0;
+    });
     py::object d = json_loads(r.to_json().dump());
     d["residual"] = image_plane(r.residual, r.width, r.height);
     return d;
@@ -486,10 +489,22 @@ Image image_of(py::handle v, const char* name) {
     return im;
 }
 
+// The background a RenderResult's scene names (image.background), else transparent.
+glm::dvec4 scene_background(py::handle v) {
+    glm::dvec4 bg(0.0);
+    if (!py::isinstance<RenderResult>(v)) return bg;
+    try {
+        const py::list b = v.cast<const RenderResult&>().scene["image"]["background"];
+        for (int c = 0; c < 4; ++c) bg[c] = b[std::size_t(c)].cast<double>();
+    } catch (const std::exception&) {
+    }
+    return bg;
+}
+
 void write_image_file(py::object path, py::object image, py::object background_arg) {
     const std::filesystem::path p = py::module_::import("os").attr("fspath")(path).cast<std::string>();
     const Image im = image_of(image, "image");
-    const glm::dvec4 bg = background_of(background_arg).value_or(glm::dvec4(0.0));
+    const glm::dvec4 bg = background_of(background_arg).value_or(scene_background(image));
     check_output_path(p);
     py::gil_scoped_release release;
     write_image(im, p, bg);
@@ -508,14 +523,10 @@ py::object profiles_dict() {
 
 // PNG bytes of the image composited over its scene's background (as volref render writes PNG):
 // IHDR, one IDAT (Python's zlib) and IEND, 8-bit RGBA, non-interlaced.
-py::bytes png_bytes(const RenderResult& r) {
+py::bytes png_bytes(py::object self) {
+    const RenderResult& r = self.cast<const RenderResult&>();
     const Image& im = *r.image;
-    glm::dvec4 bg(0.0);
-    try {
-        const py::list b = r.scene["image"]["background"];
-        for (int c = 0; c < 4; ++c) bg[c] = b[std::size_t(c)].cast<double>();
-    } catch (const std::exception&) {
-    }
+    const glm::dvec4 bg = scene_background(self);
     std::string raw;
     raw.reserve(std::size_t(im.height) * (1 + 4 * std::size_t(im.width)));
     for (int y = 0; y < im.height; ++y) {
@@ -916,7 +927,7 @@ Returns {"a", "b", "width", "height", "tolerance", "channels": {"R": {...}, ...}
 
     m.def("fit", &fit_conventions, py::arg("image"), py::arg("scene"), py::kw_only(), py::arg("tolerance") = py::none(),
           py::arg("threads") = py::none(), py::arg("overrides") = py::none(), py::arg("background") = py::none(),
-          py::arg("heatmap") = py::none(),
+          py::arg("heatmap") = py::none(), py::arg("max_memory") = py::none(),
           R"doc(Which conventions explain another renderer's image of a scene: `volref compare IMAGE --fit --scene SCENE`.
 
 The scene is re-rendered with its profile's rules changed (render.profile: placement, ray_box, table,
@@ -927,11 +938,13 @@ render's error channel and the image's quantisation (docs/compare.md, "Conventio
 
 Arguments: image (a path, numpy array (height, width, 4) of premultiplied RGBA, or a RenderResult), scene
 (as for render), tolerance, threads, overrides (as for render), background (as for compare), heatmap (a
-PNG path: the residual the best set leaves).
+PNG path: the residual the best set leaves), max_memory (as for render). tolerance None: 1e-4; 0 is 0.
 Returns {"explained", "rules" (the render.profile keys that explain, {} when not explained),
-"image_model", "unexplained_pixels", "residual_max", "residual_rms", "pixels", "explained_fraction",
-"closest": {"rules", "image_model"}, "alpha_agrees_colour_differs", "verdict", "tried": [...],
-"residual": numpy (height, width)}.)doc");
+"image_model" (None when not explained), "unexplained_pixels", "residual_max", "residual_rms", "pixels",
+"explained_fraction", "unexplained_before" (under the scene's own profile), "tolerance", "closest":
+{"rules", "image_model"}, "alpha_agrees_colour_differs", "alpha_explained_by" (when it is true),
+"verdict", "tried": [{"rules", "image_model", "unexplained_pixels", "residual_max", "residual_rms"}],
+"residual": numpy (height, width)}. Ctrl-C stops it (KeyboardInterrupt).)doc");
 
     m.def("heatmap", &heatmap_of, py::arg("a"), py::arg("b"), py::kw_only(), py::arg("path") = py::none(),
           py::arg("scale") = py::none(),
@@ -942,7 +955,8 @@ largest difference). a, b: as for compare.)doc");
     m.def("write_image", &write_image_file, py::arg("path"), py::arg("image"), py::kw_only(), py::arg("background") = py::none(),
           R"doc(Write an image as `volref render` does: .exr (linear float, premultiplied, every channel of a
 RenderResult), .png / .tif (composited over `background`, default transparent, unassociated alpha).
-image: a RenderResult or a numpy array (height, width, 4) of premultiplied linear RGBA (3: alpha 1).)doc");
+image: a RenderResult or a numpy array (height, width, 4) of premultiplied linear RGBA (3: alpha 1).
+background None: a RenderResult's own image.background (as volref render), else transparent.)doc");
 
     m.def("profiles", &profiles_dict,
           R"doc(The presets of render.profile and their rules, as dicts in render.profile's object form

@@ -299,8 +299,7 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
                 }
             }
     }
-    // Pairs of the singles that helped most (each better than the scene's own profile), then the best
-    // set grown one rule at a time while that helps.
+    // Pairs of singles, then the best set grown one rule at a time while that helps.
     // (By the RMS residual: a rule that is half of the explanation may leave as many pixels over the
     // tolerance as before while bringing every one of them closer.)
     // Every pair when pairs x pixels is within kSearchAllPairsPixels (two rules can explain together what
@@ -324,7 +323,7 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
                 if (attempt(rules, c)) consider(c);
             }
     }
-    while (best.unexplained_pixels > allowed && int(best.rules.size()) < kSearchMaxRules) {
+    while (best.unexplained_pixels > allowed && rule_count(best) < kSearchMaxRules) {
         SearchCandidate grown = best;
         for (const SearchCandidate& h : helpful) {
             if (best.rules.contains(dimension(h.rules))) continue;

@@ -3,20 +3,23 @@
 // render of the same scene.
 //
 // The scene is re-rendered with the rules of its profile (render.profile, core/integrate/profiles/
-// Profile.h) changed: every candidate value of one rule (`candidate_rules`), then pairs of the singles
-// that helped most, then the best set grown by one more rule while that helps (at most kSearchMaxRules
-// rules). Every render R is also read under each image model M (identity, vertical flip, unpremultiplied
-// or double-premultiplied colour, BGRA order, sRGB-encoded colour): a pixel p is explained by (rules,
-// M) when
+// Profile.h) changed: every candidate value of one rule (`candidate_rules`); then pairs of those singles
+// (every pair when pairs x pixels <= kSearchAllPairsPixels, else the pairs of the kSearchPairsOf singles
+// of smallest RMS residual); then the best set grown by one more rule while that helps (at most
+// kSearchMaxRules rules, an image model counting as one); then each rule of the best set swapped for the
+// other values of its rule while that helps. Every render R is read under each image model M (identity,
+// vertical flip, unpremultiplied or double-premultiplied colour, BGRA order, sRGB-encoded colour): a
+// pixel p is explained by (rules, M) when
 //     |M(R)(p, c) - G(p, c)| <= tol(p, c)   for c = R, G, B, A,
 //     tol(p, c) = T + e_R(p) + Q_G(p, c),
-// T the stated tolerance (kSearchTolerance, or --tolerance when given), e_R the render's own `error`
-// channel where it writes one (adaptive or --error), Q_G the quantisation of an integer G (Tolerance.h).
-// The set with the fewest unexplained pixels wins (ties: the smaller RMS residual, then fewer rules);
-// it *explains* the image when at most kSearchUnexplainedFraction of the pixels stay unexplained.
-// Otherwise no convention is named: what stays unexplained is a bug (or a convention volref does not
-// model), shown by the residual's heat map. "alpha agrees, colour differs" is said when every pixel's
-// alpha is explained but some colour is not.
+// T the stated tolerance (kSearchTolerance, or SearchOptions::tolerance), e_R the render's own `error`
+// channel where the scene makes one (the adaptive integrator), Q_G the quantisation of an integer G
+// (Tolerance.h). A set explains the image when at most kSearchUnexplainedFraction of the pixels stay
+// unexplained; among those the one with fewer rules wins, then the smaller RMS residual. Among sets that
+// do not explain it: fewer unexplained pixels, then the smaller RMS (equal within rounding: fewer rules).
+// When none explains it no convention is named: what stays unexplained is a bug (or a convention volref
+// does not model), shown by the best set's residual (the heat map). "alpha agrees, colour differs" names
+// the best-ranked set that explains every pixel's alpha when no set explains the colour.
 #pragma once
 #include <string>
 #include <vector>

@@ -326,6 +326,9 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                       step, diagonal / step, key.c_str(), diagonal);
         throw Error(std::string("render.step: ") + buf);
     }
+    // A profile's own ray box (texel or given) does not move the default camera: it frames the domain.
+    if (!shell && resolved.ray_box != Profile::RayBox::Domain)
+        world_box(transform ? &*transform : nullptr, volume.domain_min(), volume.domain_max(), view_lo, view_hi);
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;

@@ -107,6 +107,8 @@ void apply_override(Json& root, const std::string& text, Context& scene_ctx) {
     for (const PathStep& step : steps) {
         if (!step.is_index) {
             if (at->is_null()) *at = Json::object();  // a missing intermediate object
+            // issue 29: a rule set over a preset given by name: "vtk-gpu" becomes {"base": "vtk-gpu"}
+            if (path == "render.profile" && at->is_string()) *at = Json{{"base", *at}};
             if (!at->is_object())
                 ctx.fail(path, "expected an object to set \"" + step.key + "\" in, got " + describe(*at));
             at = &(*at)[step.key];

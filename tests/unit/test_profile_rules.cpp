@@ -147,6 +147,12 @@ TEST(ProfileRules, RulesThePathCannotHonourAreRefused) {
     EXPECT_NE(error_of(with(s, {{"arithmetic", "float32"}})).find("render.profile.arithmetic"), std::string::npos);
     EXPECT_NE(error_of(with(s, {{"compositing", "lerp"}, {"termination", {{"alpha_above", 0.5}}}})).find("render.profile.termination"),
               std::string::npos);
+    EXPECT_NE(error_of(with(s, {{"placement", "from-exit"}})).find("render.profile.placement"), std::string::npos);
+    EXPECT_NE(error_of(with(s, {{"compositing", "lerp"}, {"correction", "none"}})).find("render.profile.correction"), std::string::npos);
+    Scene vtk = s;
+    vtk.render.profile = ProfileId::VtkGpu;  // its termination would be dropped by lerp
+    EXPECT_NE(error_of(with(vtk, {{"compositing", "lerp"}})).find("render.profile.compositing"), std::string::npos);
+    EXPECT_EQ(error_of(with(vtk, {{"compositing", "lerp"}, {"termination", "none"}})), "");
     Scene bounded = with(s, {{"ray_box", "texel"}});
     bounded.volume().bounds.min = glm::dvec3(1.0);
     EXPECT_NE(error_of(bounded).find("render.profile.ray_box"), std::string::npos);
@@ -234,4 +240,19 @@ TEST(ConventionSearch, FindsTheRulesItWasGiven) {
     EXPECT_GT(rb.best.unexplained_pixels, 0);
     EXPECT_TRUE(rb.alpha_agrees) << rb.verdict;  // only colour was changed
     EXPECT_NE(rb.verdict.find("alpha agrees, colour differs (under the scene's own profile)"), std::string::npos);
+}
+
+// --set render.profile.RULE=VALUE sets a rule over the preset the scene names (a name becomes {"base": name}).
+TEST(ProfileRules, OverridesSetRulesOverANamedPreset) {
+    const std::string scene = R"({"volume": {"source": {"field": "constant", "value": 1, "dims": [4, 4, 4]}}, "render": {"profile": "vtk-gpu"}})";
+    const Scene s = parse_scene(scene, ".", "scene", {"render.profile.ray_box=texel", "render.profile.first=0"});
+    EXPECT_EQ(s.render.profile, ProfileId::VtkGpu);
+    EXPECT_EQ(s.render.profile_rules.ray_box, ProfileRules::RayBox::Texel);
+    EXPECT_EQ(s.render.profile_rules.first, 0.0);
+    EXPECT_EQ(s.render.profile_rules.keys, (std::vector<std::string>{"first", "ray_box"}));
+    const Scene d = parse_scene(R"({"volume": {"source": {"field": "constant", "value": 1, "dims": [4, 4, 4]}}})", ".", "scene",
+                                {"render.profile.correction=none"});
+    EXPECT_EQ(d.render.profile, ProfileId::Reference);
+    EXPECT_EQ(d.render.profile_rules.correction, ProfileRules::Correction::None);
+    EXPECT_FALSE(d.render.reference_integrators());
 }

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/scene/SceneLoader.h"
 
 namespace volref {
 
@@ -215,38 +216,35 @@ Profile resolve_profile(const RenderSpec& render) {
 }
 
 nlohmann::json profile_rules_json(const Profile& p) {
-    using nlohmann::json;
-    json j;
+    nlohmann::json j;
     j["base"] = preset_name(p.id);
     if (p.renderer != Profile::Renderer::RayCaster || p.id == ProfileId::Fast) return j;
-    static const char* const placement[] = {"midpoints", "from-entry", "from-exit"};
-    static const char* const correction[] = {"pow", "none", "extinction", "exact"};
-    static const char* const compositing[] = {"optical-depth", "product", "opacity-sum", "lerp"};
-    j["placement"] = placement[int(p.placement)];
-    if (p.placement == Profile::Placement::FromEntry) j["first"] = p.first;  // the rules a placement reads
-    if (p.placement != Profile::Placement::Midpoints)
-        j["step_count"] = p.step_count == Profile::StepCount::ThroughExit ? "through-exit" : "before-exit";
-    if (p.ray_box == Profile::RayBox::Given)
-        j["ray_box"] = {{"min", {p.box[0].x, p.box[0].y, p.box[0].z}}, {"max", {p.box[1].x, p.box[1].y, p.box[1].z}}};
-    else
-        j["ray_box"] = p.ray_box == Profile::RayBox::Domain ? "domain" : "texel";
-    j["step_voxel"] = p.voxel_length == Profile::VoxelLength::Spacing ? "spacing" : "extent-over-samples";
-    j["correction"] = correction[int(p.correction)];
-    j["correction_floor"] = p.correction_floor;
-    j["density_scale"] = p.density_scale;
-    j["compositing"] = compositing[int(p.compositing)];
+    // Every rule set, written by the scene reader's own inverse (SceneLoader.h, profile_rules_object).
+    ProfileRules r;
+    r.placement = p.placement;
+    if (p.placement == Profile::Placement::FromEntry) r.first = p.first;  // the rules a placement reads
+    if (p.placement != Profile::Placement::Midpoints) r.step_count = p.step_count;
+    r.ray_box = p.ray_box;
+    if (p.ray_box == Profile::RayBox::Given) r.box = p.box;
+    r.step_voxel = p.voxel_length;
+    r.correction = p.correction;
+    r.correction_floor = p.correction_floor;
+    r.density_scale = p.density_scale;
+    r.compositing = p.compositing;
     const Termination& t = p.termination;
-    if (t.test_alpha_above) j["termination"] = {{"alpha_above", t.alpha_above}};
-    else if (t.test_alpha_at_least) j["termination"] = {{"alpha_at_least", t.alpha_at_least}};
-    else if (t.test_transmittance) j["termination"] = {{"transmittance_at_most", t.transmittance_at_most}};
-    else j["termination"] = "none";
-    j["table"] = p.table_entries;
-    j["table_coordinate"] = p.table_coordinate == Profile::TableCoordinate::DataRange ? "data-range" : "data-range-times-transfer-scale";
-    j["normal"] = p.normal_along_gradient ? "+gradient" : "-gradient";
-    j["gradient"] = p.forward_gradient ? "forward" : "central";
-    if (p.gradient_offset_texture > 0.0) j["gradient_offset_texture"] = p.gradient_offset_texture;
-    else j["gradient_offset"] = p.gradient_offset;
-    j["clamp_shaded"] = p.clamp_shaded;
+    r.termination = t.test_alpha_above ? ProfileRules::Stop::AlphaAbove
+                    : t.test_alpha_at_least ? ProfileRules::Stop::AlphaAtLeast
+                    : t.test_transmittance ? ProfileRules::Stop::TransmittanceAtMost
+                                           : ProfileRules::Stop::None;
+    r.termination_value = t.test_alpha_above ? t.alpha_above : t.test_alpha_at_least ? t.alpha_at_least : t.transmittance_at_most;
+    r.table_entries = p.table_entries;
+    r.table_coordinate = p.table_coordinate;
+    r.normal_along_gradient = p.normal_along_gradient;
+    r.forward_gradient = p.forward_gradient;
+    if (p.gradient_offset_texture > 0.0) r.gradient_offset_texture = p.gradient_offset_texture;
+    else r.gradient_offset = p.gradient_offset;
+    r.clamp_shaded = p.clamp_shaded;
+    j.update(profile_rules_object(r));
     j["jitter"] = "off";
     return j;
 }

@@ -103,7 +103,8 @@ struct Profile {
     // Front to back, premultiplied, C += T alpha c with the transmittance T kept by the rule
     // (march/Accumulators.h, TransmittanceRule): OpticalDepth (tau += -log1p(-alpha), T = exp(-tau): the
     // reference), Product (T *= 1 - alpha), OpacitySum (A += (1 - A) alpha, T = 1 - A: GPU shaders);
-    // stopping by `termination` after every sample, and at an opaque sample (alpha = 1).
+    // stopping by `termination` after every sample (an opaque sample, alpha = 1, also stops OpticalDepth
+    // and Product; under OpacitySum it makes A = 1 and every later sample adds 0).
     // Lerp: seed 001: back to front, sum = lerp(sum, (c, a), a density) on R, G, B, A (density:
     // render.profile_options.density); no termination.
     using Compositing = ProfileRules::Compositing;

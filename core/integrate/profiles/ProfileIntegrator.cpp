@@ -70,7 +70,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     normalized_coordinates_ = p_.id != ProfileId::CudaCurvilinear;
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_) {
         const std::string key = band_ ? "render.profile_options.texture_band" : "render.profile_options.texture_unit";
-        if (p_.id == ProfileId::Ospray || (p_.id == ProfileId::Reference && ctx.render.profile_rules.empty()))
+        if ((p_.id == ProfileId::Ospray || p_.id == ProfileId::Reference) && ctx.render.profile_rules.empty())
             throw Error(key + ": only the vtk-gpu, glsl-basic and cuda-curvilinear profiles and custom ones (render.profile's texture_unit) model a texture unit");
         if (!shell_) {
             cartesian_ = cartesian;
@@ -144,8 +144,19 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
     if (r.step_count && p_.placement == Profile::Placement::Midpoints)
         fail("step_count", "applies to the placements \"from-entry\" and \"from-exit\" (midpoints: segment_count, conventions section 4)");
     if (r.ray_box && *r.ray_box != ProfileRules::RayBox::Domain && !cartesian) fail("ray_box", "a texel or given box needs a Cartesian grid");
-    if (p_.compositing == Profile::Compositing::Lerp && r.termination && *r.termination != ProfileRules::Stop::None)
-        fail("termination", "lerp compositing runs back to front and has no termination");
+    const Termination& t = p_.termination;
+    const bool stops = t.test_alpha_above || t.test_alpha_at_least || t.test_transmittance;
+    const bool composite = render.projection == Projection::Composite;
+    if (composite && p_.compositing == Profile::Compositing::Lerp) {
+        if (r.termination && *r.termination != ProfileRules::Stop::None)
+            fail("termination", "lerp compositing runs back to front and has no termination");
+        if (stops && r.compositing)
+            fail("compositing", "lerp has no termination, and the base's termination would be dropped (set termination \"none\")");
+        if (r.correction)
+            fail("correction", "lerp compositing weights each sample by its uncorrected opacity times render.profile_options.density");
+    }
+    if (composite && p_.placement == Profile::Placement::FromExit && p_.compositing != Profile::Compositing::Lerp)
+        fail(r.placement ? "placement" : "compositing", "placement \"from-exit\" visits the samples back to front: it composites with \"lerp\"");
     if (band_ && p_.correction == Profile::Correction::Exact && p_.table_entries > 1)
         throw Error("render.profile_options.texture_band: the band is derived for tables whose entries are corrected (correction \"pow\"), not \"exact\"");
 }
@@ -802,7 +813,9 @@ PixelValue ProfileIntegrator::composite(const Ray& ray, const std::vector<Interv
 
 // Front to back (march/Accumulators.h), the transmittance kept by rule R: a GPU shader's opacity sum
 // A += (1 - A) alpha, C += (1 - A) alpha c, the product T *= 1 - alpha, or the reference's optical
-// depth; stopping as the profile says after every sample, and at an opaque sample (alpha >= 1).
+// depth; stopping as the profile says after every sample. An opaque sample (alpha >= 1) stops the
+// optical-depth and product rules (its optical depth is infinite); under the opacity sum it makes A = 1,
+// after which every sample adds 0 (the ray runs on, as a shader's loop does, unless its test stops it).
 template <TransmittanceRule R, class Rec>
 PixelValue ProfileIntegrator::composite_front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     FrontToBack<Scalar, R> acc;

@@ -11,6 +11,7 @@ import os
 import sys
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import external_caster as ec  # noqa: E402  "your renderer"
@@ -56,6 +57,26 @@ def test_my_renderer_within_the_step_error():
     expected = volref.render(SCENE, error=True)  # expected.error: (H, W)
     report = volref.compare(ec.render(SCENE, **MY_RULES), expected, tolerance=FLOAT32_TOLERANCE, error=True)
     assert report["within_tolerance"], report["overall"]
+
+
+def test_my_rules_over_a_preset():
+    # My shader is VTK's loop, but it evaluates the transfer function exactly instead of a 1024-entry table.
+    rules = {**volref.profiles()["vtk-gpu"], "table": 0}  # a preset's dict is a valid render.profile as it is
+    scene = copy.deepcopy(SCENE)
+    scene["render"]["profile"] = rules
+    expected = volref.render(scene)
+    mine = ec.render(SCENE, **{**ec.PRESETS["vtk-gpu"], "table": 0})
+    assert volref.compare(mine, expected, tolerance=FLOAT32_TOLERANCE)["within_tolerance"]
+    assert volref.render(expected.scene).rgba.tobytes() == expected.rgba.tobytes()  # the resolved scene renders again
+
+
+def test_rules_the_scene_does_not_read_or_cannot_honour():
+    mip = with_profile(SCENE, {"correction": "none"})
+    mip["render"]["projection"] = "mip"  # a MIP does not composite: the correction is never read
+    with pytest.warns(UserWarning, match="render.profile.correction: not read by this scene"):
+        volref.render(mip)
+    with pytest.raises(volref.Error, match='render.profile.placement: placement "from-exit" .* "lerp"'):
+        volref.render(with_profile(SCENE, {"placement": "from-exit"}))  # back to front needs lerp compositing
 
 
 def test_fit_names_my_conventions():
@@ -123,3 +144,16 @@ def test_trace_lines_up_with_my_dump():
         skipped = set(mine) - set(trace["segment"].tolist())
         assert all(mine[k][2] == 0 for k in skipped)
         assert len(skipped) > 0 if skipping else len(skipped) == 0
+
+
+def test_the_doc_shows_this_file():
+    # Every Python block of docs/gpu-quick-start.md section 7 is this file's code, verbatim.
+    doc = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "gpu-quick-start.md")
+    with open(doc, encoding="utf-8") as f:
+        section = f.read().split("## 7. pytest examples", 1)[1]
+    with open(os.path.abspath(__file__), encoding="utf-8") as f:
+        source = f.read()
+    blocks = [b.split("```", 1)[0] for b in section.split("```python\n")[1:]]
+    assert len(blocks) >= 4
+    for block in blocks:
+        assert block in source, block

@@ -256,3 +256,24 @@ TEST(ProfileRules, OverridesSetRulesOverANamedPreset) {
     EXPECT_EQ(d.render.profile_rules.correction, ProfileRules::Correction::None);
     EXPECT_FALSE(d.render.reference_integrators());
 }
+
+// Every preset's rules, as volref.profiles() gives them, render as the preset (cuda-curvilinear's lerp
+// with its own correction "none" included): the same image bit for bit.
+TEST(ProfileRules, PresetRulesRenderAsThePreset) {
+    Scene s = field_scene(linear_field({0.0, 0.3, 0.2, 0.1}, {9, 8, 7}));
+    s.volume().transfer.opacity = {{0, 0.02}, {3, 0.4}};
+    s.camera = ortho_down_z(4.0, 3.5, 20.0, 9.0);
+    s.image.width = 8;
+    s.image.height = 6;
+    for (ProfileId id : {ProfileId::VtkGpu, ProfileId::GlslBasic, ProfileId::Ospray, ProfileId::CudaCurvilinear}) {
+        s.render.profile = id;
+        s.render.profile_rules = {};
+        const Image by_name = render_scene(s, {1, false});
+        RenderSpec r;
+        r.profile = id;
+        json rules = profile_rules_json(resolve_profile(r));
+        rules.erase("base");
+        const Image by_rules = render_scene(with(s, rules), {1, false});
+        EXPECT_EQ(by_name.pixels, by_rules.pixels) << rules.dump();
+    }
+}

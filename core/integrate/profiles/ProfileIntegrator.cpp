@@ -152,7 +152,7 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
             fail("termination", "lerp compositing runs back to front and has no termination");
         if (stops && r.compositing)
             fail("compositing", "lerp has no termination, and the base's termination would be dropped (set termination \"none\")");
-        if (r.correction)
+        if (r.correction && *r.correction != profile(render.profile).correction)  // the base's own value reads nothing
             fail("correction", "lerp compositing weights each sample by its uncorrected opacity times render.profile_options.density");
     }
     if (composite && p_.placement == Profile::Placement::FromExit && p_.compositing != Profile::Compositing::Lerp)

@@ -221,8 +221,10 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     }
     if (shaded) {
         d.push_back({{{"normal", "-gradient"}}, {{"normal", "+gradient"}}});
-        d.push_back({{{"gradient", "central"}}, {{"gradient", "forward"}}});
+        d.push_back({{{"gradient", "central"}}, {{"gradient", "forward"}}, {{"gradient", "central-in-domain"}}});
         d.push_back({{{"clamp_shaded", false}}, {{"clamp_shaded", true}}});
+        d.push_back({{{"gradient_offset", 0.5}}, {{"gradient_offset", 1.0}}, {{"gradient_offset", 2.0}}});
+        d.push_back({{{"gradient_offset_texture", 0.1}}});  // seed 002's +-0.1 of the domain's extent
     }
     return d;
 }

@@ -243,6 +243,10 @@ struct ProfileRules {
     enum class Stop { None, AlphaAbove, AlphaAtLeast, TransmittanceAtMost };
     enum class TableCoordinate { DataRange, DataRangeTimesTransferScale };
     enum class Arithmetic { Double, Float32 };
+    // Gradients per axis a at offset o_a: central (f(x + o) - f(x - o)) / 2o of the field clamped to the
+    // domain (GPU shaders), forward (f(x + o) - f(x)) / o, or central with the stencil kept inside the
+    // domain, one-sided at its boundary (the reference's GradientField, conventions section 2).
+    enum class Gradient { Central, Forward, CentralInDomain };
 
     std::optional<Placement> placement;
     std::optional<double> first;  // from-entry: the first sample's distance from the entry, in steps
@@ -261,7 +265,7 @@ struct ProfileRules {
     std::optional<Arithmetic> arithmetic;    // float32: seed 001's kernel (render.profile_options.kernel)
     std::optional<ProfileOptions::TextureUnit> texture_unit;  // as render.profile_options.texture_unit
     std::optional<bool> normal_along_gradient;  // "normal": "+gradient" (true) or "-gradient"
-    std::optional<bool> forward_gradient;       // "gradient": "forward" or "central"
+    std::optional<Gradient> gradient;
     std::optional<double> gradient_offset;      // voxels
     std::optional<double> gradient_offset_texture;  // a fraction of the domain's extent per axis
     std::optional<bool> clamp_shaded;

@@ -883,7 +883,10 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     if (r.has("normal"))
         out.normal_along_gradient = r.choice<bool>("normal", false, {{"-gradient", false}, {"+gradient", true}});
     if (r.has("gradient"))
-        out.forward_gradient = r.choice<bool>("gradient", false, {{"central", false}, {"forward", true}});
+        out.gradient = r.choice<P::Gradient>("gradient", P::Gradient::Central,
+                                             {{"central", P::Gradient::Central},
+                                              {"forward", P::Gradient::Forward},
+                                              {"central-in-domain", P::Gradient::CentralInDomain}});
     out.gradient_offset = r.optional_number("gradient_offset", Range::positive());
     out.gradient_offset_texture = r.optional_number("gradient_offset_texture", Range::left_open(0.0, 1.0));
     if (out.gradient_offset && out.gradient_offset_texture)
@@ -1062,7 +1065,8 @@ nlohmann::json profile_rules_object(const ProfileRules& r) {
     if (r.texture_unit) j["texture_unit"] = *r.texture_unit == ProfileOptions::TextureUnit::H100 ? "h100" : "exact";
     if (r.arithmetic) j["arithmetic"] = *r.arithmetic == P::Arithmetic::Float32 ? "float32" : "double";
     if (r.normal_along_gradient) j["normal"] = *r.normal_along_gradient ? "+gradient" : "-gradient";
-    if (r.forward_gradient) j["gradient"] = *r.forward_gradient ? "forward" : "central";
+    static const char* const gradient[] = {"central", "forward", "central-in-domain"};
+    if (r.gradient) j["gradient"] = gradient[int(*r.gradient)];
     if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
     if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
     if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;

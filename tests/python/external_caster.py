@@ -122,16 +122,28 @@ class _Volume:
         v = v + at(x0, y1, z1) * (one - p_) * q_ * r_
         return v.astype(F32)
 
-    def gradient(self, p):
-        """Central differences of the reconstructed field, one-sided at the domain (section 2)."""
+    def gradient(self, p, scheme="central-in-domain", offset=1.0):
+        """Differences of the reconstructed field at offset o = offset spacings per axis: central with the
+        stencil inside the domain, one-sided at it (section 2), central of the clamped field, or forward."""
         g = np.empty_like(p)
         for a in range(3):
+            o = F32(offset * self.spacing[a])
             c = p.copy()
             b = p.copy()
-            c[:, a] = np.maximum(p[:, a] - self.spacing[a], self.lo[a])
-            b[:, a] = np.minimum(p[:, a] + self.spacing[a], self.hi[a])
-            w = b[:, a] - c[:, a]
-            g[:, a] = np.where(w > 0, (self.sample(b) - self.sample(c)) / np.where(w > 0, w, 1), 0)
+            if scheme == "central-in-domain":
+                c[:, a] = np.maximum(p[:, a] - o, self.lo[a])
+                b[:, a] = np.minimum(p[:, a] + o, self.hi[a])
+                w = b[:, a] - c[:, a]
+                g[:, a] = np.where(w > 0, (self.sample(b) - self.sample(c)) / np.where(w > 0, w, 1), 0)
+            elif scheme == "central":
+                c[:, a] = p[:, a] - o
+                b[:, a] = p[:, a] + o
+                g[:, a] = (self.sample(b) - self.sample(c)) / (F32(2) * o)
+            elif scheme == "forward":
+                b[:, a] = p[:, a] + o
+                g[:, a] = (self.sample(b) - self.sample(p)) / o
+            else:
+                raise ValueError(f"gradient {scheme!r}")
         return g.astype(F32)
 
 
@@ -209,7 +221,8 @@ def apply_output_model(img, model):
 
 def render(scene, *, placement="midpoints", first=0.0, step_count="through-exit", ray_box="domain",
            correction="pow", correction_floor=0.0, table=0, compositing="product", termination=None,
-           projection=None, shading=True, output=(), bug=None):
+           projection=None, shading=True, gradient="central-in-domain", normal="-gradient", gradient_offset=1.0,
+           clamp_shaded=False, output=(), bug=None):
     """Render `scene` (a volref scene dict, one numpy volume) to float32 premultiplied RGBA (H, W, 4), row 0 on top.
 
     placement: "midpoints" (volref's: [t0, t1] cut into n = max(1, ceil(L/h - 1e-9)) segments of length h,
@@ -232,6 +245,11 @@ def render(scene, *, placement="midpoints", first=0.0, step_count="through-exit"
         "transmittance_at_most" (T <= x); tested after each sample (front to back only).
     projection: None (the scene's render.projection), "composite" or "mip".
     shading: honour the scene's volume.shading (composite only; blinn-phong / phong, section 8).
+    gradient: "central-in-domain" (central differences with the stencil inside the domain, one-sided at
+        its boundary: volref's reference), "central" ((f(x + o) - f(x - o)) / 2o of the field clamped to
+        the domain, a shader's), "forward" ((f(x + o) - f(x)) / o); o = gradient_offset spacings.
+    normal: "-gradient" (N = -g / |g|, volref's) or "+gradient" (a shader's that forgets the sign).
+    clamp_shaded: the shaded colour clamped to [0, 1] before compositing.
     output: an output model name or a sequence of them, applied in order to the final image:
         "flip", "unpremultiplied", "double-premultiplied", "bgra", "srgb".
     bug: None or one planted mistake: "half-texel-shift", "colour-missing-correction", "wrong-order",
@@ -381,7 +399,9 @@ def render(scene, *, placement="midpoints", first=0.0, step_count="through-exit"
         c, a, pre = classify(v)
         alpha = sample_alpha(a, pre, d)
         if shade:
-            c = _shade(c, alpha, p, dirs[idx], t, vol, sh, lights, zero_gradient)
+            c = _shade(c, alpha, p, dirs[idx], t, vol, sh, lights, zero_gradient, gradient, normal, gradient_offset)
+            if clamp_shaded:
+                c = np.clip(c, F32(0), F32(1)).astype(F32)
         weight = a if bug == "colour-missing-correction" else alpha
         if bug == "double-premultiply":
             c = c * alpha[:, None]
@@ -438,16 +458,17 @@ def render(scene, *, placement="midpoints", first=0.0, step_count="through-exit"
     return img
 
 
-def _shade(m, alpha, p, dirs, t, vol, sh, lights, zero_gradient):
+def _shade(m, alpha, p, dirs, t, vol, sh, lights, zero_gradient, scheme="central-in-domain", normal="-gradient", offset=1.0):
     """Section 8 at the samples with alpha > 0: c = sum_l I (ka m + kd m max(N.L, 0) cue) + I ks s^n cue."""
     out = m.copy()
     vis = alpha > 0
     if not vis.any():
         return out
-    g = vol.gradient(p[vis])
+    g = vol.gradient(p[vis], scheme, offset)
     gl = np.sqrt(np.sum(g * g, axis=1))
     flat = gl <= zero_gradient
-    N = (-g / np.where(flat, F32(1), gl)[:, None]).astype(F32)
+    sign = F32(-1) if normal == "-gradient" else F32(1)
+    N = (sign * g / np.where(flat, F32(1), gl)[:, None]).astype(F32)
     V = (-dirs[vis]).astype(F32)
     mv = m[vis]
     cue = (F32(1) / (F32(sh["kc"]) + F32(sh["kl"]) * t[vis]))[:, None]

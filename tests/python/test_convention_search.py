@@ -38,7 +38,8 @@ def caster_rules(kw):
     for k, v in kw.items():
         if k == "termination":
             rules[k] = {v[0]: v[1]}
-        elif k in ("placement", "first", "step_count", "ray_box", "correction", "table", "compositing", "correction_floor"):
+        elif k in ("placement", "first", "step_count", "ray_box", "correction", "table", "compositing", "correction_floor",
+                   "gradient", "normal", "gradient_offset", "clamp_shaded"):
             rules[k] = v
     return rules
 
@@ -64,6 +65,12 @@ VARIANTS = [
     ("hazy", dict(output=("bgra",)), {}, "BGRA"),
     ("hazy", dict(output=("srgb",)), {}, "sRGB-encoded"),
     ("hazy", dict(ray_box="texel", output=("flip",)), {"ray_box": "texel"}, "vertical flip"),
+    # Shaded (section 8): the gradient scheme, its offset and the normal's sign.
+    ("shaded", dict(gradient="central"), {"gradient": "central"}, "identity"),
+    ("shaded", dict(gradient="forward", normal="+gradient"), {"gradient": "forward", "normal": "+gradient"}, "identity"),
+    ("shaded", dict(gradient_offset=0.5), {"gradient_offset": 0.5}, "identity"),
+    ("shaded-phong-two-lights", dict(gradient="central", placement="from-entry", first=1.0),
+     {"gradient": "central", "placement": "from-entry", "first": 1.0}, "identity"),
 ]
 
 
@@ -118,6 +125,20 @@ def test_planted_bugs_stay_unexplained(bug, scene_name):
     assert r["rules"] == {} and r["image_model"] is None
     assert r["unexplained_pixels"] > 0.05 * r["pixels"]
     assert "a bug, or a convention volref does not model" in r["verdict"]
+
+
+def test_reference_rules_are_the_reference():
+    """The reference preset's rules (central-in-domain gradients, optical depth) rendered by the profile
+    integrator give the reference integrators' image to rounding, shaded or not; the caster with a clamped
+    central gradient and clamped shading is matched by those rules written as a profile."""
+    for name in ("shaded", "shaded-phong-two-lights", "hazy"):
+        scene = SCENES[name]
+        ref = volref.render(scene).rgba
+        rules = {k: v for k, v in volref.profiles()["reference"].items()}
+        assert np.abs(volref.render(with_profile(name, rules)).rgba - ref).max() <= 1e-12
+    kw = dict(gradient="central", clamp_shaded=True, normal="+gradient")
+    ours = volref.render(with_profile("shaded", caster_rules(kw))).rgba
+    assert np.abs(ours - ec.render(SCENES["shaded"], **kw)).max() <= MATCH
 
 
 def test_alpha_agrees_colour_differs():

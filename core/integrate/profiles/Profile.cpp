@@ -11,11 +11,12 @@ namespace {
 
 // The reference's conventions as rules (issue 29): what a custom profile on base "reference" starts
 // from. The reference itself renders through its own integrators (RenderSpec::reference_integrators);
-// this preset's ProfileIntegrator differs from them only in rounding and in its gradient (central
-// differences of the clamped field, not GradientField's one-sided differences at the boundary).
+// this preset's ProfileIntegrator differs from them only in rounding (and from a gradient cache, volume.
+// gradient.cache, by its interpolation).
 Profile make_reference() {
     Profile p;
     p.compositing = Profile::Compositing::OpticalDepth;
+    p.gradient = Profile::Gradient::CentralInDomain;
     return p;
 }
 
@@ -89,7 +90,7 @@ Profile make_ospray() {
     p.termination.test_alpha_at_least = true;
     p.termination.alpha_at_least = 1.0 - 0.001;
     p.gradient_offset = 1.0;
-    p.forward_gradient = true;
+    p.gradient = Profile::Gradient::Forward;
     return p;
 }
 
@@ -202,7 +203,7 @@ Profile resolve_profile(const RenderSpec& render) {
     if (r.table_entries) p.table_entries = *r.table_entries;
     if (r.table_coordinate) p.table_coordinate = *r.table_coordinate;
     if (r.normal_along_gradient) p.normal_along_gradient = *r.normal_along_gradient;
-    if (r.forward_gradient) p.forward_gradient = *r.forward_gradient;
+    if (r.gradient) p.gradient = *r.gradient;
     if (r.gradient_offset) {
         p.gradient_offset = *r.gradient_offset;
         p.gradient_offset_texture = 0.0;
@@ -240,7 +241,7 @@ nlohmann::json profile_rules_json(const Profile& p) {
     r.table_entries = p.table_entries;
     r.table_coordinate = p.table_coordinate;
     r.normal_along_gradient = p.normal_along_gradient;
-    r.forward_gradient = p.forward_gradient;
+    r.gradient = p.gradient;
     if (p.gradient_offset_texture > 0.0) r.gradient_offset_texture = p.gradient_offset_texture;
     else r.gradient_offset = p.gradient_offset;
     r.clamp_shaded = p.clamp_shaded;

@@ -115,12 +115,14 @@ struct Profile {
 
     // --- gradients and shading --------------------------------------------------------------------
     // Central differences of the clamped field at +-gradient_offset voxels (per axis), or forward
-    // differences f(x + h) - f(x) when `forward_gradient`. normal_along_gradient: the renderer's
+    // differences f(x + h) - f(x) (Gradient::Forward), or central with the stencil inside the domain
+    // (Gradient::CentralInDomain: the reference's). normal_along_gradient: the renderer's
     // normal is +grad f (VTK's GLSL) rather than this contract's -grad f. clamp_shaded: the shaded
     // colour is clamped to [0, 1] before compositing.
     double gradient_offset = 1.0;  // voxels
     double gradient_offset_texture = 0.0;  // > 0: the offset is this fraction of the domain's extent per axis
-    bool forward_gradient = false;
+    using Gradient = ProfileRules::Gradient;
+    Gradient gradient = Gradient::Central;
     bool normal_along_gradient = false;
     bool clamp_shaded = false;
 

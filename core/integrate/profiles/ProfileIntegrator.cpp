@@ -157,6 +157,8 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
     }
     if (composite && p_.placement == Profile::Placement::FromExit && p_.compositing != Profile::Compositing::Lerp)
         fail(r.placement ? "placement" : "compositing", "placement \"from-exit\" visits the samples back to front: it composites with \"lerp\"");
+    if (band_ && p_.gradient == Profile::Gradient::CentralInDomain && ctx_.pipeline.shaded())
+        throw Error("render.profile_options.texture_band: the band is derived for the central and forward gradients, not \"central-in-domain\"");
     if (band_ && p_.correction == Profile::Correction::Exact && p_.table_entries > 1)
         throw Error("render.profile_options.texture_band: the band is derived for tables whose entries are corrected (correction \"pow\"), not \"exact\"");
 }
@@ -383,8 +385,16 @@ glm::dvec3 ProfileIntegrator::gradient(const glm::dvec3& x) const {
     for (int a = 0; a < 3; ++a) {
         glm::dvec3 e(0.0);
         e[a] = offset_[a];
-        g[a] = p_.forward_gradient ? (value(x + e) - value(x)) / offset_[a]
-                                   : (value(x + e) - value(x - e)) / (2.0 * offset_[a]);
+        if (p_.gradient == Profile::Gradient::CentralInDomain) {  // the reference's: one-sided at the boundary
+            glm::dvec3 b = x, c = x;
+            b[a] = std::min(x[a] + offset_[a], domain_hi_[a]);
+            c[a] = std::max(x[a] - offset_[a], domain_lo_[a]);
+            const double w = b[a] - c[a];
+            g[a] = w > 0.0 ? (value(b) - value(c)) / w : 0.0;
+            continue;
+        }
+        g[a] = p_.gradient == Profile::Gradient::Forward ? (value(x + e) - value(x)) / offset_[a]
+                                                          : (value(x + e) - value(x - e)) / (2.0 * offset_[a]);
     }
     return g;
 }
@@ -678,8 +688,9 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
             for (int a = 0; a < 3; ++a) {
                 glm::dvec3 e(0.0);
                 e[a] = offset_[a];
-                const Fetch fp = texture_fetch(x + e), fm = p_.forward_gradient ? f : texture_fetch(x - e);
-                const double h = p_.forward_gradient ? offset_[a] : 2.0 * offset_[a];
+                const bool forward = p_.gradient == Profile::Gradient::Forward;
+                const Fetch fp = texture_fetch(x + e), fm = forward ? f : texture_fetch(x - e);
+                const double h = forward ? offset_[a] : 2.0 * offset_[a];
                 q.g[a] = (fp.exact - fm.exact) / h;
                 q.dg[a] = (fp.band + fm.band) / h;
             }

@@ -257,7 +257,11 @@ int run_compare(const CompareArgs& args) {
                         search->tried.size(), number(search->tolerance).c_str());
             std::printf("%s\n", search->verdict.c_str());
         }
-        std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
+        if (search)  // the exit status is the search's
+            std::printf("A against B: %s; %s\n", within ? "within tolerance" : "NOT within tolerance",
+                        search->explained ? "explained (exit 0)" : "NOT explained (exit 1)");
+        else
+            std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
     }
     // With --scene: 0 when the search explains A (ConventionSearch.h), 1 when it does not.
     if (search) return search->explained ? 0 : 1;

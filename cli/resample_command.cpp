@@ -21,7 +21,7 @@
 #include "cli/Commands.h"
 #include "core/io/InputFile.h"
 #include "core/Error.h"
-#include "core/grid/Resample.h"
+#include "core/sample/Resample.h"
 #include "core/io/NrrdWriter.h"
 #include "core/io/VolumeReader.h"
 #include "core/scene/SceneLoader.h"

@@ -30,7 +30,7 @@
 #include "core/integrate/packet/PacketComposite.h"
 #include "core/integrate/march/SamplePipeline.h"
 #include "core/integrate/march/SamplePlacement.h"
-#include "core/integrate/fixed/StepDoubling.h"
+#include "core/film/StepDoubling.h"
 #include "core/sample/GradientField.h"
 #include "core/sample/MacrocellGrid.h"
 #include "core/sample/PreClassifiedVolume.h"

@@ -16,7 +16,7 @@
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "core/integrate/adaptive/CellCubic.h"
-#include "core/integrate/fixed/StepDoubling.h"
+#include "core/film/StepDoubling.h"
 #include "core/render/PreparedScene.h"
 #include "core/sample/Trilinear.h"
 #include "core/scene/SceneLoader.h"

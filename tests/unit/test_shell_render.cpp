@@ -9,7 +9,7 @@
 
 #include "TestScenes.h"
 #include "core/grid/ProceduralField.h"
-#include "core/grid/Resample.h"
+#include "core/sample/Resample.h"
 #include "core/io/NrrdWriter.h"
 #include "geometry/ShellTessellation.h"
 

@@ -1,6 +1,6 @@
 // Beam-space sampling (issue 5, items 3, 4, 6 and 7), against closed forms: shell coordinates and grid
 // placement (geometry/ShellCoordinates.h), reconstruction on shells with periodic axes
-// (core/sample/ShellSampler.h), Cartesian <-> shell resampling (core/grid/Resample.h), the NRRD writer
+// (core/sample/ShellSampler.h), Cartesian <-> shell resampling (core/sample/Resample.h), the NRRD writer
 // (core/io/NrrdWriter.h) and the `volref resample` command.
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,7 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
-#include "core/grid/Resample.h"
+#include "core/sample/Resample.h"
 #include "core/io/NrrdWriter.h"
 #include "core/io/VolumeReader.h"
 #include "core/scene/SceneLoader.h"

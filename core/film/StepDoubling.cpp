@@ -1,4 +1,4 @@
-#include "core/integrate/fixed/StepDoubling.h"
+#include "core/film/StepDoubling.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "core/grid/Resample.h"
+#include "core/sample/Resample.h"
 
 #include <cmath>
 #include <string>

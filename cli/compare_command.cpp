@@ -18,6 +18,7 @@
 #include "core/compare/ImageMetrics.h"
 #include "core/compare/MetricsJson.h"
 #include "core/compare/Tolerance.h"
+#include "core/film/Background.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 
@@ -97,14 +98,8 @@ std::vector<ConventionVariant> convention_variants(const std::filesystem::path& 
         if (k == 1) po.ray_box_domain = !po.ray_box_domain;
         if (k == 2) po.mip_correction = !po.mip_correction;
         Image im = render_scene(s);
-        if (background) {  // as read_compared_image composites an associated input
-            const glm::dvec4 bg = *background;
-            for (std::size_t p = 0; p + 3 < im.pixels.size(); p += 4) {
-                const double t = 1.0 - im.pixels[p + 3];
-                for (int c = 0; c < 3; ++c) im.pixels[p + std::size_t(c)] += t * bg.a * bg[c];
-                im.pixels[p + 3] += t * bg.a;
-            }
-        }
+        if (background)  // as read_compared_image composites an associated input
+            for (std::size_t p = 0; p < im.pixels.size(); p += im.channels.size()) composite_over_background(&im.pixels[p], *background);
         out[std::size_t(k)].image = std::move(im);
     }
     return out;
@@ -136,12 +131,7 @@ int run_compare(const CompareArgs& args) {
             for (std::size_t c = 0; c < 4; ++c) b.rgba.pixels[p * 4 + c] = im.pixels[p * C + c];
             for (std::size_t c = 4; c < C; ++c)
                 if (im.channels[c] == "error") b.error.push_back(im.pixels[p * C + c]);
-            if (background) {
-                const glm::dvec4 bg = *background;
-                const double t = 1.0 - b.rgba.pixels[p * 4 + 3];
-                for (std::size_t c = 0; c < 3; ++c) b.rgba.pixels[p * 4 + c] += t * bg.a * bg[int(c)];
-                b.rgba.pixels[p * 4 + 3] += t * bg.a;
-            }
+            if (background) composite_over_background(&b.rgba.pixels[p * 4], *background);
         }
     }
     if (a.rgba.width != b.rgba.width || a.rgba.height != b.rgba.height)

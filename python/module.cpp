@@ -36,6 +36,7 @@
 #include "core/explain/NumberFormat.h"
 #include "core/explain/PixelTrace.h"
 #include "core/film/Image.h"
+#include "core/film/Background.h"
 #include "core/film/ImageWriter.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/render/PreparedScene.h"
@@ -282,11 +283,7 @@ compare::ComparedImage compared_input(py::handle v, const char* name, py::handle
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             double c[4] = {p(y, x, 0) / scale, p(y, x, 1) / scale, p(y, x, 2) / scale, n == 4 ? p(y, x, 3) / scale : 1.0};
-            if (background) {  // composite the associated input over the background (as the CLI)
-                const glm::dvec4& bg = *background;
-                for (int k = 0; k < 3; ++k) c[k] += (1.0 - c[3]) * bg.a * bg[k];
-                c[3] = c[3] + (1.0 - c[3]) * bg.a;
-            }
+            if (background) composite_over_background(c, *background);  // the associated input over it (as the CLI)
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
         }
     if (fault) {  // issue 28
@@ -534,8 +531,7 @@ py::bytes png_bytes(py::object self) {
         for (int x = 0; x < im.width; ++x) {
             double c[4];
             for (int k = 0; k < 4; ++k) c[k] = im.at(x, y, std::size_t(k));
-            for (int k = 0; k < 3; ++k) c[k] += (1.0 - c[3]) * bg.a * bg[k];
-            c[3] += (1.0 - c[3]) * bg.a;
+            composite_over_background(c, bg);
             for (int k = 0; k < 4; ++k) {
                 const double v = k < 3 ? (c[3] > 0.0 ? c[k] / c[3] : 0.0) : c[3];
                 const double q = std::round(std::clamp(std::isfinite(v) ? v : 0.0, 0.0, 1.0) * 255.0);

@@ -1,4 +1,5 @@
 #include "core/compare/ComparedImage.h"
+#include "core/film/Background.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -104,11 +105,8 @@ ComparedImage read_compared_image(const std::filesystem::path& path, const std::
                 for (int k = 0; k < 4; ++k) out.stored[p * 4 + std::size_t(k)] = c[k];
             if (out.unassociated)
                 for (int k = 0; k < 3; ++k) c[k] *= alpha;  // C = u a
-            else if (background) {                           // composite an associated input
-                const glm::dvec4& bg = *background;
-                for (int k = 0; k < 3; ++k) c[k] += (1.0 - alpha) * bg.a * bg[k];
-                c[3] = alpha + (1.0 - alpha) * bg.a;
-            }
+            else if (background)  // composite an associated input
+                composite_over_background(c, *background);
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
             if (e >= 0) out.error[p] = px[e];
             if (fault >= 0) out.fault[p] = px[fault] != 0.0;

@@ -7,6 +7,7 @@
 #include "core/Error.h"
 #include "core/compare/CompareConstants.h"
 #include "core/compare/Tolerance.h"
+#include "core/film/Background.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
@@ -54,14 +55,8 @@ struct Evaluator {
         SearchCandidate best = out;
         for (const std::string& m : image_models()) {
             std::vector<double> v = apply_image_model(m, r);
-            if (background) {
-                const glm::dvec4 bg = *background;
-                for (std::size_t i = 0; i + 3 < v.size(); i += 4) {
-                    const double t = 1.0 - v[i + 3];
-                    for (int c = 0; c < 3; ++c) v[i + std::size_t(c)] += t * bg.a * bg[c];
-                    v[i + 3] += t * bg.a;
-                }
-            }
+            if (background)
+                for (std::size_t i = 0; i + 3 < v.size(); i += 4) composite_over_background(&v[i], *background);
             SearchCandidate c = out;
             c.image_model = m;
             double sum2 = 0.0;

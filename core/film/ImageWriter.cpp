@@ -1,6 +1,6 @@
 #include "core/film/ImageWriter.h"
 
-#include "core/integrate/march/Accumulators.h"
+#include "core/film/Background.h"
 
 #include <unistd.h>
 
@@ -39,16 +39,11 @@ std::vector<T> quantised_over_background(const Image& image, const glm::dvec4& b
     std::vector<T> out(std::size_t(image.width) * std::size_t(image.height) * 4);
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) {
-            // The background behind the pixel: C += (1 - A) a_bg c_bg, A += (1 - A) a_bg (the
-            // opacity-sum rule of core/integrate/march/Accumulators.h).
-            FrontToBack<Scalar, TransmittanceRule::OpacitySum> over;
-            const double C[3] = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
-            const double background[3] = {bg.r, bg.g, bg.b};
-            over.resume(C, image.at(x, y, 3));
-            over.add(true, false, 0.0, bg.a, background);
-            const double a = over.alpha();
+            double px[4] = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2), image.at(x, y, 3)};
+            composite_over_background(px, bg);  // Background.h
+            const double a = px[3];
             T* p = &out[(std::size_t(y) * std::size_t(image.width) + std::size_t(x)) * 4];
-            for (int c = 0; c < 3; ++c) p[c] = q(a > 0.0 ? over.color(c) / a : 0.0);
+            for (int c = 0; c < 3; ++c) p[c] = q(a > 0.0 ? px[c] / a : 0.0);
             p[3] = q(a);
         }
     return out;

@@ -125,8 +125,7 @@ public:
             if (t.test_alpha_above) stop = L::or_(stop, L::gt(A, L::splat(t.alpha_above)));
             if (t.test_alpha_at_least) stop = L::or_(stop, L::ge(A, L::splat(t.alpha_at_least)));
         }
-        if constexpr (R == ::volref::TransmittanceRule::Product)
-            if (t.test_transmittance) stop = L::or_(stop, L::le(s_, L::splat(t.transmittance_at_most)));
+        if (t.test_transmittance) stop = L::or_(stop, L::le(transmittance(), L::splat(t.transmittance_at_most)));
         return L::and_(partial, stop);
     }
 

@@ -27,8 +27,9 @@ enum class TransmittanceRule {
 };
 
 // When a front-to-back ray stops (besides an opaque sample): once A > alpha_above (early termination;
-// VTK's GPU shader: 1 - 1/255), A >= alpha_at_least (a textbook shader: 1), or, under the product
-// rule, T <= transmittance_at_most (the fast profile's cutoff). A rule that is off is never tested.
+// VTK's GPU shader: 1 - 1/255), A >= alpha_at_least (a textbook shader: 1), or T <= transmittance_at_most
+// with T the transmittance rule's own (the fast profile's cutoff; custom profiles). A rule that is off is
+// never tested.
 struct Termination {
     bool test_alpha_above = false;
     double alpha_above = 1.0;

@@ -879,9 +879,7 @@ PixelValue ProfileIntegrator::composite_front_to_back(const Ray& ray, const std:
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        const Termination& term = p_.termination;  // (transmittance: T = 1 - A under the opacity sum)
-        return !(opaque || acc.stops(true, term) ||
-                 (term.test_transmittance && acc.transmittance() <= term.transmittance_at_most));
+        return !(opaque || acc.stops(true, p_.termination));
     });
     PixelValue out;
     out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());

@@ -120,11 +120,13 @@ int run_compare(const CompareArgs& args) {
     std::optional<Scene> scene;
     if (!args.scene.empty()) scene = load_scene(args.scene);
     ComparedImage b;
+    Image scene_render;  // B when compare renders it: the search's base render too
     if (!args.b.empty()) {
         b = read_compared_image(args.b, background);
     } else {  // issue 29: B is the scene rendered, composited as read_compared_image composites an EXR
         b.path = args.scene.string() + " (rendered)";
-        const Image im = render_scene(*scene);
+        scene_render = render_scene(*scene);
+        const Image& im = scene_render;
         b.rgba = Image(im.width, im.height, {"R", "G", "B", "A"});
         const std::size_t C = im.channels.size();
         for (std::size_t p = 0; p < std::size_t(im.width) * std::size_t(im.height); ++p) {
@@ -157,6 +159,7 @@ int run_compare(const CompareArgs& args) {
         SearchOptions so;
         so.tolerance = args.tolerance > 0.0 ? args.tolerance : -1.0;
         so.background = background;
+        if (args.b.empty()) so.base_render = &scene_render;
         search = search_conventions(a, *scene, so);
     }
     double scale = 0.0;

@@ -46,8 +46,8 @@ struct Evaluator {
     bool skipped(std::size_t p) const { return !g.fault.empty() && g.fault[p] != 0; }
 
     // The candidate's counts for one render under every image model; the best model kept in `out`.
-    // `residual` (optional) receives the best model's per-pixel residual.
-    void evaluate(const Image& r, SearchCandidate& out, std::vector<double>* residual = nullptr) const {
+    // out.residual receives the best model's per-pixel residual.
+    void evaluate(const Image& r, SearchCandidate& out) const {
         std::size_t error_channel = r.channels.size();
         for (std::size_t c = 0; c < r.channels.size(); ++c)
             if (r.channels[c] == "error") error_channel = c;
@@ -92,7 +92,7 @@ struct Evaluator {
                                 (c.unexplained_pixels == best.unexplained_pixels && c.residual_rms < best.residual_rms);
             if (better) {
                 best = c;
-                if (residual) *residual = std::move(res);
+                best.residual = std::move(res);
             }
             first = false;
         }
@@ -272,12 +272,14 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
             return false;  // not applicable to this scene (a rule's own error)
         }
         out.tried.push_back(c);
+        out.tried.back().residual.clear();  // (kept for the best set only: W x H doubles each)
         return true;
     };
 
     SearchCandidate base;
-    ev.evaluate(render_scene(scene, ro), base);
+    ev.evaluate(options.base_render ? *options.base_render : render_scene(scene, ro), base);
     out.tried.push_back(base);
+    out.tried.back().residual.clear();
     out.unexplained_before = base.unexplained_pixels;
     SearchCandidate best = base;
     auto consider = [&](const SearchCandidate& c) {
@@ -291,8 +293,9 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
             for (const json& v : values) {
                 SearchCandidate c;
                 if (attempt(v, c)) {
-                    singles.push_back(c);
                     consider(c);
+                    c.residual.clear();
+                    singles.push_back(c);
                 }
             }
     }
@@ -356,12 +359,7 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
         }
     }
 
-    // The best set's residual (heat map) and the alpha verdict.
-    {
-        Scene s = with_rules(scene, best.rules);
-        SearchCandidate c = best;
-        ev.evaluate(render_scene(s, ro), c, &out.residual);
-    }
+    out.residual = std::move(best.residual);  // the heat map
     out.best = best;
     out.explained = best.unexplained_pixels <= allowed;
     const double fraction = ev.pixels > 0 ? 100.0 * (1.0 - double(best.unexplained_pixels) / double(ev.pixels)) : 100.0;

@@ -36,6 +36,9 @@ struct SearchOptions {
     int threads = 0;          // 0: all cores
     // B's background, as read_compared_image composited an associated G over it (compare --background).
     std::optional<glm::dvec4> background;
+    // The scene's own render when the caller has made it already (compare renders B from --scene): not
+    // rendered again. Null: the search renders it.
+    const Image* base_render = nullptr;
 };
 
 // One tried set: its rules (render.profile's keys and values) and the image model.
@@ -45,6 +48,7 @@ struct SearchCandidate {
     long unexplained_pixels = 0;
     long alpha_unexplained = 0;  // pixels whose alpha alone is over the tolerance
     double residual_max = 0.0, residual_rms = 0.0;
+    std::vector<double> residual;  // |M(R) - G| max over R, G, B, A per pixel (SearchResult::best's moved out)
     std::string describe() const;  // "placement from-entry, first 0, ray_box texel (vertical flip)"
 };
 

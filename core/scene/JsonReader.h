@@ -163,6 +163,12 @@ public:
         const std::optional<std::string> s = optional_string(key);
         return s ? match(key, *s, options, planned) : fallback;
     }
+    // The same, absent when the key is (render.profile's rules: a rule not set is the base's).
+    template <class E>
+    std::optional<E> optional_choice(std::string_view key, std::initializer_list<Choice<E>> options) {
+        const std::optional<std::string> s = optional_string(key);
+        return s ? std::optional<E>(match(key, *s, options, {})) : std::nullopt;
+    }
     template <class E>
     E required_choice(std::string_view key, std::initializer_list<Choice<E>> options,
                       std::initializer_list<std::string_view> planned = {}) {

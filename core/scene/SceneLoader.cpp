@@ -809,14 +809,12 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast))
         r.fail(out.keys.front(), std::string("the \"") + std::string(base == ProfileId::VtkCpu ? "vtk-cpu" : base == ProfileId::VtkJs ? "vtk-js" : "fast") +
                                      "\" profile is its own renderer, not a set of rules (use render.profile_options, or base \"reference\")");
-    if (r.has("placement"))
-        out.placement = r.choice<P::Placement>("placement", P::Placement::Midpoints,
+    out.placement = r.optional_choice<P::Placement>("placement",
                                                {{"midpoints", P::Placement::Midpoints},
                                                 {"from-entry", P::Placement::FromEntry},
                                                 {"from-exit", P::Placement::FromExit}});
     out.first = r.optional_number("first", Range::closed(0.0, 1e6));
-    if (r.has("step_count"))
-        out.step_count = r.choice<P::StepCount>("step_count", P::StepCount::ThroughExit,
+    out.step_count = r.optional_choice<P::StepCount>("step_count",
                                                 {{"through-exit", P::StepCount::ThroughExit}, {"before-exit", P::StepCount::BeforeExit}});
     if (const Json* b = r.find("ray_box")) {
         if (b->is_object()) {
@@ -832,20 +830,17 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
                                               {{"domain", P::RayBox::Domain}, {"texel", P::RayBox::Texel}});
         }
     }
-    if (r.has("step_voxel"))
-        out.step_voxel = r.choice<P::VoxelLength>("step_voxel", P::VoxelLength::Spacing,
+    out.step_voxel = r.optional_choice<P::VoxelLength>("step_voxel",
                                                   {{"spacing", P::VoxelLength::Spacing},
                                                    {"extent-over-samples", P::VoxelLength::ExtentOverSamples}});
-    if (r.has("correction"))
-        out.correction = r.choice<P::Correction>("correction", P::Correction::Power,
+    out.correction = r.optional_choice<P::Correction>("correction",
                                                  {{"pow", P::Correction::Power},
                                                   {"exact", P::Correction::Exact},
                                                   {"none", P::Correction::None},
                                                   {"extinction", P::Correction::Extinction}});
     out.correction_floor = r.optional_number("correction_floor", Range::closed(0.0, 1.0));
     out.density_scale = r.optional_number("density_scale", Range::non_negative());
-    if (r.has("compositing"))
-        out.compositing = r.choice<P::Compositing>("compositing", P::Compositing::OpticalDepth,
+    out.compositing = r.optional_choice<P::Compositing>("compositing",
                                                    {{"optical-depth", P::Compositing::OpticalDepth},
                                                     {"product", P::Compositing::Product},
                                                     {"opacity-sum", P::Compositing::OpacitySum},
@@ -869,21 +864,16 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     }
     if (r.has("table")) out.table_entries = int(r.integer("table", 0, Range::closed(0, 1 << 20)));
     if (out.table_entries == 1) r.fail("table", "expected 0 (the transfer function read exactly) or at least 2 entries");
-    if (r.has("table_coordinate"))
-        out.table_coordinate = r.choice<P::TableCoordinate>("table_coordinate", P::TableCoordinate::DataRange,
+    out.table_coordinate = r.optional_choice<P::TableCoordinate>("table_coordinate",
                                                             {{"data-range", P::TableCoordinate::DataRange},
                                                              {"data-range-times-transfer-scale", P::TableCoordinate::DataRangeTimesTransferScale}});
-    if (r.has("texture_unit"))
-        out.texture_unit = r.choice<ProfileOptions::TextureUnit>("texture_unit", ProfileOptions::TextureUnit::Exact,
+    out.texture_unit = r.optional_choice<ProfileOptions::TextureUnit>("texture_unit",
                                                                  {{"exact", ProfileOptions::TextureUnit::Exact},
                                                                   {"h100", ProfileOptions::TextureUnit::H100}});
-    if (r.has("arithmetic"))
-        out.arithmetic = r.choice<P::Arithmetic>("arithmetic", P::Arithmetic::Double,
+    out.arithmetic = r.optional_choice<P::Arithmetic>("arithmetic",
                                                  {{"double", P::Arithmetic::Double}, {"float32", P::Arithmetic::Float32}});
-    if (r.has("normal"))
-        out.normal_along_gradient = r.choice<bool>("normal", false, {{"-gradient", false}, {"+gradient", true}});
-    if (r.has("gradient"))
-        out.gradient = r.choice<P::Gradient>("gradient", P::Gradient::Central,
+    out.normal_along_gradient = r.optional_choice<bool>("normal", {{"-gradient", false}, {"+gradient", true}});
+    out.gradient = r.optional_choice<P::Gradient>("gradient",
                                              {{"central", P::Gradient::Central},
                                               {"forward", P::Gradient::Forward},
                                               {"central-in-domain", P::Gradient::CentralInDomain}});

@@ -130,7 +130,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
         for (std::size_t i = 0; i < t.intervals.size(); ++i)
             if (t.intervals[i].t0 <= s.record.t) s.interval = std::int64_t(i);
         if (s.interval >= 0 && t.step > 0.0)
-            s.segment = std::int64_t(std::floor((s.record.t - t.intervals[std::size_t(s.interval)].t0) / t.step + 1e-9));
+            s.segment = std::int64_t(std::floor((s.record.t - t.intervals[std::size_t(s.interval)].t0) / t.step + conventions::kSegmentSlack));  // the segments' own slack
     }
     if (t.pixel.fault) t.fault = v.integrator->fault_reason(v.volume_ray(t.ray));
     return t;

@@ -38,7 +38,7 @@ struct TracedSample {
     GridLocation grid;
     // issue 29: where the sample lies, the same with empty-space skipping on or off: the interval
     // (index into PixelTrace::intervals: the last with t0 <= t) and the step from its entry,
-    // segment = floor((t - t_entry) / h + 1e-9) (midpoints: the segment's index k; from the entry:
+    // segment = floor((t - t_entry) / h + kSegmentSlack) (kSegmentSlack = 1e-9, conventions section 4) (midpoints: the segment's index k; from the entry:
     // floor(first + k)). -1 for a sample before every interval.
     std::int64_t interval = -1, segment = -1;
 };

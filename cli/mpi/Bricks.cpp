@@ -1,5 +1,7 @@
 #include "cli/mpi/Bricks.h"
 
+#include <bit>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -148,6 +150,63 @@ bool owns(const Brick& b, const Lattice& lattice, const glm::dvec3& u) {
         if (b.hi[a] < lattice.hi[a] && !(u[a] < double(b.hi[a]))) return false;
     }
     return true;
+}
+
+namespace {
+
+// Doubles in order as integers (-0 and +0 both 0), and back.
+std::int64_t ordered(double x) {
+    const std::int64_t k = std::bit_cast<std::int64_t>(x);
+    return k < 0 ? std::numeric_limits<std::int64_t>::min() - k : k;
+}
+double from_ordered(std::int64_t k) {
+    return std::bit_cast<double>(k < 0 ? std::numeric_limits<std::int64_t>::min() - k : k);
+}
+
+// The smallest t in [lo, hi] with pred(t) for a predicate false then true on the doubles; hi's
+// successor when none.
+template <class Pred>
+double first_true(Pred&& pred, double lo, double hi) {
+    std::int64_t a = ordered(lo), b = ordered(hi);
+    if (!pred(hi)) return std::nextafter(hi, std::numeric_limits<double>::infinity());
+    while (a < b) {  // pred(from_ordered(b)) holds; the answer is in [a, b]
+        // (b - a can exceed the int64 range: halved as unsigned.)
+        const std::int64_t mid = a + std::int64_t((std::uint64_t(b) - std::uint64_t(a)) / 2);
+        if (pred(from_ordered(mid))) b = mid;
+        else a = mid + 1;
+    }
+    return from_ordered(b);
+}
+
+}  // namespace
+
+RaySpan owned_span(const Brick& b, const Lattice& lattice, const GridBox& first, const Ray& ray) {
+    constexpr double kFar = 1e300;  // every t a sample can have
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    double t0 = -kFar, t_last = kFar;  // the owned t: [t0, t_last]
+    auto u = [&](int a, double t) { return (ray.at(t)[a] - first.origin[a]) / first.spacing[a]; };
+    for (int a = 0; a < 3; ++a) {
+        const bool lower = b.lo[a] > lattice.lo[a], upper = b.hi[a] < lattice.hi[a];
+        const double lo = double(b.lo[a]), hi = double(b.hi[a]);
+        auto inside_lower = [&](double t) { return u(a, t) >= lo; };
+        auto inside_upper = [&](double t) { return u(a, t) < hi; };
+        if (ray.direction[a] == 0.0) {  // the index does not change along the ray
+            if ((lower && !inside_lower(0.0)) || (upper && !inside_upper(0.0))) return RaySpan{kInf, kInf};
+            continue;
+        }
+        const bool increasing = ray.direction[a] > 0.0;
+        // u >= lo: from a first t on (u increasing) or up to a last one; u < hi the other way round.
+        if (lower) {
+            if (increasing) t0 = std::max(t0, first_true(inside_lower, -kFar, kFar));
+            else t_last = std::min(t_last, std::nextafter(first_true([&](double t) { return !inside_lower(t); }, -kFar, kFar), -kInf));
+        }
+        if (upper) {
+            if (increasing) t_last = std::min(t_last, std::nextafter(first_true([&](double t) { return !inside_upper(t); }, -kFar, kFar), -kInf));
+            else t0 = std::max(t0, first_true(inside_upper, -kFar, kFar));
+        }
+    }
+    if (!(t0 <= t_last)) return RaySpan{kInf, kInf};
+    return RaySpan{t0 == -kFar ? -kInf : t0, t_last == kFar ? kInf : std::nextafter(t_last, kInf)};
 }
 
 }  // namespace volref::mpi

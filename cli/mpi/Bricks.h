@@ -10,6 +10,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/camera/Ray.h"
+#include "core/integrate/march/RaySpan.h"
 #include "core/scene/Scene.h"
 #include "geometry/VolumeTransform.h"
 
@@ -60,5 +62,11 @@ int ghost_voxels(const VolumeSpec& vs, const RenderSpec& render);
 // open-ended at the lattice's outer faces ([0, dims - 1] for one volume), so every point belongs to
 // exactly one brick of a k-d split (the same test on every rank).
 bool owns(const Brick& b, const Lattice& lattice, const glm::dvec3& u);
+
+// The span of `ray` (in `first`'s space) that `b` owns: exactly the doubles t with
+// owns(b, lattice, (ray.at(t) - first.origin) / first.spacing) (march/RaySpan.h's [t0, t1), t1 the double
+// after the last owned t; empty: [+inf, +inf)). Each axis' index is monotone in t, so each of the
+// brick's faces bounds the owned t on one side; each bound is found by bisection over the doubles.
+RaySpan owned_span(const Brick& b, const Lattice& lattice, const GridBox& first, const Ray& ray);
 
 }  // namespace volref::mpi

@@ -9,6 +9,16 @@
 
 namespace volref {
 
+namespace {
+[[noreturn]] void not_resumable() {
+    throw Error("render: this projection, integrator or profile cannot be integrated in spans (volref-mpi) yet");
+}
+}  // namespace
+
+void Integrator::integrate_span(const Ray&, const std::vector<Interval>&, const RaySpan&, RayState&) const { not_resumable(); }
+void Integrator::merge_spans(RayState&, const RayState&) const { not_resumable(); }
+PixelValue Integrator::finish(const Ray&, const std::vector<Interval>&, const RayState&) const { not_resumable(); }
+
 std::unique_ptr<Integrator> make_integrator(const IntegrationContext& ctx) {
     const RenderSpec& r = ctx.render;
     if (r.early_termination && (r.projection != Projection::Composite || r.order != CompositeOrder::FrontToBack))

@@ -11,6 +11,7 @@
 
 #include "core/Error.h"
 #include "core/camera/Ray.h"
+#include "core/integrate/march/RaySpan.h"
 #include "core/integrate/march/SamplePipeline.h"
 #include "core/scene/Scene.h"
 #include "geometry/RayIntervals.h"
@@ -68,6 +69,29 @@ public:
         (void)recorder;
         throw Error("trace: this projection or integrator is not supported yet");
     }
+    // Resumable integration (march/RaySpan.h, issue 30): the ray in spans, the accumulator's state
+    // handed from span to span; volref-mpi's ranks each integrate their span. An integrator that
+    // cannot be resumed says so (resumable() false; the functions below then throw).
+    virtual bool resumable() const { return false; }
+    // Continues `state` over the samples `span` owns, front to back: span after span, the whole
+    // ray's pixel (finish) is integrate()'s bit for bit.
+    virtual void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                RayState& state) const;
+    // `count` rays at once (<= kMaxPacketRays); the default resumes them one by one. Each state must
+    // equal integrate_span's up to the documented rounding of the SIMD path.
+    virtual void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
+                                       RayState* states, int count) const {
+        for (int i = 0; i < count; ++i) integrate_span(rays[i], intervals[i], spans[i], states[i]);
+    }
+    // `back`, integrated from a fresh state over a span behind `front`'s, added to `front`: equal to
+    // resuming `front` over that span up to rounding, where spans_in_order() is false.
+    virtual void merge_spans(RayState& front, const RayState& back) const;
+    // The pixel of a ray whose spans have all been integrated into `state`.
+    virtual PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const;
+    // True when a span's result depends on the state in front of it (early termination): the spans
+    // must then be resumed in ray order, not merged.
+    virtual bool spans_in_order() const { return false; }
+
     // The extra channels this projection writes (e.g. "Z" for first-hit).
     virtual bool writes_depth() const { return false; }
     // True when PixelValue::error is this integrator's error estimate (the "error" channel).

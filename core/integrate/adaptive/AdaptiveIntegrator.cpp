@@ -1,5 +1,7 @@
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 
+#include "core/integrate/march/SpanStates.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -385,20 +387,33 @@ struct LineState {
 }  // namespace
 
 PixelValue AdaptiveIntegrator::line_integral(const Ray& ray, const std::vector<Interval>& intervals) const {
+    LineSums st;
+    line_over(ray, intervals, RaySpan{}, st);
+    return line_pixel(intervals, st.integral, st.error);
+}
+
+// The one loop of average and x-ray: the pieces whose midpoints `span` owns added to `st`.
+void AdaptiveIntegrator::line_over(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                   LineSums& st) const {
+    if (intervals.empty()) return;
+    const double per_length = line_budget(line_length(intervals));
+    std::vector<double> cut;
+    for (const Interval& iv : intervals) {
+        cuts(ray, iv, cut);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p)
+            if (span.owns(0.5 * (cut[p] + cut[p + 1]))) line_piece(ray, cut[p], cut[p + 1], per_length, st);
+    }
+}
+
+PixelValue AdaptiveIntegrator::line_pixel(const std::vector<Interval>& intervals, const CompensatedSum& integral,
+                                          double error) const {
     PixelValue out;
     if (intervals.empty()) return out;
     const double L = line_length(intervals);
     const bool mean = ctx_.render.projection == Projection::Average;
-    const double per_length = line_budget(L);
-    LineSums st;
-    std::vector<double> cut;
-    for (const Interval& iv : intervals) {
-        cuts(ray, iv, cut);
-        for (std::size_t p = 0; p + 1 < cut.size(); ++p) line_piece(ray, cut[p], cut[p + 1], per_length, st);
-    }
-    const double g = mean ? (L > 0.0 ? st.integral.value() / L : 0.0) : ctx_.render.gain * st.integral.value();
+    const double g = mean ? (L > 0.0 ? integral.value() / L : 0.0) : ctx_.render.gain * integral.value();
     out.rgba = glm::dvec4(g, g, g, 1.0);
-    out.error = (mean ? (L > 0.0 ? st.error / L : 0.0) : ctx_.render.gain * st.error) + rounding_bound(out.rgba);
+    out.error = (mean ? (L > 0.0 ? error / L : 0.0) : ctx_.render.gain * error) + rounding_bound(out.rgba);
     return out;
 }
 
@@ -430,21 +445,69 @@ void AdaptiveIntegrator::line_piece(const Ray& ray, double a, double b, double p
 // ---------------------------------------------------------------------------------------------
 
 PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals) const {
-    const bool maximum = ctx_.render.projection == Projection::Mip;
-    // The extremum over the candidates (march/Accumulators.h; non-finite values are ignored).
-    Extremum<Scalar> acc(maximum);
+    Extremum<Scalar> acc(ctx_.render.projection == Projection::Mip);
+    extremum_over(ray, intervals, RaySpan{}, acc);
+    PixelValue out;
+    if (acc.any()) out.rgba = extremum_rgba(ray, acc.where());
+    out.error = rounding_bound(out.rgba);
+    return out;
+}
+
+// The one loop of mip and minip: the extremum over the candidates of the pieces whose midpoints
+// `span` owns (march/Accumulators.h; non-finite values are ignored).
+void AdaptiveIntegrator::extremum_over(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                       Extremum<Scalar>& acc) const {
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
         extremum_cuts(ray, iv, cut);
-        for (std::size_t p = 0; p + 1 < cut.size(); ++p) extremum_piece(ray, cut[p], cut[p + 1], acc);
+        for (std::size_t p = 0; p + 1 < cut.size(); ++p)
+            if (span.owns(0.5 * (cut[p] + cut[p + 1]))) extremum_piece(ray, cut[p], cut[p + 1], acc);
     }
-    PixelValue out;
-    if (acc.any()) {
-        const PipelineSample p = ctx_.pipeline.sample(ray, acc.where(), SamplePipeline::Use::Unshaded);
-        out.rgba = glm::dvec4(p.opacity * p.color, p.opacity);
+}
+
+glm::dvec4 AdaptiveIntegrator::extremum_rgba(const Ray& ray, double t) const {
+    const PipelineSample p = ctx_.pipeline.sample(ray, t, SamplePipeline::Use::Unshaded);
+    return glm::dvec4(p.opacity * p.color, p.opacity);
+}
+
+// Resumable for the projections whose parts are independent (mip, minip, average, x-ray): each span's
+// extremum (classified here) or sums, merged behind the state (march/SpanStates.h). The composite's
+// state is AdaptiveComposite's (volref-mpi hands it on itself).
+bool AdaptiveIntegrator::resumable() const { return ctx_.render.projection != Projection::Composite; }
+
+void AdaptiveIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                        RayState& state) const {
+    RayState part;
+    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip) {
+        Extremum<Scalar> acc(ctx_.render.projection == Projection::Mip);
+        extremum_over(ray, intervals, span, acc);
+        if (!acc.any()) return;
+        extremum_state::save(acc.value(), acc.where(), extremum_rgba(ray, acc.where()), part);
+    } else if (resumable()) {
+        LineSums st;
+        line_over(ray, intervals, span, st);
+        line_state::save(st.integral, CompensatedSum(), st.error, part);
+    } else {
+        return Integrator::integrate_span(ray, intervals, span, state);  // (throws)
     }
-    out.error = rounding_bound(out.rgba);
-    return out;
+    merge_spans(state, part);
+}
+
+void AdaptiveIntegrator::merge_spans(RayState& front, const RayState& back) const {
+    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip)
+        extremum_state::merge(front, back, ctx_.render.projection == Projection::Mip);
+    else
+        line_state::merge(front, back);
+}
+
+PixelValue AdaptiveIntegrator::finish(const Ray&, const std::vector<Interval>& intervals, const RayState& state) const {
+    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip) {
+        PixelValue out;
+        if (extremum_state::seen(state)) out.rgba = extremum_state::rgba(state);
+        out.error = rounding_bound(out.rgba);
+        return out;
+    }
+    return line_pixel(intervals, line_state::integral(state), state.v[4]);
 }
 
 void AdaptiveIntegrator::extremum_cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const {

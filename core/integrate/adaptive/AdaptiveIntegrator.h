@@ -70,6 +70,13 @@ public:
     explicit AdaptiveIntegrator(const IntegrationContext& ctx);
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     bool writes_error() const override { return true; }
+    // Resumable (march/RaySpan.h) for mip, minip, average and x-ray: the pieces whose midpoints a span
+    // owns. Not the composite, whose state (AdaptiveComposite) volref-mpi hands on itself.
+    bool resumable() const override;
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                        RayState& state) const override;
+    void merge_spans(RayState& front, const RayState& back) const override;
+    PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
     // The cut points of one interval (t0, ..., t1), increasing: the pieces described above.
     void cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const;
@@ -121,6 +128,11 @@ private:
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;
+    void line_over(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, LineSums& st) const;
+    PixelValue line_pixel(const std::vector<Interval>& intervals, const CompensatedSum& integral, double error) const;
+    void extremum_over(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                       Extremum<Scalar>& acc) const;
+    glm::dvec4 extremum_rgba(const Ray& ray, double t) const;
     // The rows' crossings inside each piece of `out` where the field is not a cubic, found by sampling.
     void sampled_row_cuts(const Ray& ray, std::vector<double>& out) const;
     // Beam space: the crossings of the grid's coordinate surfaces inside each piece, found by sampling.

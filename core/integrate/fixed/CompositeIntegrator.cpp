@@ -9,6 +9,7 @@
 
 #include "core/integrate/march/SegmentWalk.h"
 #include "core/integrate/march/Accumulators.h"
+#include "core/integrate/march/SpanStates.h"
 
 namespace volref {
 
@@ -37,29 +38,34 @@ void record_opacity(SampleRecord& r, const SampleOpacity<Scalar>& o) {
     r.alpha = o.alpha;
 }
 
-// for_each_segment_reversed without the segments in empty macrocells.
+// for_each_segment_reversed over the segments `span` owns, without those in empty macrocells.
 template <typename Fn>
 void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ray,
-                                        const std::vector<Interval>& intervals, double step, Fn&& fn) {
-    if (!grid) return for_each_segment_reversed(intervals, step, fn);
+                                        const std::vector<Interval>& intervals, double step, const RaySpan& span, Fn&& fn) {
     for (auto it = intervals.rbegin(); it != intervals.rend(); ++it) {
         const Interval& iv = *it;
         const std::int64_t n = segment_count(iv, step);
-        std::int64_t k = n - 1;
-        while (k >= 0) {
+        const auto [first, end] = owned_segments(iv, step, n, span);
+        std::int64_t k = end - 1;
+        if (!grid) {
+            for (; k >= first; --k)
+                if (!fn(segment(iv, step, k, n))) return;
+            continue;
+        }
+        while (k >= first) {
             const MacrocellGrid::Index m = macrocell_of(*grid, ray, iv, step, k, n);
             // The estimate: segments begin .. k have their midpoints after the ray enters m.
             const std::int64_t begin =
-                std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->entry_distance(ray, m), n), 0, k);
+                std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->entry_distance(ray, m), n), first, k);
             if (grid->empty(m)) {
                 // Indices mirrored (j -> k - j) so that the run again starts at 0 and grows.
                 auto in_m = [&](std::int64_t j) { return macrocell_of(*grid, ray, iv, step, k - j, n) == m; };
-                std::int64_t in = k - begin, out = k + 1;
+                std::int64_t in = k - begin, out = k - first + 1;
                 if (in > 0 && !in_m(in)) {
                     out = in;  // the estimate is too long
                     in = 0;
                 } else {  // too short? gallop backward
-                    for (std::int64_t d = 1; in + d <= k; d *= 2) {
+                    for (std::int64_t d = 1; in + d <= k - first; d *= 2) {
                         if (!in_m(in + d)) {
                             out = in + d;
                             break;
@@ -85,16 +91,71 @@ PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Inte
         return out;
     }
     NoRecording rec;
-    return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
-                                                            : back_to_front(ray, intervals, rec);
+    return whole_ray(ray, intervals, rec);
 }
 
 PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
                                                  SampleRecorder& recorder) const {
     if (packet_ && packet_->fast) fast_profile_not_traced();
     Recording rec{recorder};
-    return ctx_.render.order == CompositeOrder::FrontToBack ? front_to_back(ray, intervals, rec)
-                                                            : back_to_front(ray, intervals, rec);
+    return whole_ray(ray, intervals, rec);
+}
+
+template <class Rec>
+PixelValue CompositeIntegrator::whole_ray(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    PixelValue out;
+    if (ctx_.render.order == CompositeOrder::FrontToBack) {
+        FrontToBack<Scalar> acc;
+        front_to_back(ray, intervals, RaySpan{}, acc, rec);
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    } else {
+        BackToFront<Scalar> acc;
+        back_to_front(ray, intervals, RaySpan{}, acc, rec);
+        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+    }
+    return out;
+}
+
+// Front to back: the state is FrontToBack's, resumed (composite_state, march/SpanStates.h). Back to
+// front: the span's part from a fresh BackToFront, put behind the state.
+void CompositeIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                         RayState& state) const {
+    if (state.stopped != 0.0) return;
+    if (packet_ && packet_->fast) return composite_packet(*packet_, &ray, &intervals, nullptr, 1, &span, &state);  // throws
+    NoRecording rec;
+    if (ctx_.render.order == CompositeOrder::FrontToBack) {
+        FrontToBack<Scalar> acc;
+        composite_state::load(acc, state);
+        const bool stopped = front_to_back(ray, intervals, span, acc, rec);
+        composite_state::save(acc, state);
+        state.stopped = stopped ? 1.0 : 0.0;
+    } else {
+        BackToFront<Scalar> acc;
+        back_to_front(ray, intervals, span, acc, rec);
+        RayState part;
+        composite_state::save_part(glm::dvec3(acc.color(0), acc.color(1), acc.color(2)), acc.optical_depth(), acc.opaque(),
+                                   part);
+        composite_state::merge(state, part);
+    }
+}
+
+void CompositeIntegrator::integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals,
+                                                const RaySpan* spans, RayState* states, int count) const {
+    if (packet_) composite_packet(*packet_, rays, intervals, nullptr, count, spans, states);
+    else Integrator::integrate_span_packet(rays, intervals, spans, states, count);
+}
+
+void CompositeIntegrator::merge_spans(RayState& front, const RayState& back) const { composite_state::merge(front, back); }
+
+PixelValue CompositeIntegrator::finish(const Ray&, const std::vector<Interval>&, const RayState& state) const {
+    PixelValue out;
+    out.rgba = composite_state::rgba(state);
+    return out;
+}
+
+bool CompositeIntegrator::spans_in_order() const {
+    const Termination& t = packet_ ? packet_->termination : termination_;
+    return t.test_alpha_above || t.test_alpha_at_least || t.test_transmittance;
 }
 
 Termination early_termination(const RenderSpec& render) {
@@ -108,11 +169,11 @@ Termination early_termination(const RenderSpec& render) {
 // the plain loop is unchanged (the records only read its state). The compositing is the
 // accumulators' (march/Accumulators.h).
 template <class Rec>
-PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+bool CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                        FrontToBack<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    const Termination stop = early_termination(ctx_.render);
-    FrontToBack<Scalar> acc;
-    ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step);
+    const Termination& stop = termination_;
+    ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step, span);
     Segment s;
     while (walk.next(s)) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
@@ -134,19 +195,17 @@ PixelValue CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        if (o.solid || acc.stops(o.partial, stop)) break;  // opaque: nothing behind is visible
+        if (o.solid || acc.stops(o.partial, stop)) return true;  // opaque: nothing behind is visible
     }
-    PixelValue out;
-    out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
-    return out;
+    return false;
 }
 
 template <class Rec>
-PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+void CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                        BackToFront<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    BackToFront<Scalar> acc;
     [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
-    for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, [&](const Segment& s) {
+    for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, span, [&](const Segment& s) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
         if (p.opacity > 0.0) {
@@ -162,9 +221,6 @@ PixelValue CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<
         }
         return true;
     });
-    PixelValue out;
-    out.rgba = accumulated();
-    return out;
 }
 
 }  // namespace volref

@@ -49,12 +49,31 @@ public:
                           int count) const override;
     bool has_packet_path() const { return packet_.has_value(); }
 
+    // Resumable (march/RaySpan.h): front to back resumes FrontToBack's state (the packet path where it
+    // applies); back to front puts each span's part behind the state (composite_state, SpanStates.h).
+    // (Not the fast profile: its float transmittance product has no state in this layout yet.)
+    bool resumable() const override { return !(packet_ && packet_->fast); }
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                        RayState& state) const override;
+    void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
+                               RayState* states, int count) const override;
+    void merge_spans(RayState& front, const RayState& back) const override;
+    PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
+    bool spans_in_order() const override;
+
 private:
-    // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h.
+    // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h. The one loop of each
+    // order, over the samples `span` owns, continuing `acc`; front_to_back returns true once the ray
+    // stops (opaque or terminated early).
     template <class Rec>
-    PixelValue front_to_back(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    PixelValue whole_ray(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     template <class Rec>
-    PixelValue back_to_front(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    bool front_to_back(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                       FrontToBack<Scalar>& acc, Rec& rec) const;
+    template <class Rec>
+    void back_to_front(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                       BackToFront<Scalar>& acc, Rec& rec) const;
+    Termination termination_;  // early_termination(render)
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
     std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
 };

@@ -13,7 +13,8 @@
 
 namespace volref {
 
-CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
+    : Integrator(ctx), termination_(early_termination(ctx.render)) {
     const SamplePipeline& p = ctx.pipeline;
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     // Where the packet path does not apply the reference takes the scalar path; the fast profile has

@@ -4,6 +4,7 @@
 #include "core/integrate/packet/PacketGrid.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
+#include "core/integrate/march/SpanStates.h"
 
 #include <algorithm>
 #include <cmath>
@@ -66,9 +67,17 @@ PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vecto
 // call at the same point).
 template <class Rec>
 PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    const Extremum<Scalar> acc = extremum(ray, intervals, RaySpan{}, rec);
+    return pixel(ray, acc.any(), acc.where());
+}
+
+// The one loop: the extremum over the samples `span` owns.
+template <class Rec>
+Extremum<Scalar> ExtremumIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                              Rec& rec) const {
     Extremum<Scalar> acc(maximum_);
     [[maybe_unused]] glm::dvec4 so_far(0.0);
-    for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
+    for_each_owned_segment(intervals, ctx_.step, span, [&](const Segment& s) {
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         double v;
         if constexpr (Rec::kOn) {
@@ -86,7 +95,44 @@ PixelValue ExtremumIntegrator::integrate_impl(const Ray& ray, const std::vector<
         }
         return true;
     });
-    return pixel(ray, acc.any(), acc.where());
+    return acc;
+}
+
+// A span's extremum (the packet path where it applies: bitwise the scalar one), classified here,
+// behind the state (extremum_state, march/SpanStates.h).
+void ExtremumIntegrator::integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
+                                               RayState* states, int count) const {
+    RayExtremum e[kMaxPacketRays];
+    if (packet_) {
+        extremum_packet(*packet_, rays, intervals, e, count, spans);
+    } else {
+        NoRecording rec;
+        for (int i = 0; i < count; ++i) {
+            const Extremum<Scalar> acc = extremum(rays[i], intervals[i], spans[i], rec);
+            e[i] = RayExtremum{acc.any(), acc.value(), acc.where()};
+        }
+    }
+    for (int i = 0; i < count; ++i) {
+        if (!e[i].any) continue;
+        RayState part;
+        extremum_state::save(e[i].value, e[i].t, pixel(rays[i], true, e[i].t).rgba, part);
+        extremum_state::merge(states[i], part, maximum_);
+    }
+}
+
+void ExtremumIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                        RayState& state) const {
+    integrate_span_packet(&ray, &intervals, &span, &state, 1);
+}
+
+void ExtremumIntegrator::merge_spans(RayState& front, const RayState& back) const {
+    extremum_state::merge(front, back, maximum_);
+}
+
+PixelValue ExtremumIntegrator::finish(const Ray&, const std::vector<Interval>&, const RayState& state) const {
+    PixelValue out;
+    if (extremum_state::seen(state)) out.rgba = extremum_state::rgba(state);
+    return out;
 }
 
 PixelValue ExtremumIntegrator::pixel(const Ray& ray, bool any, double t_best) const {

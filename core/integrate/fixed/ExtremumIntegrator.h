@@ -8,6 +8,7 @@
 
 #include "core/integrate/Integrator.h"
 #include "core/integrate/packet/PacketExtremum.h"
+#include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/SampleRecorder.h"
 
 namespace volref {
@@ -25,9 +26,20 @@ public:
     void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
                           int count) const override;
 
+    // Resumable (march/RaySpan.h): each span's extremum, classified by the span that took it.
+    bool resumable() const override { return true; }
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                        RayState& state) const override;
+    void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
+                               RayState* states, int count) const override;
+    void merge_spans(RayState& front, const RayState& back) const override;
+    PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
+
 private:
     template <class Rec>
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    Extremum<Scalar> extremum(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, Rec& rec) const;
     PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
     std::optional<PacketExtremumInputs> packet_;

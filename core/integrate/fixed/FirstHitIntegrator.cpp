@@ -1,5 +1,7 @@
 #include "core/integrate/fixed/FirstHitIntegrator.h"
 
+#include "core/integrate/march/SpanStates.h"
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -21,13 +23,19 @@ int sign(double x) { return (x > 0.0) - (x < 0.0); }
 }  // namespace
 
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
-                                           double iso) {
+                                           double iso, const RaySpan& span) {
     // Non-finite values (NaN, +-Inf voxels) never cross: parts with a non-finite end are passed over.
-    if (sampler.trilinear(ray.at(t0)) - iso == 0.0) return t0;
+    auto at_t0 = [&] { return sampler.trilinear(ray.at(t0)) - iso == 0.0; };
+    if (span.whole() && at_t0()) return t0;
     std::vector<double> cuts;
     grid_cuts(ray, t0, t1, sampler.volume(), 0.0, cuts);
-    for (std::size_t p = 0; p + 1 < cuts.size(); ++p)
+    for (std::size_t p = 0; p + 1 < cuts.size(); ++p) {
+        if (!span.whole()) {  // the pieces whose midpoints the span owns; t0 is the first piece's
+            if (!span.owns(0.5 * (cuts[p] + cuts[p + 1]))) continue;
+            if (p == 0 && at_t0()) return t0;
+        }
         if (const auto hit = first_crossing_in_cell(sampler, ray, cuts[p], cuts[p + 1], iso)) return hit;
+    }
     return std::nullopt;
 }
 
@@ -68,22 +76,34 @@ FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrat
 }
 
 PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+    RayState state;
+    integrate_span(ray, intervals, RaySpan{}, state);
+    return finish(ray, intervals, state);
+}
+
+// The one search: the brackets (segments) or cell pieces whose midpoints `span` owns, front to back;
+// a hit is classified here and stops the ray (hit_state, march/SpanStates.h).
+void FirstHitIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                        RayState& state) const {
+    if (state.stopped != 0.0) return;
     const double iso = *ctx_.render.isovalue;
     auto g = [&](double t) { return ctx_.field(ray, t) - iso; };
     std::optional<double> hit;
     for (const Interval& iv : intervals) {
         if (adaptive_) {
-            hit = first_crossing_exact(*trilinear_, ray, iv.t0, iv.t1, iso);
+            hit = first_crossing_exact(*trilinear_, ray, iv.t0, iv.t1, iso, span);
             if (hit) break;
             continue;
         }
         const std::int64_t n = segment_count(iv, ctx_.step);
-        double ta = iv.t0, ga = g(ta);
-        if (ga == 0.0) {
+        const auto [first, end] = owned_segments(iv, ctx_.step, n, span);
+        if (first >= end) continue;
+        double ta = segment(iv, ctx_.step, first, n).t0, ga = g(ta);
+        if (first == 0 && ga == 0.0) {
             hit = ta;
             break;
         }
-        for (std::int64_t k = 0; k < n && !hit && !cancel_polled(k); ++k) {
+        for (std::int64_t k = first; k < end && !hit && !cancel_polled(k); ++k) {
             const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
             hit = bracket_crossing(g, trilinear_, ray, ta, ga, tb, gb, iso, iv.length());
             ta = tb;
@@ -91,10 +111,16 @@ PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Inter
         }
         if (hit) break;
     }
+    if (hit) hit_state::save(*hit, ctx_.pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color, state);
+}
+
+void FirstHitIntegrator::merge_spans(RayState& front, const RayState& back) const { hit_state::merge(front, back); }
+
+PixelValue FirstHitIntegrator::finish(const Ray&, const std::vector<Interval>&, const RayState& state) const {
     PixelValue out;
-    if (hit) {
-        out.rgba = glm::dvec4(ctx_.pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color, 1.0);
-        out.depth = *hit;
+    if (hit_state::hit(state)) {
+        out.rgba = glm::dvec4(state.v[2], state.v[3], state.v[4], 1.0);
+        out.depth = state.v[1];
     }
     out.error = conventions::kRoundingErrorRelative * (1.0 + std::max({std::fabs(out.rgba.r), std::fabs(out.rgba.g),
                                                                        std::fabs(out.rgba.b), std::fabs(out.rgba.a)}));

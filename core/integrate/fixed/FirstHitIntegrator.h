@@ -30,6 +30,12 @@ public:
     PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
     bool writes_depth() const override { return true; }
     bool writes_error() const override { return adaptive_; }
+    // Resumable (march/RaySpan.h): the search over a span's brackets or pieces; a hit stops the ray.
+    bool resumable() const override { return true; }
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                        RayState& state) const override;
+    void merge_spans(RayState& front, const RayState& back) const override;
+    PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
 private:
     const VolumeSampler* trilinear_ = nullptr;  // Cartesian trilinear sampler, else null
@@ -42,7 +48,7 @@ private:
 // whose ends (evaluated by the sampler) have a zero or a sign change holds the first crossing, which
 // bisection narrows until no double lies between the bracket's ends. None: no crossing.
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
-                                           double iso);
+                                           double iso, const RaySpan& span = RaySpan{});
 // Its loop body: the first crossing inside one piece [ta, tb] between two grid planes (one cell), or
 // none (volref-mpi searches the pieces a rank owns; first_crossing_exact tests g(t0) = 0 first).
 std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const Ray& ray, double ta, double tb, double iso);

@@ -1,5 +1,7 @@
 #include "core/integrate/fixed/LineIntegralIntegrator.h"
 
+#include "core/integrate/march/SpanStates.h"
+
 #include <cmath>
 
 #include "core/integrate/march/CompensatedSum.h"
@@ -15,8 +17,22 @@ PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vec
     PixelValue out;
     if (intervals.empty()) return out;
     LineIntegral<CompensatedSum> acc;
-    auto result = [&] { return mean_ ? acc.mean() : ctx_.render.gain * acc.integral(); };
-    for_each_segment(intervals, ctx_.step, [&](const Segment& s) {
+    line(ray, intervals, RaySpan{}, acc, rec);
+    const double g = result(acc);
+    out.rgba = glm::dvec4(g, g, g, 1.0);
+    return out;
+}
+
+double LineIntegralIntegrator::result(const LineIntegral<CompensatedSum>& acc) const {
+    return mean_ ? acc.mean() : ctx_.render.gain * acc.integral();
+}
+
+// The one loop: the samples `span` owns added to `acc`.
+template <class Rec>
+void LineIntegralIntegrator::line(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                  LineIntegral<CompensatedSum>& acc, Rec& rec) const {
+    [[maybe_unused]] auto result = [&] { return this->result(acc); };
+    for_each_owned_segment(intervals, ctx_.step, span, [&](const Segment& s) {
         const double v = ctx_.field(ray, s.midpoint());
         const double coordinate = ctx_.pipeline.classifier().coordinate(v);
         acc.add(std::isfinite(coordinate) ? coordinate * s.length() : 0.0, s.length());  // non-finite: 0 (docs/accuracy.md)
@@ -32,7 +48,23 @@ PixelValue LineIntegralIntegrator::integrate_impl(const Ray& ray, const std::vec
         }
         return true;
     });
-    const double g = result();
+}
+
+// Resumable: the sums continue (line_state, march/SpanStates.h).
+void LineIntegralIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                            RayState& state) const {
+    LineIntegral<CompensatedSum> acc(line_state::integral(state), line_state::length(state));
+    NoRecording rec;
+    line(ray, intervals, span, acc, rec);
+    line_state::save(acc.integral_sum(), acc.length_sum(), 0.0, state);
+}
+
+void LineIntegralIntegrator::merge_spans(RayState& front, const RayState& back) const { line_state::merge(front, back); }
+
+PixelValue LineIntegralIntegrator::finish(const Ray&, const std::vector<Interval>& intervals, const RayState& state) const {
+    PixelValue out;
+    if (intervals.empty()) return out;
+    const double g = result(LineIntegral<CompensatedSum>(line_state::integral(state), line_state::length(state)));
     out.rgba = glm::dvec4(g, g, g, 1.0);
     return out;
 }

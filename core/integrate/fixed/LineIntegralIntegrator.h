@@ -7,6 +7,7 @@
 // A ray with no interval is (0, 0, 0, 0).
 #pragma once
 #include "core/integrate/Integrator.h"
+#include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SampleRecorder.h"
 
 namespace volref {
@@ -15,10 +16,21 @@ class LineIntegralIntegrator final : public OneLoopIntegrator<LineIntegralIntegr
 public:
     LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : OneLoopIntegrator(ctx), mean_(mean) {}
 
+    // Resumable (march/RaySpan.h): the two sums continue span after span.
+    bool resumable() const override { return true; }
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                        RayState& state) const override;
+    void merge_spans(RayState& front, const RayState& back) const override;
+    PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
+
 private:
     friend class OneLoopIntegrator<LineIntegralIntegrator>;
     template <class Rec>
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    template <class Rec>
+    void line(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, LineIntegral<CompensatedSum>& acc,
+              Rec& rec) const;
+    double result(const LineIntegral<CompensatedSum>& acc) const;
     bool mean_;
 };
 

@@ -157,6 +157,10 @@ public:
     }
     // The transmittance of what is composited so far (0 once a sample was opaque).
     V transmittance() const { return L::select(opaque_, L::splat(0.0), L::exp(L::neg(s_ + c_))); }
+    // Over: the optical depth of the partial samples so far, and the lanes that met an opaque one (a
+    // part handed to what lies in front: march/SpanStates.h).
+    V optical_depth() const { return s_ + c_; }
+    M opaque() const { return opaque_; }
 
     // Over: a sample in front of everything so far, on the lanes `visible` (see FrontToBack::add).
     void add(M visible, M solid, V tau, V alpha, const V c[3]) {

@@ -54,6 +54,10 @@ public:
         integral_.add(x);
         length_.add(length);
     }
+    LineIntegral() = default;
+    LineIntegral(const Sum& integral, const Sum& length) : integral_(integral), length_(length) {}
+    const Sum& integral_sum() const { return integral_; }
+    const Sum& length_sum() const { return length_; }
     double integral() const { return integral_.value(); }
     double length() const { return length_.value(); }
     double mean() const { return integral_.value() / length_.value(); }

@@ -9,6 +9,11 @@ namespace volref {
 
 class CompensatedSum {
 public:
+    CompensatedSum() = default;
+    // A sum handed over as its two parts (march/SpanStates.h): value() is s + c again, bit for bit.
+    CompensatedSum(double s, double c) : s_(s), c_(c) {}
+    double sum() const { return s_; }
+    double compensation() const { return c_; }
     void add(double x) { compensated_add<Scalar>(s_, c_, x, true); }
     double value() const { return s_ + c_; }
 

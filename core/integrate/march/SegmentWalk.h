@@ -26,6 +26,7 @@
 #include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/camera/Ray.h"
+#include "core/integrate/march/RaySpan.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/sample/MacrocellGrid.h"
 
@@ -66,15 +67,18 @@ std::int64_t last_in_run(std::int64_t in, std::int64_t out, InM&& in_m) {
 class ForwardSegmentWalk {
 public:
     ForwardSegmentWalk() = default;
-    ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step)
-        : grid_(grid), ray_(&ray), intervals_(&intervals), step_(step) {
-        if (!intervals.empty()) n_ = segment_count(intervals[0], step);
+    // `span` (march/RaySpan.h): only the segments whose midpoints it owns are visited, placed as on
+    // the whole ray.
+    ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step,
+                       const RaySpan& span = RaySpan{})
+        : grid_(grid), ray_(&ray), intervals_(&intervals), step_(step), span_(span) {
+        if (!intervals.empty()) enter();
     }
     // Extremum mode (see the header comment): `extremum` is the ray's running maximum (`maximum`) or
     // minimum, NaN until its first sample; the caller updates it between calls to next().
     ForwardSegmentWalk(const MacrocellGrid* grid, const Ray& ray, const std::vector<Interval>& intervals, double step,
-                       const double* extremum, bool maximum)
-        : ForwardSegmentWalk(grid, ray, intervals, step) {
+                       const double* extremum, bool maximum, const RaySpan& span = RaySpan{})
+        : ForwardSegmentWalk(grid, ray, intervals, step, span) {
         extremum_ = extremum;
         maximum_ = maximum;
     }
@@ -120,13 +124,12 @@ private:
         while (iv_ < intervals_->size()) {
             const Interval& iv = (*intervals_)[iv_];
             if (k_ < end_) return true;
-            if (k_ >= n_) {
-                if (++iv_ < intervals_->size()) n_ = segment_count((*intervals_)[iv_], step_);
-                k_ = end_ = 0;
+            if (k_ >= lim_) {
+                if (++iv_ < intervals_->size()) enter();
                 continue;
             }
             if (!grid_) {
-                end_ = n_;
+                end_ = lim_;
                 continue;
             }
             const MacrocellGrid::Index m = macrocell_of(*grid_, *ray_, iv, step_, k_, n_);
@@ -137,18 +140,18 @@ private:
             const std::int64_t r = skip && !extremum_ ? std::max<std::int64_t>(1, grid_->empty_radius(m)) : 1;
             // The estimate: segments k .. end - 1 have their midpoints before the ray leaves the box.
             const std::int64_t end =
-                std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m, r), n_), k_ + 1, n_);
+                std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m, r), n_), k_ + 1, lim_);
             if (!skip) {
                 // Composite: a run that is visited is at least kMinVisitedRun segments long (it may
                 // run on into empty macrocells, whose segments have opacity 0 and change nothing), so
                 // a ray that grazes many small non-empty runs pays fewer checks.
-                end_ = extremum_ ? end : std::max(end, std::min(n_, k_ + kMinVisitedRun));
+                end_ = extremum_ ? end : std::max(end, std::min(lim_, k_ + kMinVisitedRun));
                 if (extremum_) {
                     // Extremum mode backs off on rays where the checks keep failing (the ray's
                     // extremum is not yet beyond what the macrocells hold): after f failed checks in a
                     // row the run is stretched to 2^min(f, 3) times its length, so such a ray pays for
                     // one check per up to 8 macrocells. Visiting more segments never changes the result.
-                    end_ = std::min(n_, k_ + ((end - k_) << std::min(failed_checks_, 3)));
+                    end_ = std::min(lim_, k_ + ((end - k_) << std::min(failed_checks_, 3)));
                     ++failed_checks_;
                 }
                 continue;
@@ -171,6 +174,14 @@ private:
         return false;
     }
 
+    // The first segment and the end of the owned ones of interval iv_ (all of them for the whole ray).
+    void enter() {
+        n_ = segment_count((*intervals_)[iv_], step_);
+        const auto owned = owned_segments((*intervals_)[iv_], step_, n_, span_);
+        k_ = end_ = owned.first;
+        lim_ = owned.second;
+    }
+
     bool skippable(const MacrocellGrid::Index& m) const {
         if (!extremum_) return grid_->empty(m);
         const std::array<double, 2> b = grid_->value_bounds(m);
@@ -184,8 +195,10 @@ private:
     const Ray* ray_ = nullptr;
     const std::vector<Interval>* intervals_ = nullptr;
     double step_ = 1.0;
+    RaySpan span_;
     std::size_t iv_ = 0;
     std::int64_t k_ = 0, n_ = 0, end_ = 0;  // segments [k_, end_) are to be visited
+    std::int64_t lim_ = 0;                  // the end of the owned segments of interval iv_
     std::int64_t polled_ = 0;               // segments since cancellation was last polled
 };
 

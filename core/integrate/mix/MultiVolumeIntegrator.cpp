@@ -1,5 +1,7 @@
 #include "core/integrate/mix/MultiVolumeIntegrator.h"
 
+#include "core/integrate/march/SpanStates.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -183,6 +185,18 @@ PixelValue MultiVolumeIntegrator::adaptive_composite(const Ray* rays, const std:
 
 PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<Interval>* intervals) const {
     if (!adaptive_.empty()) return adaptive_composite(rays, intervals);
+    RayState state;
+    composite_span(rays, intervals, RaySpan{}, state);
+    PixelValue out;
+    out.rgba = composite_state::rgba(state);
+    return out;
+}
+
+// The one loop of the fixed mix, over the segments `span` owns of every piece: front to back resumes
+// FrontToBack's state; back to front puts the span's part behind it (composite_state, SpanStates.h).
+void MultiVolumeIntegrator::composite_span(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan& span,
+                                           RayState& state) const {
+    if (state.stopped != 0.0) return;
     const std::vector<Piece> ps = pieces(intervals, volumes_.size());
     MixScratch scratch;
     auto mix = [&](const std::vector<int>& present, const Segment& s) { return this->mix(rays, present, s, scratch); };
@@ -193,14 +207,15 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
         const double c[3] = {m.color.r, m.color.g, m.color.b};
         acc.add(true, m.opaque, m.tau, m.opaque ? 1.0 : segment_alpha<Scalar>(m.tau), c);
     };
-    PixelValue out;
     if (render_.order == CompositeOrder::FrontToBack) {
         const Termination stop = early_termination(render_);
         FrontToBack<Scalar> acc;
+        composite_state::load(acc, state);
         bool done = false;
         for (const Piece& p : ps) {
             const std::int64_t n = segment_count(p.span, step_);
-            for (std::int64_t k = 0; k < n && !done && !cancel_polled(k); ++k) {
+            const auto [first, end] = owned_segments(p.span, step_, n, span);
+            for (std::int64_t k = first; k < end && !done && !cancel_polled(k); ++k) {
                 const MixedSegment m = mix(p.present, segment(p.span, step_, k, n));
                 if (!m.opaque && !(m.tau > 0.0)) continue;
                 add(acc, m);
@@ -208,19 +223,27 @@ PixelValue MultiVolumeIntegrator::composite(const Ray* rays, const std::vector<I
             }
             if (done) break;
         }
-        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+        composite_state::save(acc, state);
+        state.stopped = done ? 1.0 : 0.0;
     } else {
         BackToFront<Scalar> acc;
         for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
             const std::int64_t n = segment_count(it->span, step_);
-            for (std::int64_t k = n - 1; k >= 0 && !cancel_polled(n - 1 - k); --k) {
+            const auto [first, end] = owned_segments(it->span, step_, n, span);
+            for (std::int64_t k = end - 1; k >= first && !cancel_polled(end - 1 - k); --k) {
                 const MixedSegment m = mix(it->present, segment(it->span, step_, k, n));
                 if (m.opaque || m.tau > 0.0) add(acc, m);
             }
         }
-        out.rgba = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+        RayState part;
+        composite_state::save_part(glm::dvec3(acc.color(0), acc.color(1), acc.color(2)), acc.optical_depth(), acc.opaque(),
+                                   part);
+        composite_state::merge(state, part);
     }
-    return out;
+}
+
+bool MultiVolumeIntegrator::composite_spans_in_order() const {
+    return render_.order == CompositeOrder::FrontToBack && render_.early_termination.has_value();
 }
 
 PixelValue MultiVolumeIntegrator::combine(const PixelValue* values, const std::vector<Interval>* intervals) const {

@@ -58,6 +58,11 @@ public:
 
     // Composite only: the mix along the ray; rays[k], intervals[k] are volume k's.
     PixelValue composite(const Ray* rays, const std::vector<Interval>* intervals) const;
+    // Composite with the fixed step, resumable (march/RaySpan.h): `state` (composite_state,
+    // SpanStates.h) continued over the mixed segments `span` owns; composite() is the whole ray's.
+    void composite_span(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan& span, RayState& state) const;
+    // True with early termination: the spans must then be resumed in ray order, not merged.
+    bool composite_spans_in_order() const;
     // Other projections: the volumes' own pixels values[k] (from their integrators) combined.
     PixelValue combine(const PixelValue* values, const std::vector<Interval>* intervals) const;
 

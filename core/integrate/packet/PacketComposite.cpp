@@ -8,6 +8,7 @@
 
 #include <type_traits>
 
+#include "core/Error.h"
 #include "core/integrate/packet/PacketComposite.h"
 #include "core/integrate/packet/PacketKernels-inl.h"
 
@@ -207,7 +208,7 @@ HWY_INLINE void shade(const PacketCompositeInputs& in, VT<T> m[3], const VT<T> g
 
 template <typename T>
 void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                     PixelValue* out, int count) {
+                     PixelValue* out, int count, const RaySpan* spans, RayState* states) {
     using D = DT<T>;
     using V = VT<T>;
     using M = MT<T>;
@@ -218,7 +219,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const double* local = kFast ? in.grid.origin : nullptr;
     const double zero_origin[3] = {0.0, 0.0, 0.0};
     const double* origin = kFast ? zero_origin : in.grid.origin;
-    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local);
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local, spans);
     const std::size_t L = packet.lanes;
     HWY_ALIGN T buf[RayPacketT<T>::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
@@ -247,6 +248,26 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const RegisterTable<T> opacity_reg(d, tab.opacity_x, tab.opacity_y, in.opacity_rows, 1);
     const RegisterTable<T> color_reg(d, tab.color_x, tab.color_y, in.color_rows, 3);
     const RegisterTable<T> gradient_reg(d, tab.gradient_opacity_x, tab.gradient_opacity_y, in.gradient_opacity_rows, 1);
+    // Resuming (march/SpanStates.h, composite_state): each lane's FrontToBack state in; a stopped ray
+    // takes no sample.
+    bool stopped[RayPacketT<T>::kLanes] = {};
+    constexpr int kState = FrontToBack<SL, kRule>::kStateValues;
+    if constexpr (!kFast) {
+        if (states) {
+            V init[kState];
+            for (int k = 0; k < kState; ++k) {
+                for (std::size_t l = 0; l < L; ++l) buf[l] = int(l) < count ? T(states[l].v[k]) : T(0);
+                init[k] = hn::Load(d, buf);
+            }
+            for (std::size_t l = 0; l < L; ++l) buf[l] = int(l) < count && states[l].v[8] != 0.0 ? T(1) : T(0);
+            acc.load(init, hn::Gt(hn::Load(d, buf), zero));
+            for (int l = 0; l < count && l < int(L); ++l)
+                if (states[l].stopped != 0.0) {
+                    stopped[l] = true;
+                    packet.retire(std::size_t(l));
+                }
+        }
+    }
 
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
@@ -285,8 +306,28 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             if (!hn::AllFalse(d, stop)) {
                 hn::Store(hn::IfThenElseZero(stop, one), d, buf);
                 for (std::size_t l = 0; l < L; ++l)
-                    if (buf[l] != T(0)) packet.retire(l);
+                    if (buf[l] != T(0)) {
+                        stopped[l] = true;
+                        packet.retire(l);
+                    }
             }
+        }
+    }
+    if constexpr (!kFast) {
+        if (states) {  // each lane's state out
+            V saved[kState];
+            M opaque;
+            acc.save(saved, opaque);
+            for (int k = 0; k < kState; ++k) {
+                hn::Store(saved[k], d, buf);
+                for (int l = 0; l < count && l < int(L); ++l) states[l].v[k] = double(buf[l]);
+            }
+            hn::Store(hn::IfThenElseZero(opaque, one), d, buf);
+            for (int l = 0; l < count && l < int(L); ++l) {
+                states[l].v[8] = buf[l] != T(0) ? 1.0 : 0.0;
+                states[l].stopped = stopped[l] ? 1.0 : 0.0;
+            }
+            return;
         }
     }
     const V A = acc.alpha();
@@ -303,18 +344,19 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
 
 template <typename T>
 void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                   PixelValue* out, int count) {
+                   PixelValue* out, int count, const RaySpan* spans, RayState* states) {
     const int L = int(hn::Lanes(DT<T>()));
     for (int first = 0; first < count; first += L)
-        composite_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first));
+        composite_lanes<T>(in, rays + first, intervals + first, out ? out + first : nullptr, std::min(L, count - first),
+                           spans ? spans + first : nullptr, states ? states + first : nullptr);
 }
 
 void CompositePacket(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                     PixelValue* out, int count) {
+                     PixelValue* out, int count, const RaySpan* spans, RayState* states) {
     if (in.fast)
-        composite_all<float>(in, rays, intervals, out, count);
+        composite_all<float>(in, rays, intervals, out, count, spans, states);
     else
-        composite_all<double>(in, rays, intervals, out, count);
+        composite_all<double>(in, rays, intervals, out, count, spans, states);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -326,8 +368,9 @@ namespace volref {
 HWY_EXPORT(CompositePacket);
 
 void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                      PixelValue* out, int count) {
-    HWY_DYNAMIC_DISPATCH(CompositePacket)(in, rays, intervals, out, count);
+                      PixelValue* out, int count, const RaySpan* spans, RayState* states) {
+    if (states && in.fast) throw Error("render.profile: the fast profile cannot be integrated in spans");
+    HWY_DYNAMIC_DISPATCH(CompositePacket)(in, rays, intervals, out, count, spans, states);
 }
 }  // namespace volref
 #endif

@@ -105,8 +105,10 @@ struct PacketCompositeInputs {
     Light lights[kMaxPacketLights];
 };
 
-// Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count).
+// Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count). With `states`
+// (the reference's double lanes only; march/RaySpan.h), instead resumes states[i] over the samples
+// spans[i] owns and writes nothing to `out`.
 void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                      PixelValue* out, int count);
+                      PixelValue* out, int count, const RaySpan* spans = nullptr, RayState* states = nullptr);
 
 }  // namespace volref

@@ -18,7 +18,7 @@ using namespace packet;
 
 template <typename T>
 void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                    RayExtremum* out, int count) {
+                    RayExtremum* out, int count, const RaySpan* spans) {
     using D = hn::ScalableTag<T>;
     using V = hn::Vec<D>;
     using M = hn::Mask<D>;
@@ -34,7 +34,7 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     const double zero_origin[3] = {0.0, 0.0, 0.0};
     const double* origin = kFast ? zero_origin : in.grid.origin;
     RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum,
-                         kFast ? in.grid.origin : nullptr);
+                         kFast ? in.grid.origin : nullptr, spans);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
     const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, origin, in.grid.inv_spacing);
@@ -59,20 +59,21 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
 
 template <typename T>
 void extremum_all(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                  RayExtremum* out, int count) {
+                  RayExtremum* out, int count, const RaySpan* spans) {
     const int L = int(hn::Lanes(hn::ScalableTag<T>()));
     for (int first = 0; first < count; first += L)
-        extremum_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first));
+        extremum_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first),
+                          spans ? spans + first : nullptr);
 }
 
 }  // namespace
 
 void ExtremumPacket(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                    RayExtremum* out, int count) {
+                    RayExtremum* out, int count, const RaySpan* spans) {
     if (in.fast)
-        extremum_all<float>(in, rays, intervals, out, count);
+        extremum_all<float>(in, rays, intervals, out, count, spans);
     else
-        extremum_all<double>(in, rays, intervals, out, count);
+        extremum_all<double>(in, rays, intervals, out, count, spans);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -84,8 +85,8 @@ namespace volref {
 HWY_EXPORT(ExtremumPacket);
 
 void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                     RayExtremum* out, int count) {
-    HWY_DYNAMIC_DISPATCH(ExtremumPacket)(in, rays, intervals, out, count);
+                     RayExtremum* out, int count, const RaySpan* spans) {
+    HWY_DYNAMIC_DISPATCH(ExtremumPacket)(in, rays, intervals, out, count, spans);
 }
 }  // namespace volref
 #endif

@@ -9,6 +9,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/grid/VoxelArray.h"
+#include "core/integrate/march/RaySpan.h"
 #include "core/integrate/packet/PacketGrid.h"
 #include "geometry/RayIntervals.h"
 
@@ -33,7 +34,8 @@ struct RayExtremum {
     double t = 0.0;        // the midpoint where it was first reached
 };
 
+// `spans` (march/RaySpan.h; null: the whole rays): each lane's extremum over the samples its span owns.
 void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
-                     RayExtremum* out, int count);
+                     RayExtremum* out, int count, const RaySpan* spans = nullptr);
 
 }  // namespace volref

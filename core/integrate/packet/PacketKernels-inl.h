@@ -106,7 +106,7 @@ struct RayPacketT {
     // kLanes values the caller keeps up to date (NaN before a lane's first sample).
     RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
                const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true,
-               const double* local_origin = nullptr) {
+               const double* local_origin = nullptr, const RaySpan* spans = nullptr) {
         lanes = hn::Lanes(hn::ScalableTag<T>());
         this->step = step;
         for (std::size_t l = 0; l < lanes; ++l) {
@@ -128,9 +128,10 @@ struct RayPacketT {
             dy[l] = T(r.direction.y);
             dz[l] = T(r.direction.z);
             active[l] = real;
+            const RaySpan span = spans && real ? spans[l] : RaySpan{};  // (march/RaySpan.h)
             if (real)
-                walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum)
-                                   : ForwardSegmentWalk(grid, rays[l], intervals[l], step);
+                walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span)
+                                   : ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
         }
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live

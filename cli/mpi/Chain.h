@@ -1,0 +1,24 @@
+// volref-mpi's composites whose parts cannot be merged afterwards, handed from rank to rank in ray
+// order instead (docs/conventions.md §14): the fixed step with early termination (Integrator::
+// spans_in_order: a span depends on the opacity in front of it), and render.integrator "adaptive"
+// (AdaptiveComposite's refinement depends on the transmittance in front, the largest colour seen and
+// the rules left; its error sums run back to front). Every rank lists the pixels whose ray it owns a
+// span of (the span's t0 is the key); the keys are all-gathered, giving each pixel's ranks in ray
+// order; in round j the j-th rank of each pixel continues that pixel's state over its span, and an
+// MPI_Allreduce hands the states on.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "cli/mpi/Frame.h"
+
+namespace volref::mpi {
+
+// The finished pixels (Frame::channels() doubles each, on every rank) and the bytes this rank handed to
+// the collectives; false after an error (reported by rank 0 through any_error; every rank returns false).
+bool chained_pixels(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes_handed);
+
+// Whether the scene's composite is chained (rather than merged from independent parts).
+bool chained(const Frame& frame);
+
+}  // namespace volref::mpi

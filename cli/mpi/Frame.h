@@ -1,0 +1,86 @@
+// What one volref-mpi rank builds for a frame (cli/mpi/main.cpp's set-up) and what its stages share:
+// the scene, this rank's brick of every volume with its pipeline and integrator, the camera, the
+// bounding geometry, and the per-pixel queries (rays, intervals, the span this rank owns) and per-slot
+// rules (how parts merge, what pixel they give). docs/architecture.md, "volref-mpi".
+#pragma once
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera/Camera.h"
+#include "core/integrate/march/RaySpan.h"
+#include "core/integrate/mix/MultiVolumeIntegrator.h"
+#include "core/render/PreparedVolume.h"
+#include "core/scene/Scene.h"
+#include "geometry/BoundingGeometry.h"
+#include "geometry/VolumeTransform.h"
+#include "cli/mpi/BrickReader.h"
+#include "cli/mpi/Bricks.h"
+
+namespace volref::mpi {
+
+// One volume of the scene on this rank: its whole grid, the voxels of its brick, its pipeline on them.
+struct Member {
+    GridBox grid;
+    VolumeLayout header;  // file sources
+    int ghost = 1;
+    std::array<std::int64_t, 3> vlo{0, 0, 0}, vhi{0, 0, 0};
+    Volume brick;
+    std::unique_ptr<PreparedVolume> prepared;
+    int geometry_id = 0;
+    std::optional<VolumeTransform> transform;  // its own space to world (`transform`), if any
+};
+
+// One pixel's part in a slot: the ray-order key (the t0 of the span it covers; +inf: this rank owns
+// none of the ray) and the RayState (march/RaySpan.h), kPart doubles.
+constexpr int kPart = 1 + RayState::kDoubles;
+constexpr double kNone = std::numeric_limits<double>::infinity();
+
+// Every rank's error (empty: none) to rank 0; returns true when some rank failed (rank 0 printed the
+// lowest failing rank's message as `volref: error: ...`). Every rank calls it at the same points.
+bool any_error(const std::string& mine, int rank, int size);
+
+struct Frame {
+    Scene scene;
+    std::vector<Member> members;
+    Lattice lattice;
+    std::vector<Brick> bricks;
+    int rank = 0, size = 1;
+    int threads = 0;
+    std::unique_ptr<Camera> camera;
+    BoundingGeometry geometry;
+    std::unique_ptr<MultiVolumeIntegrator> multi;  // several volumes
+
+    int width() const { return scene.image.width; }
+    int height() const { return scene.image.height; }
+    std::size_t pixels() const { return std::size_t(width()) * std::size_t(height()); }
+    std::size_t volumes() const { return members.size(); }
+    bool adaptive() const { return scene.render.integrator == IntegrationMethod::Adaptive; }
+    bool first_hit() const { return scene.render.projection == Projection::FirstHit; }
+    // Several volumes composite as one mixed medium (one slot); other projections keep one slot per
+    // volume, combined after the ranks' parts (MultiVolumeIntegrator::combine).
+    bool mixed() const { return volumes() > 1 && scene.render.projection == Projection::Composite; }
+    std::size_t slots() const { return volumes() > 1 && !mixed() ? volumes() : 1; }
+    // The image's channels: R G B A, Z (first hit), error (adaptive), as `volref render` writes them.
+    int channels() const { return 4 + (first_hit() ? 1 : 0) + (adaptive() ? 1 : 0); }
+
+    // Pixel (x, y)'s ray in every volume's own space (rays[k], the same t) and every volume's intervals
+    // (bounds AND domain and crop on the volume's ray, clip planes on the world ray: conventions §4).
+    void pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* intervals) const;
+    // The span of the ray this rank owns (`rays[0]`, the first volume's ray: the lattice's space);
+    // empty ([+inf, +inf)) when the ray misses the brick's box (padded: every sample a rank owns lies in it).
+    RaySpan span(const Ray& lattice_ray) const;
+    glm::dvec3 brick_lo{0.0}, brick_hi{0.0};  // this rank's brick's box in the first volume's space, padded
+    // Slot `slot`'s rule: `back` (a part behind) merged into `front`, and the pixel of a finished state.
+    void merge(std::size_t slot, RayState& front, const RayState& back) const;
+    PixelValue finish(std::size_t slot, const Ray* rays, const std::vector<Interval>* intervals,
+                      const RayState& state) const;
+    // A pixel from its slots' finished values (several volumes: combined), as R G B A [Z] [error].
+    void write_pixel(const PixelValue* values, const std::vector<Interval>* intervals, double* out) const;
+};
+
+}  // namespace volref::mpi

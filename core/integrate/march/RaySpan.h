@@ -1,0 +1,77 @@
+// Resumable integration (issue 30): a ray integrated in parts, each part a span of the ray with the
+// accumulator's state handed in and out. volref-mpi's ranks each own the span of a ray inside their
+// brick (cli/mpi/); the single-process render integrates the whole ray as one span.
+//
+//   span      [t0, t1): the samples it owns are those whose position t (a segment's midpoint,
+//             SamplePlacement.h) satisfies t0 <= t < t1; the whole ray is [-inf, +inf). The
+//             placement is the whole ray's: a span never moves a sample, it only selects samples.
+//   state     the accumulator after the spans integrated so far, in RayState's kValues doubles; the
+//             layout is the integrator's (composite: FrontToBack's state, see composite_state below).
+//   resume    Integrator::integrate_span(ray, intervals, span, state) continues `state` over the
+//             span's samples, front to back, exactly as the whole-ray loop would at those samples: a
+//             ray cut into spans and integrated span after span gives the whole-ray pixel bit for bit.
+//   merge     Integrator::merge_spans(front, back): `back` integrated from a fresh state over a span
+//             behind `front`'s; for independent parts (no early termination), equal to resuming up to
+//             rounding (composite: C = C_f + exp(-tau_f) C_b, tau = tau_f + tau_b).
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "core/integrate/march/SamplePlacement.h"
+
+namespace volref {
+
+struct RaySpan {
+    double t0 = -std::numeric_limits<double>::infinity();
+    double t1 = std::numeric_limits<double>::infinity();
+    bool whole() const { return t0 == -std::numeric_limits<double>::infinity() && t1 == std::numeric_limits<double>::infinity(); }
+    bool owns(double t) const { return t0 <= t && t < t1; }
+};
+
+// The segments [first, end) of interval `iv` (n segments at `step`) whose midpoints `span` owns: the
+// midpoints increase with k (a + b with a = t0 + k h, b = t0 + (k + 1) h or t1, each monotone in k in
+// floating point), so they are one run, found by bisection on k.
+inline std::pair<std::int64_t, std::int64_t> owned_segments(const Interval& iv, double step, std::int64_t n,
+                                                             const RaySpan& span) {
+    if (span.whole()) return {0, n};
+    // The first k in [0, n] whose midpoint is >= t (n: none).
+    auto first_at_or_after = [&](double t) {
+        std::int64_t lo = 0, hi = n;
+        while (lo < hi) {
+            const std::int64_t mid = lo + (hi - lo) / 2;
+            if (segment(iv, step, mid, n).midpoint() >= t) hi = mid;
+            else lo = mid + 1;
+        }
+        return lo;
+    };
+    const std::int64_t first = first_at_or_after(span.t0);
+    return {first, std::max(first, first_at_or_after(span.t1))};
+}
+
+// Calls fn(segment) front to back over the segments `span` owns of every interval; fn returns false to
+// stop early (for_each_segment, SamplePlacement.h, restricted to the span).
+template <typename Fn>
+void for_each_owned_segment(const std::vector<Interval>& intervals, double step, const RaySpan& span, Fn&& fn) {
+    for (const Interval& iv : intervals) {
+        const std::int64_t n = segment_count(iv, step);
+        const auto [first, end] = owned_segments(iv, step, n, span);
+        for (std::int64_t k = first; k < end; ++k)
+            if (!fn(segment(iv, step, k, n))) return;
+    }
+}
+
+// A ray's integration state between spans: kValues doubles in the integrator's own layout, and
+// whether the ray has ended (opaque, terminated early, hit): later spans change nothing then.
+// Plain doubles, so that volref-mpi sends states as MPI_DOUBLE arrays (kDoubles per ray).
+struct RayState {
+    static constexpr int kValues = 10;
+    static constexpr int kDoubles = kValues + 1;
+    double stopped = 0.0;  // 1: the ray has ended
+    double v[kValues] = {};
+};
+static_assert(sizeof(RayState) == RayState::kDoubles * sizeof(double));
+
+}  // namespace volref

@@ -172,7 +172,8 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     bool ok = hand_on(frame, order, S, state, false, [&](std::size_t px, const std::vector<Ray>& rays,
                                                           const std::vector<std::vector<Interval>>& intervals, double* s) {
         if (V == 1) {
-            Composite st(AdaptiveIntegrator::OneVolume{one, &rays[0]}, tolerance, safety, total[px]);
+            const AdaptiveIntegrator::OneVolume medium{one, &rays[0]};  // (AdaptiveComposite keeps a reference)
+            Composite st(medium, tolerance, safety, total[px]);
             st.load(s);
             for (const auto& piece : pieces[px]) {
                 if (st.is_opaque()) break;

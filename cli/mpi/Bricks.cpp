@@ -163,17 +163,42 @@ double from_ordered(std::int64_t k) {
     return std::bit_cast<double>(k < 0 ? std::numeric_limits<std::int64_t>::min() - k : k);
 }
 
-// The smallest t in [lo, hi] with pred(t) for a predicate false then true on the doubles; hi's
-// successor when none.
+// The smallest t in [lo, hi] with pred(t) for a predicate false then true on the doubles (hi's
+// successor when none), searched from `guess`: galloping away from it in doubles (1, 2, 4, ... apart)
+// until the predicate changes, then bisection between the last two points.
 template <class Pred>
-double first_true(Pred&& pred, double lo, double hi) {
-    std::int64_t a = ordered(lo), b = ordered(hi);
+double first_true(Pred&& pred, double lo, double hi, double guess) {
     if (!pred(hi)) return std::nextafter(hi, std::numeric_limits<double>::infinity());
-    while (a < b) {  // pred(from_ordered(b)) holds; the answer is in [a, b]
-        // (b - a can exceed the int64 range: halved as unsigned.)
-        const std::int64_t mid = a + std::int64_t((std::uint64_t(b) - std::uint64_t(a)) / 2);
-        if (pred(from_ordered(mid))) b = mid;
-        else a = mid + 1;
+    if (pred(lo)) return lo;
+    // Invariant: pred(from_ordered(a)) is false, pred(from_ordered(b)) is true.
+    std::int64_t a = ordered(lo), b = ordered(hi);
+    // b - a as unsigned (it can exceed the int64 range).
+    auto gap = [&] { return std::uint64_t(b) - std::uint64_t(a); };
+    const std::int64_t g = std::isfinite(guess) ? std::clamp(ordered(guess), a, b) : a;
+    if (pred(from_ordered(g))) {
+        b = g;
+        for (std::uint64_t d = 1; gap() > 1 && d != 0; d *= 2) {  // down from g
+            const std::int64_t c = gap() > d ? b - std::int64_t(d) : a;
+            if (c == a || !pred(from_ordered(c))) {
+                a = c;
+                break;
+            }
+            b = c;
+        }
+    } else {
+        a = g;
+        for (std::uint64_t d = 1; gap() > 1 && d != 0; d *= 2) {  // up from g
+            const std::int64_t c = gap() > d ? a + std::int64_t(d) : b;
+            if (c == b || pred(from_ordered(c))) {
+                b = c;
+                break;
+            }
+            a = c;
+        }
+    }
+    while (gap() > 1) {
+        const std::int64_t mid = a + std::int64_t(gap() / 2);
+        (pred(from_ordered(mid)) ? b : a) = mid;
     }
     return from_ordered(b);
 }
@@ -185,25 +210,30 @@ RaySpan owned_span(const Brick& b, const Lattice& lattice, const GridBox& first,
     constexpr double kInf = std::numeric_limits<double>::infinity();
     double t0 = -kFar, t_last = kFar;  // the owned t: [t0, t_last]
     auto u = [&](int a, double t) { return (ray.at(t)[a] - first.origin[a]) / first.spacing[a]; };
+    // Where the ray meets the plane u_a = plane (the search's first guess).
+    auto guess = [&](int a, double plane) {
+        return (first.origin[a] + plane * first.spacing[a] - ray.origin[a]) / ray.direction[a];
+    };
     for (int a = 0; a < 3; ++a) {
         const bool lower = b.lo[a] > lattice.lo[a], upper = b.hi[a] < lattice.hi[a];
         const double lo = double(b.lo[a]), hi = double(b.hi[a]);
         auto inside_lower = [&](double t) { return u(a, t) >= lo; };
         auto inside_upper = [&](double t) { return u(a, t) < hi; };
+        auto outside_lower = [&](double t) { return !inside_lower(t); };
+        auto outside_upper = [&](double t) { return !inside_upper(t); };
         if (ray.direction[a] == 0.0) {  // the index does not change along the ray
             if ((lower && !inside_lower(0.0)) || (upper && !inside_upper(0.0))) return RaySpan{kInf, kInf};
             continue;
         }
+        // u >= lo holds from a first t on (u increasing along the ray) or up to a last one; u < hi the
+        // other way round. The last t where a predicate holds is the one before it first fails.
         const bool increasing = ray.direction[a] > 0.0;
-        // u >= lo: from a first t on (u increasing) or up to a last one; u < hi the other way round.
-        if (lower) {
-            if (increasing) t0 = std::max(t0, first_true(inside_lower, -kFar, kFar));
-            else t_last = std::min(t_last, std::nextafter(first_true([&](double t) { return !inside_lower(t); }, -kFar, kFar), -kInf));
-        }
-        if (upper) {
-            if (increasing) t_last = std::min(t_last, std::nextafter(first_true([&](double t) { return !inside_upper(t); }, -kFar, kFar), -kInf));
-            else t0 = std::max(t0, first_true(inside_upper, -kFar, kFar));
-        }
+        if (lower && increasing) t0 = std::max(t0, first_true(inside_lower, -kFar, kFar, guess(a, lo)));
+        if (lower && !increasing)
+            t_last = std::min(t_last, std::nextafter(first_true(outside_lower, -kFar, kFar, guess(a, lo)), -kInf));
+        if (upper && increasing)
+            t_last = std::min(t_last, std::nextafter(first_true(outside_upper, -kFar, kFar, guess(a, hi)), -kInf));
+        if (upper && !increasing) t0 = std::max(t0, first_true(inside_upper, -kFar, kFar, guess(a, hi)));
     }
     if (!(t0 <= t_last)) return RaySpan{kInf, kInf};
     return RaySpan{t0 == -kFar ? -kInf : t0, t_last == kFar ? kInf : std::nextafter(t_last, kInf)};

@@ -37,14 +37,16 @@ bool any_error(const std::string& mine, int rank, int size) {
 
 void Frame::pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* intervals) const {
     const Ray world = camera->pixel_ray(x, y);
-    for (std::size_t k = 0; k < volumes(); ++k) {
-        const VolumeSpec& vs = scene.volumes[k];
-        rays[k] = members[k].transform ? members[k].transform->local_ray(world) : world;
-        const Ray local = rays[k];
-        intervals[k].clear();
-        geometry.intervals(&rays[k], 1, members[k].geometry_id, &intervals[k]);
-        if (vs.crop) crop_intervals(local, *vs.crop, intervals[k]);
-        if (!vs.clip_planes.empty()) clip_intervals(world, vs.clip_planes, intervals[k]);
+    for (std::size_t k = 0; k < volumes(); ++k) volume_intervals(k, &world, 1, &rays[k], &intervals[k]);
+}
+
+void Frame::volume_intervals(std::size_t k, const Ray* world, int count, Ray* local, std::vector<Interval>* out) const {
+    const VolumeSpec& vs = scene.volumes[k];
+    for (int i = 0; i < count; ++i) local[i] = members[k].transform ? members[k].transform->local_ray(world[i]) : world[i];
+    geometry.intervals(local, count, members[k].geometry_id, out);
+    for (int i = 0; i < count; ++i) {
+        if (vs.crop) crop_intervals(local[i], *vs.crop, out[i]);
+        if (!vs.clip_planes.empty()) clip_intervals(world[i], vs.clip_planes, out[i]);
     }
 }
 

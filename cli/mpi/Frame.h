@@ -71,6 +71,8 @@ struct Frame {
     // Pixel (x, y)'s ray in every volume's own space (rays[k], the same t) and every volume's intervals
     // (bounds AND domain and crop on the volume's ray, clip planes on the world ray: conventions §4).
     void pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* intervals) const;
+    // Volume k's rays and intervals of `count` world rays (<= kMaxPacketRays; Embree packets).
+    void volume_intervals(std::size_t k, const Ray* world, int count, Ray* local, std::vector<Interval>* out) const;
     // The span of the ray this rank owns (`rays[0]`, the first volume's ray: the lattice's space);
     // empty ([+inf, +inf)) when the ray misses the brick's box (padded: every sample a rank owns lies in it).
     RaySpan span(const Ray& lattice_ray) const;

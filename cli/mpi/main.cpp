@@ -235,55 +235,68 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
         p[0] = key;
         std::memcpy(p + 1, &st, sizeof st);
     };
+    // Several volumes: one pixel at a time (the mix, or each volume's own integrator).
+    auto one_pixel = [&](int x, int y, std::vector<Ray>& rays, std::vector<std::vector<Interval>>& intervals) {
+        const std::size_t px = std::size_t(y) * W + std::size_t(x);
+        f.pixel_intervals(x, y, rays.data(), intervals.data());
+        const RaySpan span = f.span(rays[0]);
+        if (!(span.t0 < span.t1)) return;
+        RayState st;
+        if (f.mixed()) {
+            f.multi->composite_span(rays.data(), intervals.data(), span, st);
+            return store(px, 0, span.t0, st);
+        }
+        for (std::size_t k = 0; k < V; ++k) {
+            if (intervals[k].empty()) continue;
+            st = RayState{};
+            f.members[k].prepared->integrator->integrate_span(rays[k], intervals[k], span, st);
+            store(px, k, span.t0, st);
+        }
+    };
+    // Blocks of kBlock x kBlock pixels (one packet for one volume: `volref render`'s blocks), rows of
+    // blocks in parallel.
+    constexpr int kBlock = 4;
+    static_assert(kBlock * kBlock == kMaxPacketRays);
     tbb::task_arena arena(f.threads > 0 ? f.threads : tbb::task_arena::automatic);
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, f.height()), [&](const tbb::blocked_range<int>& rows) {
-            // One volume: the row's rays with a span, kMaxPacketRays at a time.
-            Ray rays[kMaxPacketRays];
+        tbb::parallel_for(tbb::blocked_range<int>(0, (f.height() + kBlock - 1) / kBlock), [&](const tbb::blocked_range<int>& rows) {
+            Ray world[kMaxPacketRays], rays[kMaxPacketRays];
             std::vector<Interval> intervals[kMaxPacketRays];
             RaySpan spans[kMaxPacketRays];
             RayState states[kMaxPacketRays];
             std::size_t at[kMaxPacketRays];
-            int count = 0;
-            auto flush = [&] {
-                if (first.packets) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
-                else
-                    for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);
-                for (int i = 0; i < count; ++i) store(at[i], 0, spans[i].t0, states[i]);
-                count = 0;
-            };
             std::vector<Ray> vrays(V);
             std::vector<std::vector<Interval>> vintervals(V);
-            for (int y = rows.begin(); y != rows.end(); ++y) {
-                for (std::size_t x = 0; x < W; ++x) {
-                    const std::size_t px = std::size_t(y) * W + x;
-                    if (V == 1) {
-                        f.pixel_intervals(int(x), y, &rays[count], &intervals[count]);
-                        spans[count] = f.span(rays[count]);
-                        if (intervals[count].empty() || !(spans[count].t0 < spans[count].t1)) continue;
+            for (int by = rows.begin() * kBlock; by < std::min(rows.end() * kBlock, f.height()); by += kBlock)
+                for (int bx = 0; bx < f.width(); bx += kBlock) {
+                    int n = 0;
+                    for (int y = by; y < std::min(by + kBlock, f.height()); ++y)
+                        for (int x = bx; x < std::min(bx + kBlock, f.width()); ++x) {
+                            if (V > 1) {
+                                one_pixel(x, y, vrays, vintervals);
+                                continue;
+                            }
+                            world[n] = f.camera->pixel_ray(x, y);
+                            at[n++] = std::size_t(y) * W + std::size_t(x);
+                        }
+                    if (n == 0) continue;
+                    f.volume_intervals(0, world, n, rays, intervals);
+                    int count = 0;  // the rays with a span, moved to the front
+                    for (int i = 0; i < n; ++i) {
+                        const RaySpan span = f.span(rays[i]);
+                        if (intervals[i].empty() || !(span.t0 < span.t1)) continue;
+                        std::swap(intervals[count], intervals[i]);
+                        rays[count] = rays[i];
+                        spans[count] = span;
                         states[count] = RayState{};
-                        at[count] = px;
-                        if (++count == kMaxPacketRays) flush();
-                        continue;
+                        at[count++] = at[i];
                     }
-                    f.pixel_intervals(int(x), y, vrays.data(), vintervals.data());
-                    const RaySpan span = f.span(vrays[0]);
-                    if (!(span.t0 < span.t1)) continue;
-                    if (f.mixed()) {
-                        RayState st;
-                        f.multi->composite_span(vrays.data(), vintervals.data(), span, st);
-                        store(px, 0, span.t0, st);
-                        continue;
-                    }
-                    for (std::size_t k = 0; k < V; ++k) {
-                        if (vintervals[k].empty()) continue;
-                        RayState st;
-                        f.members[k].prepared->integrator->integrate_span(vrays[k], vintervals[k], span, st);
-                        store(px, k, span.t0, st);
-                    }
+                    if (count == 0) continue;
+                    if (first.packets) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
+                    else
+                        for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);
+                    for (int i = 0; i < count; ++i) store(at[i], 0, spans[i].t0, states[i]);
                 }
-                if (count > 0) flush();
-            }
         });
     });
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cstring>
 #include <new>
 
@@ -18,43 +19,59 @@ namespace volref::mpi {
 
 namespace {
 
-// Each pixel's ranks in ray order: this rank's place among them (-1: none) and how many there are.
+// Each pixel's ranks in ray order (by their spans' keys, then rank): this rank's place among them
+// (-1: none), how many there are, and the ranks just in front of and behind this one (-1: none).
 struct RankOrder {
-    std::vector<int> position, count;
+    std::vector<int> position, count, front, behind;
 };
 RankOrder rank_order(const Frame& frame, const std::vector<double>& key) {
     const std::size_t P = frame.pixels();
     std::vector<double> keys(P * std::size_t(frame.size));
     MPI_Allgather(key.data(), int(P), MPI_DOUBLE, keys.data(), int(P), MPI_DOUBLE, MPI_COMM_WORLD);
-    RankOrder o{std::vector<int>(P, -1), std::vector<int>(P, 0)};
+    RankOrder o{std::vector<int>(P, -1), std::vector<int>(P, 0), std::vector<int>(P, -1), std::vector<int>(P, -1)};
     for (std::size_t px = 0; px < P; ++px) {
+        const double mine = key[px];
+        double front_key = -kNone, behind_key = kNone;
         for (int r = 0; r < frame.size; ++r) {
             const double k = keys[std::size_t(r) * P + px];
             if (k == kNone) continue;
             ++o.count[px];
-            if (key[px] != kNone && (k < key[px] || (k == key[px] && r < frame.rank))) ++o.position[px];
+            if (mine == kNone || r == frame.rank) continue;
+            const bool in_front = k < mine || (k == mine && r < frame.rank);
+            if (in_front) {
+                ++o.position[px];
+                if (k > front_key || (k == front_key && r > o.front[px])) front_key = k, o.front[px] = r;
+            } else if (k < behind_key || (k == behind_key && r < o.behind[px])) {
+                behind_key = k, o.behind[px] = r;
+            }
         }
-        if (key[px] != kNone) ++o.position[px];  // from -1: the ranks in front of this one
+        if (mine != kNone) ++o.position[px];  // from -1: the ranks in front of this one
     }
     return o;
 }
 
-// f(px, rays, intervals) for every pixel (round < 0) or this rank's pixels of `round`, in parallel;
-// returns the error message of an exception (empty: none).
+// Pixel px's rays and intervals in every volume, for the steps that sample (scratch of one thread).
+struct PixelRays {
+    std::vector<Ray> rays;
+    std::vector<std::vector<Interval>> intervals;
+    explicit PixelRays(std::size_t volumes) : rays(volumes), intervals(volumes) {}
+    void of(const Frame& frame, std::size_t px) {
+        const std::size_t W = std::size_t(frame.width());
+        frame.pixel_intervals(int(px % W), int(px / W), rays.data(), intervals.data());
+    }
+};
+
+// f(px, scratch) for the pixels `list` (all of them when null), in parallel; the error message of an
+// exception (empty: none).
 template <class F>
-std::string each_pixel(const Frame& frame, const RankOrder* order, int round, F&& f) {
+std::string each_pixel(const Frame& frame, const std::vector<std::size_t>* list, F&& f) {
     try {
         tbb::task_arena arena(frame.threads > 0 ? frame.threads : tbb::task_arena::automatic);
+        const std::size_t n = list ? list->size() : frame.pixels();
         arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frame.pixels()), [&](const tbb::blocked_range<std::size_t>& r) {
-                std::vector<std::vector<Interval>> intervals(frame.volumes());
-                std::vector<Ray> rays(frame.volumes());
-                const std::size_t W = std::size_t(frame.width());
-                for (std::size_t px = r.begin(); px != r.end(); ++px) {
-                    if (round >= 0 && order->position[px] != round) continue;
-                    frame.pixel_intervals(int(px % W), int(px / W), rays.data(), intervals.data());
-                    f(px, rays, intervals);
-                }
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+                PixelRays scratch(frame.volumes());
+                for (std::size_t i = r.begin(); i != r.end(); ++i) f(list ? (*list)[i] : i, scratch);
             });
         });
     } catch (const std::bad_alloc&) {
@@ -65,58 +82,129 @@ std::string each_pixel(const Frame& frame, const RankOrder* order, int round, F&
     return {};
 }
 
-// The state (S doubles a pixel) handed on: in round j (front to back, or from the last rank with
-// `reverse`) each pixel's j-th rank runs step(px, rays, intervals, in_out); one rank wrote each pixel,
-// so the MPI_Allreduce sum of the rounds' writes is the next state. False after an error (reported).
+// Pixels per block of the pipeline below.
+constexpr std::size_t kChainBlock = 256;
+
+// The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
+// kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
+// takes its round-j pixels' states from the ranks in front of it (blocking receives, in the order they
+// were sent), runs step(px, scratch, state) on them, and sends them on to the ranks behind
+// (non-blocking). Every rank goes through the units (j, b) in the same order and a unit only waits for
+// (j - 1, b), which its sender did earlier in that order: no deadlock, and a rank waits only where it
+// overtakes the rank in front of it on the same block (no barrier per round, no image-wide reduction).
+// On return each pixel's state is final on its last rank. An error aborts every rank (MPI_Abort: the
+// ranks behind would wait for its states).
 template <class Step>
-bool hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vector<double>& state, bool reverse, Step&& step) {
+void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vector<double>& state, bool reverse,
+             std::size_t& bytes, Step&& step) {
     const std::size_t P = frame.pixels();
-    std::vector<double> delta(P * S), next(P * S);
-    for (int i = 0; i < frame.size; ++i) {
-        const int j = reverse ? frame.size - 1 - i : i;
-        std::fill(delta.begin(), delta.end(), 0.0);
-        const std::string err = each_pixel(frame, &order, j, [&](std::size_t px, const std::vector<Ray>& rays,
-                                                                  const std::vector<std::vector<Interval>>& intervals) {
-            std::copy(&state[px * S], &state[px * S] + S, &delta[px * S]);
-            step(px, rays, intervals, &delta[px * S]);
-        });
-        if (any_error(err, frame.rank, frame.size)) return false;
-        MPI_Allreduce(delta.data(), next.data(), int(P * S), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-        for (std::size_t px = 0; px < P; ++px)
-            if (order.count[px] > j) std::copy(&next[px * S], &next[px * S] + S, &state[px * S]);
+    auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
+    const std::vector<int>& from = reverse ? order.behind : order.front;
+    const std::vector<int>& to = reverse ? order.front : order.behind;
+    std::vector<std::vector<double>> outbox;
+    std::vector<MPI_Request> requests;
+    std::string err;
+    std::vector<std::size_t> mine;
+    std::vector<double> buffer;
+    for (int j = 0; j < frame.size && err.empty(); ++j) {
+        for (std::size_t b0 = 0; b0 < P && err.empty(); b0 += kChainBlock) {
+            const std::size_t b1 = std::min(P, b0 + kChainBlock);
+            mine.clear();
+            for (std::size_t px = b0; px < b1; ++px)
+                if (order.position[px] >= 0 && round_of(px) == j) mine.push_back(px);
+            if (mine.empty()) continue;
+            // In: from each rank in front, its pixels in pixel order (as it sent them).
+            for (int r = 0; r < frame.size && j > 0; ++r) {
+                std::size_t n = 0;
+                for (std::size_t px : mine) n += from[px] == r ? 1 : 0;
+                if (n == 0) continue;
+                buffer.resize(n * S);
+                MPI_Recv(buffer.data(), int(n * S), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                std::size_t i = 0;
+                for (std::size_t px : mine)
+                    if (from[px] == r) std::copy(&buffer[i * S], &buffer[i * S] + S, &state[px * S]), ++i;
+            }
+            err = each_pixel(frame, &mine, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
+            // Out: to each rank behind, in pixel order.
+            for (int r = 0; r < frame.size && err.empty(); ++r) {
+                std::vector<double> out;
+                for (std::size_t px : mine)
+                    if (to[px] == r) out.insert(out.end(), &state[px * S], &state[px * S] + S);
+                if (out.empty()) continue;
+                bytes += out.size() * sizeof(double);
+                outbox.push_back(std::move(out));
+                requests.emplace_back();
+                MPI_Isend(outbox.back().data(), int(outbox.back().size()), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, &requests.back());
+            }
+            // (Progress: a large send moves only while its sender is inside MPI.)
+            int flag = 0;
+            if (!requests.empty()) MPI_Testall(int(requests.size()), requests.data(), &flag, MPI_STATUSES_IGNORE);
+        }
     }
-    return true;
+    // (An error stops this rank's pipeline; the ranks behind it may then wait for its states: abort.)
+    if (!err.empty()) {
+        std::fprintf(stderr, "volref: error: %s\n", err.c_str());
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+}
+
+// The final states (on each pixel's last rank, or first with `first`) summed onto rank 0; zero elsewhere.
+std::vector<double> collect(const Frame& frame, const RankOrder& order, std::size_t S, const std::vector<double>& state,
+                            bool first, std::size_t& bytes) {
+    const std::size_t P = frame.pixels();
+    std::vector<double> mine(P * S, 0.0), all(frame.rank == 0 ? P * S : 0);
+    for (std::size_t px = 0; px < P; ++px) {
+        const bool holds = order.position[px] >= 0 && order.position[px] == (first ? 0 : order.count[px] - 1);
+        if (holds) std::copy(&state[px * S], &state[px * S] + S, &mine[px * S]);
+    }
+    MPI_Reduce(mine.data(), all.data(), int(P * S), MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    bytes += mine.size() * sizeof(double);
+    return all;
+}
+
+// The keys of the pixels whose ray this rank owns a span of (kNone elsewhere): its span's t0, where
+// has(px, span, scratch) says the span holds something to integrate.
+template <class Has>
+bool span_keys(const Frame& frame, std::vector<double>& key, Has&& has) {
+    key.assign(frame.pixels(), kNone);
+    const std::string err = each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
+        scratch.of(frame, px);
+        const RaySpan span = frame.span(scratch.rays[0]);
+        if (span.t0 < span.t1 && has(px, span, scratch)) key[px] = span.t0;
+    });
+    return !any_error(err, frame.rank, frame.size);
 }
 
 // The fixed step with early termination: RayState resumed span after span (the volume's integrator,
-// or the several-volume mix); pixels R G B A.
+// or the several-volume mix); pixels R G B A on rank 0.
 bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes) {
     const std::size_t P = frame.pixels(), S = RayState::kDoubles;
-    std::vector<double> key(P, kNone);
-    std::string err = each_pixel(frame, nullptr, -1, [&](std::size_t px, const std::vector<Ray>& rays,
-                                                         const std::vector<std::vector<Interval>>& intervals) {
-        const RaySpan span = frame.span(rays[0]);
-        bool any = false;
-        for (const auto& iv : intervals) any = any || !iv.empty();
-        if (any && span.t0 < span.t1) key[px] = span.t0;
-    });
-    if (any_error(err, frame.rank, frame.size)) return false;
-    const RankOrder order = rank_order(frame, key);
-    std::vector<double> state(P * S, 0.0);  // fresh states (all zero)
-    const bool ok = hand_on(frame, order, S, state, false, [&](std::size_t, const std::vector<Ray>& rays,
-                                                                const std::vector<std::vector<Interval>>& intervals, double* s) {
-        RayState st;
-        std::memcpy(&st, s, sizeof st);
-        if (frame.mixed()) frame.multi->composite_span(rays.data(), intervals.data(), frame.span(rays[0]), st);
-        else frame.members[0].prepared->integrator->integrate_span(rays[0], intervals[0], frame.span(rays[0]), st);
-        std::memcpy(s, &st, sizeof st);
+    std::vector<double> key;
+    const bool ok = span_keys(frame, key, [&](std::size_t, const RaySpan&, const PixelRays& scratch) {
+        for (const auto& iv : scratch.intervals)
+            if (!iv.empty()) return true;
+        return false;
     });
     if (!ok) return false;
-    bytes = P * sizeof(double) * (1 + std::size_t(frame.size) * S);
+    const RankOrder order = rank_order(frame, key);
+    bytes = P * sizeof(double) * std::size_t(frame.size);
+    std::vector<double> state(P * S, 0.0);  // fresh states (all zero)
+    hand_on(frame, order, S, state, false, bytes, [&](std::size_t px, PixelRays& scratch, double* s) {
+        scratch.of(frame, px);
+        RayState st;
+        std::memcpy(&st, s, sizeof st);
+        const RaySpan span = frame.span(scratch.rays[0]);
+        if (frame.mixed()) frame.multi->composite_span(scratch.rays.data(), scratch.intervals.data(), span, st);
+        else frame.members[0].prepared->integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
+        std::memcpy(s, &st, sizeof st);
+    });
+    const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
+    if (frame.rank != 0) return true;
     pixels.assign(P * 4, 0.0);
     for (std::size_t px = 0; px < P; ++px) {
         RayState st;
-        std::memcpy(&st, &state[px * S], sizeof st);
+        std::memcpy(&st, &final_state[px * S], sizeof st);
         const glm::dvec4 rgba = composite_state::rgba(st);
         for (int c = 0; c < 4; ++c) pixels[px * 4 + std::size_t(c)] = rgba[c];
     }
@@ -126,7 +214,7 @@ bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& b
 // render.integrator "adaptive": the pieces cut as the single process cuts them (AdaptiveIntegrator::
 // composite, MultiVolumeIntegrator::adaptive_composite), a piece belonging to the rank whose span
 // holds its midpoint; AdaptiveComposite's state front to back, then the error's sums back to front;
-// pixels R G B A error.
+// pixels R G B A error on rank 0.
 bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes) {
     using Composite = AdaptiveIntegrator::Composite;
     using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
@@ -136,32 +224,44 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     if (V == 1) made = std::make_unique<AdaptiveIntegrator>(*frame.members[0].prepared->context);
     const AdaptiveIntegrator* one = made.get();
     std::vector<std::vector<std::array<double, 3>>> pieces(P);  // [a, b, union piece]
-    std::vector<double> key(P, kNone), total(P, 0.0);
-    std::string err = each_pixel(frame, nullptr, -1, [&](std::size_t px, const std::vector<Ray>& rays,
-                                                         const std::vector<std::vector<Interval>>& intervals) {
+    std::vector<double> key, total(P, 0.0);
+    const bool ok = span_keys(frame, key, [&](std::size_t px, const RaySpan& span, const PixelRays& scratch) {
         std::vector<double> cut, all;
-        const RaySpan span = frame.span(rays[0]);
         auto keep = [&](double a, double b, std::size_t piece) {
             if (span.owns(0.5 * (a + b))) pieces[px].push_back({a, b, double(piece)});
         };
         if (V == 1) {
-            for (const Interval& iv : intervals[0]) total[px] += iv.length();
-            for (const Interval& iv : intervals[0]) {
-                one->cuts(rays[0], iv, cut);
+            for (const Interval& iv : scratch.intervals[0]) total[px] += iv.length();
+            for (const Interval& iv : scratch.intervals[0]) {
+                one->cuts(scratch.rays[0], iv, cut);
                 for (std::size_t q = 0; q + 1 < cut.size(); ++q) keep(cut[q], cut[q + 1], 0);
             }
         } else {
-            const auto ps = MultiVolumeIntegrator::pieces(intervals.data(), V);
+            const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
             for (const auto& piece : ps) total[px] += piece.span.length();
             for (std::size_t i = 0; i < ps.size(); ++i) {
-                frame.multi->adaptive_cuts(rays.data(), ps[i], all, cut);
+                frame.multi->adaptive_cuts(scratch.rays.data(), ps[i], all, cut);
                 for (std::size_t q = 0; q + 1 < all.size(); ++q) keep(all[q], all[q + 1], i);
             }
         }
-        if (!pieces[px].empty()) key[px] = span.t0;
+        return !pieces[px].empty();
     });
-    if (any_error(err, frame.rank, frame.size)) return false;
+    if (!ok) return false;
+    // The total length on rank 0 for every pixel, also where this rank owns nothing of the ray.
+    if (any_error(each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
+                      if (total[px] > 0.0 || frame.rank != 0) return;
+                      scratch.of(frame, px);
+                      if (V == 1) {
+                          for (const Interval& iv : scratch.intervals[0]) total[px] += iv.length();
+                      } else {
+                          for (const auto& piece : MultiVolumeIntegrator::pieces(scratch.intervals.data(), V))
+                              total[px] += piece.span.length();
+                      }
+                  }),
+                  frame.rank, frame.size))
+        return false;
     const RankOrder order = rank_order(frame, key);
+    bytes = P * sizeof(double) * std::size_t(frame.size);
     const double tolerance = frame.scene.render.tolerance;
     const double safety = V == 1 ? one->safety() : frame.multi->adaptive_safety();
     const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
@@ -169,8 +269,9 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     const Composite fresh(none, tolerance, safety, 1.0);
     for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
     std::vector<std::vector<adaptive_detail::Leaf>> leaves(P);
-    bool ok = hand_on(frame, order, S, state, false, [&](std::size_t px, const std::vector<Ray>& rays,
-                                                          const std::vector<std::vector<Interval>>& intervals, double* s) {
+    hand_on(frame, order, S, state, false, bytes, [&](std::size_t px, PixelRays& scratch, double* s) {
+        scratch.of(frame, px);
+        const std::vector<Ray>& rays = scratch.rays;
         if (V == 1) {
             const AdaptiveIntegrator::OneVolume medium{one, &rays[0]};  // (AdaptiveComposite keeps a reference)
             Composite st(medium, tolerance, safety, total[px]);
@@ -183,7 +284,7 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
             leaves[px] = st.leaves();
             return;
         }
-        const auto ps = MultiVolumeIntegrator::pieces(intervals.data(), V);
+        const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
         MultiVolumeIntegrator::AdaptiveMix medium = frame.multi->adaptive_mix(rays.data());
         MixComposite st(medium, tolerance, safety, total[px]);
         st.load(s);
@@ -197,27 +298,28 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
         st.save(s);
         leaves[px] = st.leaves();
     });
-    if (!ok) return false;
-    // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c.
+    // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c
+    // (the last rank's final state).
     constexpr std::size_t E = 5;
     std::vector<double> sums(P * E, 0.0);
     for (std::size_t px = 0; px < P; ++px)
-        for (std::size_t i = 0; i < 3; ++i) sums[px * E + i] = state[px * S + Composite::kStateOpaqueColour + i];
-    ok = hand_on(frame, order, E, sums, true, [&](std::size_t px, const std::vector<Ray>&, const std::vector<std::vector<Interval>>&,
-                                                  double* q) {
+        if (order.position[px] >= 0 && order.position[px] == order.count[px] - 1)
+            for (std::size_t i = 0; i < 3; ++i) sums[px * E + i] = state[px * S + Composite::kStateOpaqueColour + i];
+    hand_on(frame, order, E, sums, true, bytes, [&](std::size_t px, PixelRays&, double* q) {
         glm::dvec3 behind(q[0], q[1], q[2]);
         double colour_err = q[3], tau_err = q[4];
         Composite::error_sums(leaves[px], behind, colour_err, tau_err);
         q[0] = behind.r, q[1] = behind.g, q[2] = behind.b, q[3] = colour_err, q[4] = tau_err;
     });
-    if (!ok) return false;
-    bytes = P * sizeof(double) * (1 + std::size_t(frame.size) * (S + E));
+    const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
+    const std::vector<double> final_sums = collect(frame, order, E, sums, true, bytes);
+    if (frame.rank != 0) return true;
     pixels.assign(P * 5, 0.0);
     for (std::size_t px = 0; px < P; ++px) {
         if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as the single process)
         Composite st(none, tolerance, safety, total[px]);
-        st.load(&state[px * S]);
-        const PixelValue v = st.result_from(sums[px * E + 3], sums[px * E + 4]);
+        st.load(&final_state[px * S]);
+        const PixelValue v = st.result_from(final_sums[px * E + 3], final_sums[px * E + 4]);
         for (int c = 0; c < 4; ++c) pixels[px * 5 + std::size_t(c)] = v.rgba[c];
         pixels[px * 5 + 4] = v.error;
     }

@@ -4,8 +4,8 @@
 // (AdaptiveComposite's refinement depends on the transmittance in front, the largest colour seen and
 // the rules left; its error sums run back to front). Every rank lists the pixels whose ray it owns a
 // span of (the span's t0 is the key); the keys are all-gathered, giving each pixel's ranks in ray
-// order; in round j the j-th rank of each pixel continues that pixel's state over its span, and an
-// MPI_Allreduce hands the states on.
+// order; the j-th rank of each pixel continues that pixel's state over its span and sends it point to
+// point to the next (Chain.cpp, hand_on: a pipeline over blocks of pixels).
 #pragma once
 #include <cstddef>
 #include <vector>
@@ -14,8 +14,8 @@
 
 namespace volref::mpi {
 
-// The finished pixels (Frame::channels() doubles each, on every rank) and the bytes this rank handed to
-// the collectives; false after an error (reported by rank 0 through any_error; every rank returns false).
+// The finished pixels (Frame::channels() doubles each) on rank 0, and the bytes this rank sent; false
+// after an error (reported by rank 0 through any_error; every rank returns false).
 bool chained_pixels(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes_handed);
 
 // Whether the scene's composite is chained (rather than merged from independent parts).

@@ -192,23 +192,64 @@ bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& b
     std::vector<double> state(P * S, 0.0);  // fresh states (all zero)
     hand_on(frame, order, S, state, false, bytes, [&](std::size_t px, PixelRays& scratch, double* s) {
         scratch.of(frame, px);
-        RayState st;
-        std::memcpy(&st, s, sizeof st);
+        RayState st = RayState::read(s);
         const RaySpan span = frame.span(scratch.rays[0]);
         if (frame.mixed()) frame.multi->composite_span(scratch.rays.data(), scratch.intervals.data(), span, st);
         else frame.members[0].prepared->integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
-        std::memcpy(s, &st, sizeof st);
+        st.write(s);
     });
     const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
     if (frame.rank != 0) return true;
     pixels.assign(P * 4, 0.0);
     for (std::size_t px = 0; px < P; ++px) {
-        RayState st;
-        std::memcpy(&st, &final_state[px * S], sizeof st);
-        const glm::dvec4 rgba = composite_state::rgba(st);
+        const glm::dvec4 rgba = composite_state::rgba(RayState::read(&final_state[px * S]));
         for (int c = 0; c < 4; ++c) pixels[px * 4 + std::size_t(c)] = rgba[c];
     }
     return true;
+}
+
+// The adaptive composite's pieces this rank owns in every pixel ([a, b, union piece]: cut as the single
+// process cuts them, AdaptiveIntegrator::composite and MultiVolumeIntegrator::adaptive_composite; a
+// piece belongs to the rank whose span holds its midpoint), the keys, and each ray's total length
+// (rank 0: every pixel's). False after an error (reported).
+bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vector<std::vector<std::array<double, 3>>>& pieces,
+                     std::vector<double>& key, std::vector<double>& total) {
+    const std::size_t V = frame.volumes();
+    auto length = [&](const PixelRays& scratch) {
+        double L = 0.0;
+        if (V == 1)
+            for (const Interval& iv : scratch.intervals[0]) L += iv.length();
+        else
+            for (const auto& piece : MultiVolumeIntegrator::pieces(scratch.intervals.data(), V)) L += piece.span.length();
+        return L;
+    };
+    const bool ok = span_keys(frame, key, [&](std::size_t px, const RaySpan& span, const PixelRays& scratch) {
+        std::vector<double> cut, all;
+        auto keep = [&](double a, double b, std::size_t piece) {
+            if (span.owns(0.5 * (a + b))) pieces[px].push_back({a, b, double(piece)});
+        };
+        total[px] = length(scratch);
+        if (V == 1) {
+            for (const Interval& iv : scratch.intervals[0]) {
+                one->cuts(scratch.rays[0], iv, cut);
+                for (std::size_t q = 0; q + 1 < cut.size(); ++q) keep(cut[q], cut[q + 1], 0);
+            }
+        } else {
+            const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
+            for (std::size_t i = 0; i < ps.size(); ++i) {
+                frame.multi->adaptive_cuts(scratch.rays.data(), ps[i], all, cut);
+                for (std::size_t q = 0; q + 1 < all.size(); ++q) keep(all[q], all[q + 1], i);
+            }
+        }
+        return !pieces[px].empty();
+    });
+    if (!ok) return false;
+    const std::string err = each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
+        if (frame.rank != 0 || total[px] > 0.0) return;
+        scratch.of(frame, px);
+        total[px] = length(scratch);
+    });
+    return !any_error(err, frame.rank, frame.size);
 }
 
 // render.integrator "adaptive": the pieces cut as the single process cuts them (AdaptiveIntegrator::
@@ -225,41 +266,7 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     const AdaptiveIntegrator* one = made.get();
     std::vector<std::vector<std::array<double, 3>>> pieces(P);  // [a, b, union piece]
     std::vector<double> key, total(P, 0.0);
-    const bool ok = span_keys(frame, key, [&](std::size_t px, const RaySpan& span, const PixelRays& scratch) {
-        std::vector<double> cut, all;
-        auto keep = [&](double a, double b, std::size_t piece) {
-            if (span.owns(0.5 * (a + b))) pieces[px].push_back({a, b, double(piece)});
-        };
-        if (V == 1) {
-            for (const Interval& iv : scratch.intervals[0]) total[px] += iv.length();
-            for (const Interval& iv : scratch.intervals[0]) {
-                one->cuts(scratch.rays[0], iv, cut);
-                for (std::size_t q = 0; q + 1 < cut.size(); ++q) keep(cut[q], cut[q + 1], 0);
-            }
-        } else {
-            const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
-            for (const auto& piece : ps) total[px] += piece.span.length();
-            for (std::size_t i = 0; i < ps.size(); ++i) {
-                frame.multi->adaptive_cuts(scratch.rays.data(), ps[i], all, cut);
-                for (std::size_t q = 0; q + 1 < all.size(); ++q) keep(all[q], all[q + 1], i);
-            }
-        }
-        return !pieces[px].empty();
-    });
-    if (!ok) return false;
-    // The total length on rank 0 for every pixel, also where this rank owns nothing of the ray.
-    if (any_error(each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
-                      if (total[px] > 0.0 || frame.rank != 0) return;
-                      scratch.of(frame, px);
-                      if (V == 1) {
-                          for (const Interval& iv : scratch.intervals[0]) total[px] += iv.length();
-                      } else {
-                          for (const auto& piece : MultiVolumeIntegrator::pieces(scratch.intervals.data(), V))
-                              total[px] += piece.span.length();
-                      }
-                  }),
-                  frame.rank, frame.size))
-        return false;
+    if (!adaptive_pieces(frame, one, pieces, key, total)) return false;
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
     const double tolerance = frame.scene.render.tolerance;

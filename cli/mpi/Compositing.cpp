@@ -4,17 +4,12 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 
 namespace volref::mpi {
 
 namespace {
 
-RayState state_of(const double* part) {
-    RayState s;
-    std::memcpy(&s, part + 1, sizeof(RayState));
-    return s;
-}
+RayState state_of(const double* part) { return RayState::read(part + 1); }
 
 // Pixel px from its slots' merged parts (`slot_part(sl)`: kPart doubles each), into out.
 template <class SlotPart>
@@ -73,7 +68,7 @@ void binary_swap(const Frame& frame, std::vector<double>& part, double* image, T
         RayState front = state_of(b_front ? b : a);
         frame.merge(sl, front, state_of(b_front ? a : b));
         a[0] = std::min(a[0], b[0]);
-        std::memcpy(a + 1, &front, sizeof(RayState));
+        front.write(a + 1);
     };
     auto range_of = [&](int r) {
         std::size_t lo = 0, hi = pixels;

@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <limits>
 #include <new>
@@ -233,7 +232,7 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
     auto store = [&](std::size_t px, std::size_t slot, double key, const RayState& st) {
         double* p = &part[(px * slots + slot) * kPart];
         p[0] = key;
-        std::memcpy(p + 1, &st, sizeof st);
+        st.write(p + 1);
     };
     // Several volumes: one pixel at a time (the mix, or each volume's own integrator).
     auto one_pixel = [&](int x, int y, std::vector<Ray>& rays, std::vector<std::vector<Interval>>& intervals) {

@@ -71,7 +71,17 @@ struct RayState {
     static constexpr int kDoubles = kValues + 1;
     double stopped = 0.0;  // 1: the ray has ended
     double v[kValues] = {};
+    // As kDoubles plain doubles (volref-mpi's messages): stopped, then v.
+    void write(double* out) const {
+        out[0] = stopped;
+        std::copy(v, v + kValues, out + 1);
+    }
+    static RayState read(const double* in) {
+        RayState s;
+        s.stopped = in[0];
+        std::copy(in + 1, in + 1 + kValues, s.v);
+        return s;
+    }
 };
-static_assert(sizeof(RayState) == RayState::kDoubles * sizeof(double));
 
 }  // namespace volref

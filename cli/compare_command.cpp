@@ -107,6 +107,103 @@ std::vector<ConventionVariant> convention_variants(const std::filesystem::path& 
 
 }  // namespace
 
+namespace {
+
+// The report as JSON (--json).
+void print_json(const CompareArgs& args, const ComparedImage& a, const ComparedImage& b, const ToleranceSpec& tspec,
+                 const ImageMetrics& m, const std::vector<std::array<int, 2>>& faults, bool within,
+                 const std::optional<DifferenceExplanation>& fit, const std::optional<SearchResult>& search, double scale) {
+    nlohmann::json j;
+    j["a"] = {{"path", a.path.string()}, {"description", a.description()}};
+    j["b"] = {{"path", b.path.string()}, {"description", b.description()}};
+    j["width"] = a.rgba.width;
+    j["height"] = a.rgba.height;
+    j["tolerance"] = describe_tolerance(a, b, tspec);
+    for (const ChannelMetrics& c : m.channels) j["channels"][c.name] = channel_json(c, m.pixels);
+    j["overall"] = channel_json(m.overall, m.pixels);
+    j["pixels"] = m.pixels;
+    j["pixels_over"] = m.overall.over;
+    j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};
+    j["fault"] = nlohmann::json::array();
+    for (const auto& f : faults) j["fault"].push_back({f[0], f[1]});
+    j["fraction_over"] = m.fraction_over();
+    j["within_tolerance"] = within;
+    if (!args.heatmap.empty()) j["heatmap"] = {{"path", args.heatmap.string()}, {"scale", scale}};
+    if (fit) {
+        for (const ModelFit& f : fit->fits)
+            j["fit"][f.model] = {{"fitted", f.fitted},
+                                 {"values", f.values},
+                                 {"judged_on", f.judged_on},
+                                 {"residual_before", f.residual_before},
+                                 {"residual_after", f.residual_after},
+                                 {"rgba_residual_before", f.rgba_before},
+                                 {"rgba_residual_after", f.rgba_after},
+                                 {"note", f.note},
+                                 {"parameters", f.parameters}};
+        j["fit"]["verdict"] = fit->verdict;
+    }
+    if (search) {  // {"explained", "rules", "unexplained_pixels", "residual_max", ...} at the top level
+        const nlohmann::json sj = search->to_json();  // compare's own "tolerance", "pixels" kept: the search's are search_*
+        for (auto it = sj.begin(); it != sj.end(); ++it) j[j.contains(it.key()) ? "search_" + it.key() : it.key()] = it.value();
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+}
+
+// The report as text.
+void print_text(const CompareArgs& args, const ComparedImage& a, const ComparedImage& b, const ToleranceSpec& tspec,
+                 const ImageMetrics& m, const std::vector<std::array<int, 2>>& faults, bool within,
+                 const std::optional<DifferenceExplanation>& fit, const std::optional<SearchResult>& search, double scale) {
+    std::printf("A: %s (%s)\n", a.path.string().c_str(), a.description().c_str());
+    std::printf("B: %s (%s)\n", b.path.string().c_str(), b.description().c_str());
+    std::printf("compared as linear premultiplied RGBA; tolerance per pixel and channel: %s\n",
+                describe_tolerance(a, b, tspec).c_str());
+    std::printf("%-7s %12s %12s %12s %9s %9s %10s\n", "channel", "max abs", "mean abs", "RMSE", "PSNR dB",
+                "SSIM", "over tol");
+    for (const ChannelMetrics& c : m.channels) print_row(c);
+    print_row(m.overall);
+    std::printf("pixels over tolerance: %ld of %ld (%s)\n", m.overall.over, m.pixels,
+                number(m.fraction_over()).c_str());
+    if (!faults.empty())
+        std::printf("%zu pixels where the mirrored program does not finish (fault channel): left out of the metrics "
+                    "and the tolerance test\n", faults.size());
+    if (m.non_finite_a > 0 || m.non_finite_b > 0)
+        std::printf("non-finite pixels: %ld in A, %ld in B, %ld disagreeing (those are over the tolerance); all left "
+                    "out of the metrics and the fit\n", m.non_finite_a, m.non_finite_b, m.non_finite_disagree);
+    if (!args.heatmap.empty())
+        std::printf("heat map: %s (%s per pixel, 0 black -> %s white)\n", args.heatmap.string().c_str(),
+                    search ? "the residual the search's best set leaves" : "max abs difference", number(scale).c_str());
+    if (fit) {
+        for (const ModelFit& f : fit->fits) {
+            if (!f.fitted)
+                std::printf("fit %-8s not fitted: %s\n", f.model.c_str(), f.note.c_str());
+            else if (f.judged_on == "RGBA" && f.model != "gain" && f.model != "shift")
+                std::printf("fit %-8s %s: RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
+                            number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
+            else if (f.judged_on == "RGBA")
+                std::printf("fit %-8s %s; RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
+                            number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
+            else
+                std::printf("fit %-8s %s; RMS residual in %s %s -> %s (RGBA %s -> %s)\n", f.model.c_str(),
+                            f.parameters.c_str(), f.judged_on.c_str(), number(f.residual_before, "%.4e").c_str(),
+                            number(f.residual_after, "%.4e").c_str(), number(f.rgba_before, "%.4e").c_str(),
+                            number(f.rgba_after, "%.4e").c_str());
+        }
+        if (!search) std::printf("%s\n", fit->verdict.c_str());  // with --scene the search's verdict is the answer
+    }
+    if (search) {
+        std::printf("convention search: %zu sets rendered (rules of render.profile, image models); tolerance %s per channel\n",
+                    search->tried.size(), number(search->tolerance).c_str());
+        std::printf("%s\n", search->verdict.c_str());
+    }
+    if (search)  // the exit status is the search's
+        std::printf("A against B: %s; %s\n", within ? "within tolerance" : "NOT within tolerance",
+                    search->explained ? "explained (exit 0)" : "NOT explained (exit 1)");
+    else
+        std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
+}
+
+}  // namespace
+
 int run_compare(const CompareArgs& args) {
     if (!args.heatmap.empty()) check_heatmap_path(args.heatmap);  // fail before any work
     if (!(args.heatmap_scale >= 0.0) || !std::isfinite(args.heatmap_scale))
@@ -172,90 +269,8 @@ int run_compare(const CompareArgs& args) {
         write_heatmap(map, a.rgba.width, a.rgba.height, scale, args.heatmap);
     }
 
-    if (args.json) {
-        nlohmann::json j;
-        j["a"] = {{"path", a.path.string()}, {"description", a.description()}};
-        j["b"] = {{"path", b.path.string()}, {"description", b.description()}};
-        j["width"] = a.rgba.width;
-        j["height"] = a.rgba.height;
-        j["tolerance"] = describe_tolerance(a, b, tspec);
-        for (const ChannelMetrics& c : m.channels) j["channels"][c.name] = channel_json(c, m.pixels);
-        j["overall"] = channel_json(m.overall, m.pixels);
-        j["pixels"] = m.pixels;
-        j["pixels_over"] = m.overall.over;
-        j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};
-        j["fault"] = nlohmann::json::array();
-        for (const auto& f : faults) j["fault"].push_back({f[0], f[1]});
-        j["fraction_over"] = m.fraction_over();
-        j["within_tolerance"] = within;
-        if (!args.heatmap.empty()) j["heatmap"] = {{"path", args.heatmap.string()}, {"scale", scale}};
-        if (fit) {
-            for (const ModelFit& f : fit->fits)
-                j["fit"][f.model] = {{"fitted", f.fitted},
-                                     {"values", f.values},
-                                     {"judged_on", f.judged_on},
-                                     {"residual_before", f.residual_before},
-                                     {"residual_after", f.residual_after},
-                                     {"rgba_residual_before", f.rgba_before},
-                                     {"rgba_residual_after", f.rgba_after},
-                                     {"note", f.note},
-                                     {"parameters", f.parameters}};
-            j["fit"]["verdict"] = fit->verdict;
-        }
-        if (search) {  // {"explained", "rules", "unexplained_pixels", "residual_max", ...} at the top level
-            const nlohmann::json sj = search->to_json();  // compare's own "tolerance", "pixels" kept: the search's are search_*
-            for (auto it = sj.begin(); it != sj.end(); ++it) j[j.contains(it.key()) ? "search_" + it.key() : it.key()] = it.value();
-        }
-        std::printf("%s\n", j.dump(2).c_str());
-    } else {
-        std::printf("A: %s (%s)\n", a.path.string().c_str(), a.description().c_str());
-        std::printf("B: %s (%s)\n", b.path.string().c_str(), b.description().c_str());
-        std::printf("compared as linear premultiplied RGBA; tolerance per pixel and channel: %s\n",
-                    describe_tolerance(a, b, tspec).c_str());
-        std::printf("%-7s %12s %12s %12s %9s %9s %10s\n", "channel", "max abs", "mean abs", "RMSE", "PSNR dB",
-                    "SSIM", "over tol");
-        for (const ChannelMetrics& c : m.channels) print_row(c);
-        print_row(m.overall);
-        std::printf("pixels over tolerance: %ld of %ld (%s)\n", m.overall.over, m.pixels,
-                    number(m.fraction_over()).c_str());
-        if (!faults.empty())
-            std::printf("%zu pixels where the mirrored program does not finish (fault channel): left out of the metrics "
-                        "and the tolerance test\n", faults.size());
-        if (m.non_finite_a > 0 || m.non_finite_b > 0)
-            std::printf("non-finite pixels: %ld in A, %ld in B, %ld disagreeing (those are over the tolerance); all left "
-                        "out of the metrics and the fit\n", m.non_finite_a, m.non_finite_b, m.non_finite_disagree);
-        if (!args.heatmap.empty())
-            std::printf("heat map: %s (%s per pixel, 0 black -> %s white)\n", args.heatmap.string().c_str(),
-                        search ? "the residual the search's best set leaves" : "max abs difference", number(scale).c_str());
-        if (fit) {
-            for (const ModelFit& f : fit->fits) {
-                if (!f.fitted)
-                    std::printf("fit %-8s not fitted: %s\n", f.model.c_str(), f.note.c_str());
-                else if (f.judged_on == "RGBA" && f.model != "gain" && f.model != "shift")
-                    std::printf("fit %-8s %s: RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
-                                number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
-                else if (f.judged_on == "RGBA")
-                    std::printf("fit %-8s %s; RMS residual %s -> %s\n", f.model.c_str(), f.parameters.c_str(),
-                                number(f.residual_before, "%.4e").c_str(), number(f.residual_after, "%.4e").c_str());
-                else
-                    std::printf("fit %-8s %s; RMS residual in %s %s -> %s (RGBA %s -> %s)\n", f.model.c_str(),
-                                f.parameters.c_str(), f.judged_on.c_str(), number(f.residual_before, "%.4e").c_str(),
-                                number(f.residual_after, "%.4e").c_str(), number(f.rgba_before, "%.4e").c_str(),
-                                number(f.rgba_after, "%.4e").c_str());
-            }
-            if (!search) std::printf("%s\n", fit->verdict.c_str());  // with --scene the search's verdict is the answer
-        }
-        if (search) {
-            std::printf("convention search: %zu sets rendered (rules of render.profile, image models); tolerance %s per channel\n",
-                        search->tried.size(), number(search->tolerance).c_str());
-            std::printf("%s\n", search->verdict.c_str());
-        }
-        if (search)  // the exit status is the search's
-            std::printf("A against B: %s; %s\n", within ? "within tolerance" : "NOT within tolerance",
-                        search->explained ? "explained (exit 0)" : "NOT explained (exit 1)");
-        else
-            std::printf("%s\n", within ? "within tolerance" : "NOT within tolerance");
-    }
+    if (args.json) print_json(args, a, b, tspec, m, faults, within, fit, search, scale);
+    else print_text(args, a, b, tspec, m, faults, within, fit, search, scale);
     // With --scene: 0 when the search explains A (ConventionSearch.h), 1 when it does not.
     if (search) return search->explained ? 0 : 1;
     return within ? 0 : 1;

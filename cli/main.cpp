@@ -32,17 +32,10 @@ void install_signal_handlers() {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
-    CLI::App app{"volref: a CPU reference volume ray caster, the numerical oracle for GPU volume renderers"};
-    app.require_subcommand(1);
-    // Options of every command; they may also follow the command's name (fallthrough).
-    app.fallthrough();
-    std::string max_memory;
-    app.add_option("--max-memory", max_memory,
-                   "Refuse a volume, image or cache needing more than SIZE (e.g. 512M, 4G); default: physical memory")
-        ->envname("VOLREF_MAX_MEMORY");
+namespace {
 
-    volref::cli::RenderArgs render;
+// `volref render`'s options into `args`.
+CLI::App* add_render(CLI::App& app, volref::cli::RenderArgs& render) {
     CLI::App* rc = app.add_subcommand("render", "Render a scene file to an image (.exr, .png, .tif)");
     rc->add_option("scene", render.scene, "Scene file (JSON)")->required();
     rc->add_option("-o,--output", render.output, "Output image; the format follows the extension")->required();
@@ -59,8 +52,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 100000));
     rc->add_option("--set", render.overrides, "Override one scene value: PATH=VALUE (e.g. render.step=0.25)")
         ->take_all();
+    return rc;
+}
 
-    volref::cli::ResampleArgs resample;
+// `volref resample`'s options into `args`.
+CLI::App* add_resample(CLI::App& app, volref::cli::ResampleArgs& resample) {
     CLI::App* rs = app.add_subcommand(
         "resample", "Resample a volume between Cartesian and beam-space (cylindrical, spherical) grids; writes NRRD");
     rs->add_option("input", resample.input, "Input volume (.nrrd, .nhdr, .raw)")->required();
@@ -77,8 +73,11 @@ int main(int argc, char** argv) {
     rs->add_option("--type", resample.type, "Output type: f64 (default) or f32");
     rs->add_option("--encoding", resample.encoding, "Output encoding: raw (default) or gzip");
     rs->add_option("--format", resample.format, "Input format: nrrd or raw (default: from the extension)");
+    return rs;
+}
 
-    volref::cli::CompareArgs compare;
+// `volref compare`'s options into `args`.
+CLI::App* add_compare(CLI::App& app, volref::cli::CompareArgs& compare) {
     CLI::App* cmp = app.add_subcommand(
         "compare", "Compare two images: max abs, mean abs, RMSE, PSNR, SSIM, pixels over a tolerance; exit 0 within "
                    "tolerance, 1 not, 2 usage or input errors (docs/compare.md)");
@@ -100,23 +99,32 @@ int main(int argc, char** argv) {
                     "With --fit: the scene A is a render of (B: volref's render of it); the scene is re-rendered with its "
                     "profile's rules changed, one and then two at a time, and under image models (flip, premultiplication, "
                     "BGRA, sRGB), naming the set that explains A (docs/compare.md, \"Convention search\")");
+    return cmp;
+}
 
-    volref::cli::InfoArgs info;
+// `volref info`'s options into `args`.
+CLI::App* add_info(CLI::App& app, volref::cli::InfoArgs& info) {
     CLI::App* ic = app.add_subcommand("info", "Print a volume file's dims, type, spacing, origin, value range and histogram");
     ic->add_option("file", info.input, "Volume file (.nrrd .nhdr .raw .nii .nii.gz .mhd .mha .vtk .vti .den)")->required();
     ic->add_option("--format", info.format, "nrrd, raw, nifti, metaimage, vtk, vti or den (default: from the extension)");
     ic->add_flag("--json", info.json, "Print JSON instead of text");
     ic->add_option("--bins", info.bins, "Histogram bins (default 16)");
+    return ic;
+}
 
-    volref::cli::ConvertArgs convert;
+// `volref convert`'s options into `args`.
+CLI::App* add_convert(CLI::App& app, volref::cli::ConvertArgs& convert) {
     CLI::App* cv = app.add_subcommand("convert", "Convert a volume file to NRRD (.nrrd) or raw + JSON sidecar (.raw)");
     cv->add_option("input", convert.input, "Input volume (any format `volref info` reads)")->required();
     cv->add_option("output", convert.output, "Output volume: .nrrd or .raw (+ .raw.json)")->required();
     cv->add_option("--format", convert.format, "Input format (default: from the extension)");
     cv->add_option("--type", convert.type, "Output type: f64 (NRRD default) or f32; raw: u8..f64 (default: the input's)");
     cv->add_option("--encoding", convert.encoding, "raw (default) or gzip");
+    return cv;
+}
 
-    volref::cli::TraceArgs trace;
+// `volref trace`'s options into `args`.
+CLI::App* add_trace(CLI::App& app, volref::cli::TraceArgs& trace) {
     CLI::App* tc = app.add_subcommand("trace", "Every sample along one pixel's ray, as CSV or JSON (docs/trace.md)");
     tc->add_option("scene", trace.scene, "Scene file (JSON)")->required();
     tc->add_option("--pixel", trace.pixel, "The pixel X,Y (x right, y down from the top-left corner)")->required();
@@ -124,14 +132,20 @@ int main(int argc, char** argv) {
     tc->add_option("-o,--output", trace.output, "Output file (default: standard output)");
     tc->add_flag("--no-skipping", trace.no_skipping, "List every segment (no empty-space skipping)");
     tc->add_option("--set", trace.overrides, "Override one scene value: PATH=VALUE")->take_all();
+    return tc;
+}
 
-    volref::cli::ExplainArgs explain;
+// `volref explain`'s options into `args`.
+CLI::App* add_explain(CLI::App& app, volref::cli::ExplainArgs& explain) {
     CLI::App* ex = app.add_subcommand("explain", "Work one formula step by step with the renderer's own functions "
                                                  "(docs/explain.md); --json for programs");
     ex->add_option("topic", explain.topic, std::string("One of: ") + volref::cli::explain_topics())->required();
     ex->fallthrough(false)->prefix_command()->allow_extras();  // the topic's options are parsed by run_explain (one-line errors naming the option)
+    return ex;
+}
 
-    volref::cli::SweepArgs sweep;
+// `volref sweep`'s options into `args`.
+CLI::App* add_sweep(CLI::App& app, volref::cli::SweepArgs& sweep) {
     CLI::App* sw = app.add_subcommand(
         "sweep", "Render every combination of scene parameters, time each (median of N whole-process runs), measure "
                  "the error against a reference; table, sweep.csv, sweep.png/.svg (gnuplot), order of accuracy");
@@ -151,6 +165,37 @@ int main(int argc, char** argv) {
     sw->add_option("--threads", sweep.threads, "Worker threads of each render (default: all cores)")
         ->check(CLI::Range(1, 4096));
     sw->add_option("--set", sweep.overrides, "Override one scene value for every render: PATH=VALUE")->take_all();
+    return sw;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"volref: a CPU reference volume ray caster, the numerical oracle for GPU volume renderers"};
+    app.require_subcommand(1);
+    // Options of every command; they may also follow the command's name (fallthrough).
+    app.fallthrough();
+    std::string max_memory;
+    app.add_option("--max-memory", max_memory,
+                   "Refuse a volume, image or cache needing more than SIZE (e.g. 512M, 4G); default: physical memory")
+        ->envname("VOLREF_MAX_MEMORY");
+
+    volref::cli::RenderArgs render;
+    CLI::App* rc = add_render(app, render);
+    volref::cli::ResampleArgs resample;
+    CLI::App* rs = add_resample(app, resample);
+    volref::cli::CompareArgs compare;
+    CLI::App* cmp = add_compare(app, compare);
+    volref::cli::InfoArgs info;
+    CLI::App* ic = add_info(app, info);
+    volref::cli::ConvertArgs convert;
+    CLI::App* cv = add_convert(app, convert);
+    volref::cli::TraceArgs trace;
+    CLI::App* tc = add_trace(app, trace);
+    volref::cli::ExplainArgs explain;
+    CLI::App* ex = add_explain(app, explain);
+    volref::cli::SweepArgs sweep;
+    CLI::App* sw = add_sweep(app, sweep);
 
     // ---- more subcommands: add each one's block above this line ----
 

@@ -11,12 +11,13 @@ namespace {
 
 RayState state_of(const double* part) { return RayState::read(part + 1); }
 
-// Pixel px from its slots' merged parts (`slot_part(sl)`: kPart doubles each), into out.
+// Pixel px from its slots' merged parts (`slot_part(sl)`: kPart doubles each), into out. The pixel's
+// rays and intervals are recomputed only where finishing reads them (else they stay empty).
 template <class SlotPart>
 void finish_pixel(const Frame& frame, std::size_t px, SlotPart&& slot_part, std::vector<Ray>& rays,
                   std::vector<std::vector<Interval>>& intervals, std::vector<PixelValue>& values, double* out) {
     const std::size_t W = std::size_t(frame.width());
-    frame.pixel_intervals(int(px % W), int(px / W), rays.data(), intervals.data());
+    if (frame.finish_reads_intervals()) frame.pixel_intervals(int(px % W), int(px / W), rays.data(), intervals.data());
     for (std::size_t sl = 0; sl < frame.slots(); ++sl)
         values[sl] = frame.finish(sl, rays.data(), intervals.data(), slot_part(sl));
     frame.write_pixel(values.data(), intervals.data(), out);

@@ -81,6 +81,12 @@ struct Frame {
     void merge(std::size_t slot, RayState& front, const RayState& back) const;
     PixelValue finish(std::size_t slot, const Ray* rays, const std::vector<Interval>* intervals,
                       const RayState& state) const;
+    // Whether finishing a pixel reads its intervals: several volumes' combination (MultiVolumeIntegrator::
+    // combine) and the line integrals (an empty ray is (0, 0, 0, 0); average divides by the length).
+    bool finish_reads_intervals() const {
+        const Projection p = scene.render.projection;
+        return slots() > 1 || p == Projection::Average || p == Projection::Xray;
+    }
     // A pixel from its slots' finished values (several volumes: combined), as R G B A [Z] [error].
     void write_pixel(const PixelValue* values, const std::vector<Interval>* intervals, double* out) const;
 };

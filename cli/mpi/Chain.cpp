@@ -231,7 +231,7 @@ bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vec
         total[px] = length(scratch);
         if (V == 1) {
             for (const Interval& iv : scratch.intervals[0]) {
-                one->cuts(scratch.rays[0], iv, cut);
+                one->cuts(scratch.rays[0], iv, cut, span);
                 for (std::size_t q = 0; q + 1 < cut.size(); ++q) keep(cut[q], cut[q + 1], 0);
             }
         } else {

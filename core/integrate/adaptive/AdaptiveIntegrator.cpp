@@ -77,6 +77,31 @@ PixelValue AdaptiveIntegrator::integrate(const Ray& ray, const std::vector<Inter
     throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
 }
 
+// The part of `iv` whose pieces a span can own: [t0 - m, t1 + m] of the span with m two of the ray's
+// longest pieces (a piece lies between two consecutive grid planes of every axis the ray crosses, so it
+// is at most min_a spacing_a / |d_a| long). Cutting that part gives the whole interval's cuts inside it
+// (each plane's t is computed on its own: grid_cuts), and its end pieces, cut short, lie outside the
+// span (their midpoints before t0 or after t1), so the pieces the span owns are the whole interval's.
+// The whole interval for the whole span, beam space, or a ray that crosses no plane.
+Interval AdaptiveIntegrator::span_part(const Ray& ray, const Interval& iv, const RaySpan& span) const {
+    if (span.whole() || !cut_cells_) return iv;
+    const Volume& v = cartesian_->volume();
+    double longest = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a)
+        if (v.dims[a] >= 2 && ray.direction[a] != 0.0) longest = std::min(longest, v.spacing[a] / std::fabs(ray.direction[a]));
+    if (!std::isfinite(longest)) return iv;
+    Interval part = iv;
+    part.t0 = std::max(iv.t0, span.t0 - 2.0 * longest);
+    part.t1 = std::min(iv.t1, span.t1 + 2.0 * longest);
+    return part;
+}
+
+void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<double>& out, const RaySpan& span) const {
+    const Interval part = span_part(ray, iv, span);
+    if (!(part.t0 < part.t1) && !span.whole()) return out.clear();
+    cuts(ray, part, out);
+}
+
 void AdaptiveIntegrator::cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const {
     out.clear();
     if (!cut_cells_) {  // beam space: the fixed integrator's segment ends
@@ -399,7 +424,7 @@ void AdaptiveIntegrator::line_over(const Ray& ray, const std::vector<Interval>& 
     const double per_length = line_budget(line_length(intervals));
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
-        cuts(ray, iv, cut);
+        cuts(ray, iv, cut, span);
         for (std::size_t p = 0; p + 1 < cut.size(); ++p)
             if (span.owns(0.5 * (cut[p] + cut[p + 1]))) line_piece(ray, cut[p], cut[p + 1], per_length, st);
     }
@@ -459,7 +484,9 @@ void AdaptiveIntegrator::extremum_over(const Ray& ray, const std::vector<Interva
                                        Extremum<Scalar>& acc) const {
     std::vector<double> cut;
     for (const Interval& iv : intervals) {
-        extremum_cuts(ray, iv, cut);
+        const Interval part = span_part(ray, iv, span);
+        if (!(part.t0 < part.t1) && !span.whole()) continue;
+        extremum_cuts(ray, part, cut);
         for (std::size_t p = 0; p + 1 < cut.size(); ++p)
             if (span.owns(0.5 * (cut[p] + cut[p + 1]))) extremum_piece(ray, cut[p], cut[p + 1], acc);
     }

@@ -80,6 +80,9 @@ public:
 
     // The cut points of one interval (t0, ..., t1), increasing: the pieces described above.
     void cuts(const Ray& ray, const Interval& iv, std::vector<double>& out) const;
+    // The same cuts where `span` (march/RaySpan.h) can own pieces: those the span owns are the whole
+    // interval's, the others may be missing or cut short (span_part). Empty when the span is far from iv.
+    void cuts(const Ray& ray, const Interval& iv, std::vector<double>& out, const RaySpan& span) const;
 
     // What the composite reads, also used by the several-volume mix (MultiVolumeIntegrator):
     // sigma(t) = -log1p(-min(a, kAdaptiveMaxOpacity)) / l and c(t), 0 and 0 where not finite;
@@ -135,6 +138,7 @@ private:
     glm::dvec4 extremum_rgba(const Ray& ray, double t) const;
     // The rows' crossings inside each piece of `out` where the field is not a cubic, found by sampling.
     void sampled_row_cuts(const Ray& ray, std::vector<double>& out) const;
+    Interval span_part(const Ray& ray, const Interval& iv, const RaySpan& span) const;
     // Beam space: the crossings of the grid's coordinate surfaces inside each piece, found by sampling.
     void sampled_shell_cuts(const Ray& ray, std::vector<double>& out) const;
 

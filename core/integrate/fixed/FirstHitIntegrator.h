@@ -50,7 +50,7 @@ private:
 std::optional<double> first_crossing_exact(const VolumeSampler& sampler, const Ray& ray, double t0, double t1,
                                            double iso, const RaySpan& span = RaySpan{});
 // Its loop body: the first crossing inside one piece [ta, tb] between two grid planes (one cell), or
-// none (volref-mpi searches the pieces a rank owns; first_crossing_exact tests g(t0) = 0 first).
+// none (first_crossing_exact calls it for each piece its span owns and tests g(t0) = 0 first).
 std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const Ray& ray, double ta, double tb, double iso);
 
 // One bracket [ta, tb] of the fixed-step search, g = f - iso with ga = g(ta), gb = g(tb): the crossing
@@ -59,7 +59,7 @@ std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const
 // of the cell cubics (trilinear, `trilinear` non-null), else bisection keeping the sign change until
 // the bracket is at most kFirstHitRelativeTolerance * interval_length wide, the hit its midpoint.
 // ga = 0 is the caller's to test (only at an interval's first end: inside, ga is the last bracket's gb).
-// FirstHitIntegrator and volref-mpi's ranks (cli/mpi/) search with it.
+// FirstHitIntegrator::integrate_span searches with it (the whole ray, or volref-mpi's span of it).
 template <class G>
 std::optional<double> bracket_crossing(const G& g, const VolumeSampler* trilinear, const Ray& ray, double ta, double ga,
                                        double tb, double gb, double iso, double interval_length) {

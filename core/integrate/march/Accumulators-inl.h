@@ -101,8 +101,8 @@ public:
     }
 
     // The whole state: 8 values (optical depth or transmittance and its compensation, colour and its
-    // compensation) and the opaque lanes. volref-mpi hands a ray's accumulator from rank to rank
-    // (the adaptive integrator's pieces, cli/mpi/); load(save()) changes no bit.
+    // compensation) and the opaque lanes: the composite's RayState (march/SpanStates.h, composite_state),
+    // which a span resumes and volref-mpi hands from rank to rank; load(save()) changes no bit.
     static constexpr int kStateValues = 8;
     void save(V* out, M& opaque) const {
         out[0] = s_;

@@ -75,8 +75,8 @@ public:
     static std::vector<Piece> pieces(const std::vector<Interval>* intervals, std::size_t n);
 
     // The mix of the volumes `present` at segment s (composite; fixed step): its optical depth and
-    // extinction-weighted colour, or opaque with the mean colour of the opaque samples. composite()
-    // adds these front to back; volref-mpi adds the segments a rank owns (cli/mpi/).
+    // extinction-weighted colour, or opaque with the mean colour of the opaque samples. composite_span
+    // adds these front to back (the whole ray's for composite(), a rank's span for volref-mpi).
     struct MixedSegment {
         double tau = 0.0;
         glm::dvec3 color{0.0};

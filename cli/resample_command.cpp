@@ -26,6 +26,7 @@
 #include "core/io/VolumeReader.h"
 #include "core/scene/SceneLoader.h"
 #include "geometry/ShellCoordinates.h"
+#include "core/scene/SceneNames.h"
 
 namespace volref::cli {
 
@@ -93,12 +94,8 @@ glm::dvec3 parse_vec3(const std::string& s, const std::string& option, bool posi
 }
 
 Interpolation parse_interpolation(const std::string& s) {
-    if (s == "nearest") return Interpolation::Nearest;
-    if (s == "trilinear") return Interpolation::Trilinear;
-    if (s == "tricubic-bspline") return Interpolation::TricubicBSpline;
-    if (s == "tricubic-catmull-rom") return Interpolation::TricubicCatmullRom;
-    throw Error("--interpolation: expected nearest, trilinear, tricubic-bspline or tricubic-catmull-rom, got '" + s +
-                "'");
+    if (const auto named = scene_names::value_of(scene_names::kInterpolations, s)) return *named;
+    throw Error("--interpolation: expected " + scene_names::listing(scene_names::kInterpolations) + ", got '" + s + "'");
 }
 
 // ---- the shell, as the scene's volume.bounds object (read by the scene loader's parse_shell) ----

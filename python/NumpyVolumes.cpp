@@ -38,7 +38,7 @@ std::string volref_type(const py::dtype& dt) {
 
 }  // namespace
 
-std::shared_ptr<const Volume> numpy_volume(py::handle handle, const std::string& key) {
+std::shared_ptr<Volume> numpy_volume(py::handle handle, const std::string& key) {
     if (!is_ndarray(handle)) throw Error(key + ": expected a 3-D numpy array");
     py::array array = py::reinterpret_borrow<py::array>(handle);
     if (array.ndim() != 3)

@@ -23,8 +23,8 @@ namespace volref::python {
 bool is_ndarray(pybind11::handle h);
 
 // Checks `array` (a numpy.ndarray) and copies it into a Volume (dims nx, ny, nz; origin 0, spacing 1:
-// the scene's origin and spacing apply). `key` names the scene key in messages, e.g. "scene:
+// read_scene_input sets the scene's origin and spacing in it). `key` names the scene key in messages, e.g. "scene:
 // volume.source". Holds the GIL. Throws volref::Error.
-std::shared_ptr<const Volume> numpy_volume(pybind11::handle array, const std::string& key);
+std::shared_ptr<Volume> numpy_volume(pybind11::handle array, const std::string& key);
 
 }  // namespace volref::python

@@ -6,8 +6,9 @@
 
 #include "core/Conventions.h"
 #include "core/Error.h"
+#include "core/integrate/profiles/Profile.h"
 #include "core/scene/SceneLoader.h"
-#include "python/SceneDict.h"
+#include "core/scene/SceneWriter.h"
 
 namespace py = pybind11;
 
@@ -129,7 +130,11 @@ std::string SceneInput::rewrite(const std::string& message) const {
 }
 
 py::object SceneInput::resolved() const {
-    py::object d = py::module_::import("json").attr("loads")(scene_to_json(scene).dump());
+    // The scene in its own format (SceneWriter.h), with render.profile's rules resolved (every rule the
+    // base fills in) where the scene sets any.
+    nlohmann::ordered_json j = scene_json(scene);
+    if (!scene.render.profile_rules.empty()) j["render"]["profile"] = resolved_profile_json(scene.render);
+    py::object d = py::module_::import("json").attr("loads")(j.dump());
     if (arrays.empty()) return d;
     py::list volumes;
     if (d.contains("volume"))
@@ -211,6 +216,10 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
     for (VolumeSpec& vs : in->scene.volumes)
         for (SceneInput::Array& a : in->arrays)
             if (vs.source.file && vs.source.file->filename() == a.file) {
+                // A volume in memory is complete (VolumeSourceSpec::memory): the scene's origin and
+                // spacing go into it here (the defaults, 0 and 1, where the scene gives none).
+                a.volume->origin = vs.origin.value_or(glm::dvec3(0.0));
+                a.volume->spacing = vs.spacing.value_or(glm::dvec3(1.0));
                 vs.source.memory = a.volume;
                 a.file = vs.source.file->string();  // as the resolved scene and messages write it
             }

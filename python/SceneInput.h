@@ -33,14 +33,14 @@ struct SceneInput {
         std::string file;
         pybind11::object array;
         std::string key;  // "volume.source", "volumes[1].source"
-        std::shared_ptr<const Volume> volume;
+        std::shared_ptr<Volume> volume;  // origin and spacing set from the parsed scene
     };
     std::vector<Array> arrays;
 
     // `message` with each numpy volume's name replaced by the scene key of its array, so that an
     // error about it names the key ("scene: volume.source (numpy array): ...").
     std::string rewrite(const std::string& message) const;
-    // The resolved scene (SceneDict.h) as a Python dict, with each numpy volume's "source" the array
+    // The resolved scene (core/scene/SceneWriter.h) as a Python dict, with each numpy volume's "source" the array
     // itself (instead of its temporary file). Needs the GIL.
     pybind11::object resolved() const;
 };

@@ -31,7 +31,6 @@
 #include "core/MemoryLimit.h"
 #include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
-#include "core/render/VolumeLoaderHook.h"
 #include "core/scene/SceneLoader.h"
 #include "cli/mpi/Chain.h"
 #include "cli/mpi/Compositing.h"
@@ -168,9 +167,10 @@ void prepare(const Args& args, Frame& f, bool swap) {
     glm::dvec3 view_lo(std::numeric_limits<double>::infinity()), view_hi(-std::numeric_limits<double>::infinity());
     for (std::size_t k = 0; k < f.members.size(); ++k) {
         Member& m = f.members[k];
-        set_volume_loader_hook([&](const VolumeSpec&) { return std::move(m.brick); });
+        // The brick in memory (VolumeSourceSpec::memory): complete, with its own origin (its lower
+        // corner, ghosts included) and the volume's spacing; the scene's file then only names it.
+        f.scene.volumes[k].source.memory = std::make_shared<const Volume>(std::move(m.brick));
         m.prepared = std::make_unique<PreparedVolume>(f.scene, k, options, held);
-        set_volume_loader_hook({});
         held += m.prepared->bytes;
         if (!m.prepared->integrator->resumable() && !(f.adaptive() && f.scene.render.projection == Projection::Composite))
             throw Error("render: volref-mpi cannot integrate this projection or integrator in parts yet");
@@ -326,9 +326,7 @@ int run(const Args& args, int rank, int size) {
     f.size = size;
     f.threads = args.threads;
     if (any_error(guarded([&] { read_bricks(args, f); }), rank, size)) return 1;
-    std::string err = guarded([&] { prepare(args, f, swap); });
-    set_volume_loader_hook({});
-    if (any_error(err, rank, size)) return 1;
+    if (any_error(guarded([&] { prepare(args, f, swap); }), rank, size)) return 1;
 
     const double t_setup = now();
     const bool chain = chained(f);
@@ -357,6 +355,7 @@ int run(const Args& args, int rank, int size) {
         direct_send(f, part, pixels, traffic);
     }
     const double t_gather = now();
+    std::string err;
     if (rank == 0)
         err = guarded([&] {
             if (dump_output(args.output)) write_dump(*image, args.output);

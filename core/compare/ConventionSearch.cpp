@@ -11,6 +11,7 @@
 #include "core/integrate/profiles/Profile.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
+#include "core/scene/SceneWriter.h"
 
 namespace volref::compare {
 

@@ -22,6 +22,7 @@
 #include "core/io/VolumeReader.h"
 #include "core/render/PreparedScene.h"
 #include "core/scene/SceneLoader.h"
+#include "core/scene/SceneNames.h"
 
 namespace volref::explain {
 
@@ -197,8 +198,9 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         CompositeOrder order = CompositeOrder::FrontToBack;
         if (o.has("--order")) {
             const std::string s = o.one("--order");
-            if (s == "back-to-front") order = CompositeOrder::BackToFront;
-            else if (s != "front-to-back") throw Error("--order: expected front-to-back or back-to-front, got \"" + s + "\"");
+            const auto named = scene_names::value_of(scene_names::kOrders, s);
+            if (!named) throw Error("--order: expected " + scene_names::listing(scene_names::kOrders) + ", got \"" + s + "\"");
+            order = *named;
         }
         return composite(samples, order, number_or(o, "--unit-distance", 1.0), number_or(o, "--step", 1.0));
     }
@@ -255,9 +257,9 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         ShadingSpec& k = in.spec;
         if (o.has("--model")) {
             const std::string m = o.one("--model");
-            if (m == "phong") k.model = ShadingSpec::Model::Phong;
-            else if (m == "nodal") k.model = ShadingSpec::Model::Nodal;
-            else if (m != "blinn-phong") throw Error("--model: expected blinn-phong, phong or nodal, got \"" + m + "\"");
+            const auto named = scene_names::value_of(scene_names::kShadingModels, m);
+            if (!named) throw Error("--model: expected " + scene_names::listing(scene_names::kShadingModels) + ", got \"" + m + "\"");
+            k.model = *named;
         }
         if (k.model == ShadingSpec::Model::Nodal && (o.has("--ks") || o.has("--n")))
             throw Error("--ks: the nodal model has no specular term (no --ks or --n)");

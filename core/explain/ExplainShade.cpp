@@ -8,14 +8,13 @@
 #include <glm/geometric.hpp>
 
 #include "transfer/Shader.h"
+#include "core/scene/SceneNames.h"
 
 namespace volref::explain {
 
 namespace {
 std::vector<double> v3(const glm::dvec3& c) { return {c.x, c.y, c.z}; }
-const char* model_name(ShadingSpec::Model m) {
-    return m == ShadingSpec::Model::Phong ? "phong" : m == ShadingSpec::Model::Nodal ? "nodal" : "blinn-phong";
-}
+const char* model_name(ShadingSpec::Model m) { return scene_names::name_of(scene_names::kShadingModels, m); }
 }  // namespace
 
 Explanation shade(const ShadeInput& in) {

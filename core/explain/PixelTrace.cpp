@@ -16,6 +16,7 @@
 #include "core/explain/NumberFormat.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/render/PreparedScene.h"
+#include "core/scene/SceneNames.h"
 
 namespace volref::explain {
 
@@ -65,17 +66,7 @@ bool line_integral(const PixelTrace& t) { return t.projection == Projection::Ave
 
 }  // namespace
 
-const char* projection_name(Projection p) {
-    switch (p) {
-        case Projection::Composite: return "composite";
-        case Projection::Mip: return "mip";
-        case Projection::Minip: return "minip";
-        case Projection::Average: return "average";
-        case Projection::Xray: return "xray";
-        case Projection::FirstHit: return "first-hit";
-    }
-    return "?";
-}
+const char* projection_name(Projection p) { return scene_names::name_of(scene_names::kProjections, p); }
 
 std::array<int, 2> parse_pixel(const std::string& text, int width, int height) {
     std::array<long long, 2> v{};
@@ -253,7 +244,7 @@ std::string trace_json(const PixelTrace& t, int indent) {
     nlohmann::json j;
     j["pixel"] = {t.x, t.y};
     j["projection"] = projection_name(t.projection);
-    if (composite(t)) j["order"] = t.order == CompositeOrder::FrontToBack ? "front-to-back" : "back-to-front";
+    if (composite(t)) j["order"] = scene_names::name_of(scene_names::kOrders, t.order);
     j["ray"] = {{"origin", jvec(t.ray.origin)}, {"direction", jvec(t.ray.direction)}};
     nlohmann::json iv = nlohmann::json::array();
     for (const Interval& i : t.intervals) iv.push_back({jnum(i.t0), jnum(i.t1)});

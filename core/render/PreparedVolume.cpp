@@ -142,10 +142,11 @@ void world_box(const VolumeTransform* transform, const glm::dvec3& lo, const glm
 
 void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
     if (!is_shell(vs.bounds)) {
-        m.volume = load_volume(vs);
-        m.cartesian = std::make_unique<VolumeSampler>(m.volume, vs.interpolation);
+        m.data = share_volume(vs);
+        const Volume& v = *m.data;
+        m.cartesian = std::make_unique<VolumeSampler>(v, vs.interpolation);
         m.sampler = m.cartesian.get();
-        m.voxel = std::min({m.volume.spacing.x, m.volume.spacing.y, m.volume.spacing.z});
+        m.voxel = std::min({v.spacing.x, v.spacing.y, v.spacing.z});
         return;
     }
     if (vs.origin) throw Error("volume.origin: not used with shell bounds (the shell places the samples)");
@@ -158,15 +159,14 @@ void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
     if (vs.source.field) {
         m.shell_grid = make_grid(vs.source.field->dims);
         const ShellGrid& grid = *m.shell_grid;
-        m.volume = make_procedural_volume(*vs.source.field, [&grid](std::int64_t i, std::int64_t j, std::int64_t k) {
-            return grid.sample_position(i, j, k);
-        });
+        m.data = std::make_shared<const Volume>(make_procedural_volume(
+            *vs.source.field, [&grid](std::int64_t i, std::int64_t j, std::int64_t k) { return grid.sample_position(i, j, k); }));
     } else {
-        m.volume = read_volume(*vs.source.file, vs.source.format);
-        m.shell_grid = make_grid(m.volume.dims);
+        m.data = share_volume(vs);  // a file or memory: the shell places the samples, not origin and spacing
+        m.shell_grid = make_grid(m.data->dims);
     }
-    m.shell = cylinder ? std::make_unique<ShellSampler>(m.volume, vs.bounds.cylinder, vs.interpolation)
-                       : std::make_unique<ShellSampler>(m.volume, vs.bounds.sphere, vs.interpolation);
+    m.shell = cylinder ? std::make_unique<ShellSampler>(*m.data, vs.bounds.cylinder, vs.interpolation)
+                       : std::make_unique<ShellSampler>(*m.data, vs.bounds.sphere, vs.interpolation);
     m.shell_field = std::make_unique<ShellField>(*m.shell);
     m.sampler = m.shell_field.get();
     m.voxel = m.shell_grid->default_gradient_step();
@@ -187,7 +187,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         throw;
     }
     if (vs.transform) transform.emplace(*vs.transform);
-    const Volume& volume = model.volume;
+    const Volume& volume = model.volume();
     const FieldSampler& sampler = *model.sampler;
     classifier = make_classifier(vs, volume);
 

@@ -59,7 +59,10 @@ struct VolumeModel {
     VolumeModel() = default;
     VolumeModel(const VolumeModel&) = delete;
     VolumeModel& operator=(const VolumeModel&) = delete;
-    Volume volume;
+    // The volume's data: read, generated, or given in memory (VolumeSourceSpec::memory, shared, not
+    // copied). volume() is what the samplers refer to.
+    std::shared_ptr<const Volume> data;
+    const Volume& volume() const { return *data; }
     std::unique_ptr<VolumeSampler> cartesian;
     std::unique_ptr<ShellGrid> shell_grid;
     std::unique_ptr<ShellSampler> shell;

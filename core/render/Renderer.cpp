@@ -1,5 +1,4 @@
 #include "core/render/Renderer.h"
-#include "core/render/VolumeLoaderHook.h"
 #include "core/render/PreparedScene.h"
 
 #include <algorithm>
@@ -50,14 +49,15 @@ namespace volref {
 constexpr int kPacketBlockWidth = 4;
 constexpr int kPacketBlockHeight = kMaxPacketRays / kPacketBlockWidth;
 
+std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec) {
+    if (spec.source.memory) return spec.source.memory;  // complete: its own origin and spacing
+    return std::make_shared<const Volume>(load_volume(spec));
+}
+
 Volume load_volume(const VolumeSpec& spec) {
-    if (const VolumeLoaderHook& hook = volume_loader_hook()) return hook(spec);  // volref-mpi: the rank's brick
+    if (spec.source.memory) return *spec.source.memory;
     Volume v;
-    if (spec.source.memory) {  // a numpy volume (python/NumpyVolumes.h): the scene's origin and spacing apply
-        v = *spec.source.memory;
-        if (spec.origin) v.origin = *spec.origin;
-        if (spec.spacing) v.spacing = *spec.spacing;
-    } else if (spec.source.field) {
+    if (spec.source.field) {
         v = make_procedural_volume(*spec.source.field, spec.origin.value_or(glm::dvec3(0.0)),
                                    spec.spacing.value_or(glm::dvec3(1.0)));
     } else {
@@ -186,7 +186,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         stats->warnings.clear();
         for (const auto& v : prepared.volumes) stats->warnings.insert(stats->warnings.end(), v->warnings.begin(), v->warnings.end());
         for (const auto& v : prepared.volumes)
-            for (double x : v->model.volume.values)
+            for (double x : v->model.volume().values)
                 if (!std::isfinite(x)) ++stats->non_finite_voxels;
     }
     const int W = scene.image.width, H = scene.image.height;

@@ -6,6 +6,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,8 +33,11 @@ struct RenderOptions {
 };
 
 // The volume a VolumeSpec names: read from its file or made from its procedural field, with the
-// spec's origin and spacing overriding the file's.
+// spec's origin and spacing overriding the file's; or a copy of the volume it holds in memory
+// (VolumeSourceSpec::memory, whose origin and spacing are its own).
 Volume load_volume(const VolumeSpec& spec);
+// The same, shared: the volume in memory itself (not copied), or a new one.
+std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec);
 
 // The world-space step: render.step, times the smallest spacing when step_units is voxel.
 double world_step(const RenderSpec& render, const Volume& volume);

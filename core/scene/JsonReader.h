@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -155,30 +156,45 @@ public:
     glm::dvec3 vec3(std::string_view key, const glm::dvec3& fallback, const Range& range = {});
     std::optional<glm::dvec3> optional_vec3(std::string_view key, const Range& range = {});
 
-    // A string key with a fixed set of values. A value listed in `planned` is recognised but
-    // rejected as "not implemented yet"; any other unknown value is an error listing `options`.
+    // A string key with a fixed set of values (a table of SceneNames.h, or a list). A value listed in
+    // `planned` is recognised but rejected as "not implemented yet"; any other unknown value is an
+    // error listing `options`.
     template <class E>
-    E choice(std::string_view key, E fallback, std::initializer_list<Choice<E>> options,
+    E choice(std::string_view key, E fallback, std::span<const Choice<E>> options,
              std::initializer_list<std::string_view> planned = {}) {
         const std::optional<std::string> s = optional_string(key);
         return s ? match(key, *s, options, planned) : fallback;
     }
+    template <class E>
+    E choice(std::string_view key, E fallback, std::initializer_list<Choice<E>> options,
+             std::initializer_list<std::string_view> planned = {}) {
+        return choice(key, fallback, std::span<const Choice<E>>(options.begin(), options.size()), planned);
+    }
     // The same, absent when the key is (render.profile's rules: a rule not set is the base's).
     template <class E>
-    std::optional<E> optional_choice(std::string_view key, std::initializer_list<Choice<E>> options) {
+    std::optional<E> optional_choice(std::string_view key, std::span<const Choice<E>> options) {
         const std::optional<std::string> s = optional_string(key);
         return s ? std::optional<E>(match(key, *s, options, {})) : std::nullopt;
     }
     template <class E>
-    E required_choice(std::string_view key, std::initializer_list<Choice<E>> options,
+    std::optional<E> optional_choice(std::string_view key, std::initializer_list<Choice<E>> options) {
+        return optional_choice(key, std::span<const Choice<E>>(options.begin(), options.size()));
+    }
+    template <class E>
+    E required_choice(std::string_view key, std::span<const Choice<E>> options,
                       std::initializer_list<std::string_view> planned = {}) {
         required(key);
-        return choice(key, options.begin()->value, options, planned);
+        return choice(key, options.front().value, options, planned);
+    }
+    template <class E>
+    E required_choice(std::string_view key, std::initializer_list<Choice<E>> options,
+                      std::initializer_list<std::string_view> planned = {}) {
+        return required_choice(key, std::span<const Choice<E>>(options.begin(), options.size()), planned);
     }
 
 private:
     template <class E>
-    E match(std::string_view key, const std::string& s, std::initializer_list<Choice<E>> options,
+    E match(std::string_view key, const std::string& s, std::span<const Choice<E>> options,
             std::initializer_list<std::string_view> planned) const {
         std::vector<std::string_view> names;
         for (const Choice<E>& o : options) {

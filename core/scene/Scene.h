@@ -35,8 +35,10 @@ struct Volume;
 struct VolumeSourceSpec {
     // Exactly one of file / field is set.
     std::optional<std::filesystem::path> file;  // absolute (resolved against the scene file's folder)
-    // A volume given in memory (a numpy array, python/NumpyVolumes.h): load_volume takes it instead of
-    // reading `file`, which then only names it in messages. Not in scene files.
+    // A volume given in memory (a numpy array, python/NumpyVolumes.h; a volref-mpi rank's brick,
+    // cli/mpi/main.cpp): the renderer shares it (share_volume, Renderer.h) instead of reading `file`,
+    // which then only names it in messages. It is complete: its origin and spacing are its own, and the
+    // spec's origin and spacing are not applied again (the caller put them in). Not in scene files.
     std::shared_ptr<const Volume> memory;
     std::string format;                          // "" (from the extension), "nrrd" or "raw"
     std::optional<FieldSpec> field;

@@ -21,12 +21,14 @@
 #include "core/Error.h"
 #include "core/io/InputFile.h"
 #include "core/scene/JsonReader.h"
+#include "core/scene/SceneNames.h"
 
 namespace volref {
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace names = scene_names;
 using json_reader::Choice;
 using json_reader::Context;
 using json_reader::Json;
@@ -228,12 +230,7 @@ std::vector<double> read_cell_values(ObjectReader& r, const std::array<std::int6
 FieldSpec read_field(ObjectReader& r) {
     using K = FieldSpec::Kind;
     FieldSpec f;
-    f.kind = r.required_choice<K>("field", {{"constant", K::Constant},
-                                            {"linear", K::Linear},
-                                            {"radial", K::Radial},
-                                            {"marschner-lobb", K::MarschnerLobb},
-                                            {"gaussian", K::Gaussian},
-                                            {"cells", K::Cells}});
+    f.kind = r.required_choice<K>("field", names::kFields);
     const std::string what = "for field \"" + r.string("field", "") + "\"";
     switch (f.kind) {
         case K::Constant: r.allow({"field", "dims", "value"}, what); break;
@@ -360,7 +357,9 @@ void read_shell(ObjectReader& r, BoundsSpec& b) {
                 const Json& e = (*ax)[i];
                 const std::string ep = p + "[" + std::to_string(i) + "]";
                 const std::string name = e.is_string() ? e.get<std::string>() : "";
-                const int k = name == "longitude" ? 0 : name == "latitude" ? 1 : name == "radius" ? 2 : -1;
+                int k = -1;
+                for (const auto& axis : names::kSphericalAxes)
+                    if (axis.name == name) k = axis.value;
                 if (k < 0) ctx.fail(ep, "expected \"longitude\", \"latitude\" or \"radius\", got " + describe(e));
                 if (used[std::size_t(k)]) ctx.fail(ep, "\"" + name + "\" is given twice");
                 used[std::size_t(k)] = true;
@@ -375,8 +374,7 @@ BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ct
     using T = BoundsSpec::Type;
     ObjectReader r(v, path, ctx);
     BoundsSpec b;
-    b.type = r.choice<T>("type", T::Box,
-                         {{"box", T::Box}, {"mesh", T::Mesh}, {"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
+    b.type = r.choice<T>("type", T::Box, names::kBounds);
     switch (b.type) {
         case T::Box: break;
         case T::Mesh:
@@ -403,7 +401,7 @@ TransferSpec read_transfer(const Json& v, const std::string& path, const Context
     ObjectReader r(v, path, ctx);
     r.allow({"domain", "window", "color", "opacity", "gradient_opacity", "opacity_unit_distance"});
     TransferSpec t;
-    t.domain = r.choice<D>("domain", D::Data, {{"data", D::Data}, {"normalized", D::Normalized}});
+    t.domain = r.choice<D>("domain", D::Data, names::kTransferDomains);
     if (const Json* w = r.find("window")) {
         if (t.domain != D::Normalized)
             r.fail("window", "a window applies only to \"domain\": \"normalized\" (the data domain uses values as they are)");
@@ -451,7 +449,7 @@ ClassificationSpec read_classification(const Json& v, const std::string& path, c
     // Without "type", a misspelt key is reported before "type: required".
     if (!r.has("type")) r.allow({"type", "isovalues", "regions", "opacity_unit_distance"});
     ClassificationSpec c;
-    c.type = r.required_choice<T>("type", {{"isovalue", T::Isovalue}, {"boundary", T::Boundary}});
+    c.type = r.required_choice<T>("type", names::kClassifications);
     if (c.type == T::Isovalue) {
         r.allow({"type", "isovalues", "opacity_unit_distance"}, "for classification type \"isovalue\"");
         const Json& list = r.required("isovalues");
@@ -486,8 +484,7 @@ ShadingSpec read_shading(const Json& v, const std::string& path, const Context& 
     ObjectReader r(v, path, ctx);
     r.allow({"model", "ka", "kd", "ks", "n", "kc", "kl", "two_sided"});
     ShadingSpec s;
-    s.model = r.choice<M>("model", M::BlinnPhong,
-                          {{"blinn-phong", M::BlinnPhong}, {"phong", M::Phong}, {"nodal", M::Nodal}});
+    s.model = r.choice<M>("model", M::BlinnPhong, names::kShadingModels);
     if (s.model == M::Nodal) {
         r.reject("ks", "the nodal model has no specular term");
         r.reject("n", "the nodal model has no specular term (n is its exponent)");
@@ -510,8 +507,7 @@ GradientSpec read_gradient(const Json& v, const std::string& path, const Context
     ObjectReader r(v, path, ctx);
     r.allow({"scheme", "cache"});
     GradientSpec g;
-    g.scheme = r.choice<S>("scheme", S::Default,
-                           {{"central", S::Central}, {"forward", S::Forward}, {"analytic", S::Analytic}});
+    g.scheme = r.choice<S>("scheme", S::Default, names::kGradientSchemes);
     const bool tricubic =
         interpolation == Interpolation::TricubicBSpline || interpolation == Interpolation::TricubicCatmullRom;
     if (g.scheme == S::Analytic && !tricubic)
@@ -633,13 +629,9 @@ VolumeSpec read_volume(const Json& v, const std::string& path, const Context& ct
     spec.source = read_source(r.required("source"), r.path("source"), ctx, base_dir);
     spec.origin = r.optional_vec3("origin");
     spec.spacing = r.optional_vec3("spacing", Range::positive());
-    spec.interpolation = r.choice<Interpolation>("interpolation", Interpolation::Trilinear,
-                                                 {{"nearest", Interpolation::Nearest},
-                                                  {"trilinear", Interpolation::Trilinear},
-                                                  {"tricubic-bspline", Interpolation::TricubicBSpline},
-                                                  {"tricubic-catmull-rom", Interpolation::TricubicCatmullRom}});
+    spec.interpolation = r.choice<Interpolation>("interpolation", Interpolation::Trilinear, names::kInterpolations);
     using C = VolumeSpec::Classify;
-    spec.classify = r.choice<C>("classify", C::Post, {{"post", C::Post}, {"pre", C::Pre}});
+    spec.classify = r.choice<C>("classify", C::Post, names::kClassify);
     if (const Json* b = r.find("bounds")) spec.bounds = read_bounds(*b, r.path("bounds"), ctx, base_dir);
     const Json* transfer = r.find("transfer");
     const Json* classification = r.find("classification");
@@ -683,7 +675,7 @@ LightSpec read_light(const Json& v, const std::string& path, const Context& ctx)
     using T = LightSpec::Type;
     ObjectReader r(v, path, ctx);
     LightSpec l;
-    l.type = r.choice<T>("type", T::Headlight, {{"headlight", T::Headlight}, {"directional", T::Directional}});
+    l.type = r.choice<T>("type", T::Headlight, names::kLights);
     if (l.type == T::Headlight) {
         r.allow({"type", "color"}, "for a headlight");
     } else {
@@ -737,8 +729,7 @@ CameraSpec read_camera(const Json& v, const std::string& path, const Context& ct
     using T = CameraSpec::Type;
     ObjectReader r(v, path, ctx);
     CameraSpec c;
-    c.type = r.required_choice<T>(
-        "type", {{"perspective", T::Perspective}, {"orthographic", T::Orthographic}, {"matrices", T::Matrices}});
+    c.type = r.required_choice<T>("type", names::kCameras);
     switch (c.type) {
         case T::Perspective:
             r.allow({"type", "eye", "target", "up", "fov_y"}, "for camera type \"perspective\"");
@@ -781,15 +772,7 @@ ImageSpec read_image(const Json& v, const std::string& path, const Context& ctx)
 
 template <class Reader>
 ProfileId read_profile_id(Reader& r, std::string_view key) {
-    return r.template choice<ProfileId>(key, ProfileId::Reference,
-                                        {{"reference", ProfileId::Reference},
-                                         {"vtk-gpu", ProfileId::VtkGpu},
-                                         {"glsl-basic", ProfileId::GlslBasic},
-                                         {"ospray", ProfileId::Ospray},
-                                         {"cuda-curvilinear", ProfileId::CudaCurvilinear},
-                                         {"vtk-cpu", ProfileId::VtkCpu},
-                                         {"fast", ProfileId::Fast},
-                                         {"vtk-js", ProfileId::VtkJs}});
+    return r.template choice<ProfileId>(key, ProfileId::Reference, names::kProfiles);
 }
 
 // render.profile as an object (issue 29): each rule of Profile.h by its key (scene-format.md,
@@ -809,13 +792,9 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast))
         r.fail(out.keys.front(), std::string("the \"") + std::string(base == ProfileId::VtkCpu ? "vtk-cpu" : base == ProfileId::VtkJs ? "vtk-js" : "fast") +
                                      "\" profile is its own renderer, not a set of rules (use render.profile_options, or base \"reference\")");
-    out.placement = r.optional_choice<P::Placement>("placement",
-                                               {{"midpoints", P::Placement::Midpoints},
-                                                {"from-entry", P::Placement::FromEntry},
-                                                {"from-exit", P::Placement::FromExit}});
+    out.placement = r.optional_choice<P::Placement>("placement", names::kPlacements);
     out.first = r.optional_number("first", Range::closed(0.0, 1e6));
-    out.step_count = r.optional_choice<P::StepCount>("step_count",
-                                                {{"through-exit", P::StepCount::ThroughExit}, {"before-exit", P::StepCount::BeforeExit}});
+    out.step_count = r.optional_choice<P::StepCount>("step_count", names::kStepCounts);
     if (const Json* b = r.find("ray_box")) {
         if (b->is_object()) {
             ObjectReader br(*b, r.path("ray_box"), r.context());
@@ -826,35 +805,23 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
             out.ray_box = P::RayBox::Given;
             out.box = std::array<glm::dvec3, 2>{lo, hi};
         } else {
-            out.ray_box = r.choice<P::RayBox>("ray_box", P::RayBox::Domain,
-                                              {{"domain", P::RayBox::Domain}, {"texel", P::RayBox::Texel}});
+            out.ray_box = r.choice<P::RayBox>("ray_box", P::RayBox::Domain, names::kRayBoxes);
         }
     }
-    out.step_voxel = r.optional_choice<P::VoxelLength>("step_voxel",
-                                                  {{"spacing", P::VoxelLength::Spacing},
-                                                   {"extent-over-samples", P::VoxelLength::ExtentOverSamples}});
-    out.correction = r.optional_choice<P::Correction>("correction",
-                                                 {{"pow", P::Correction::Power},
-                                                  {"exact", P::Correction::Exact},
-                                                  {"none", P::Correction::None},
-                                                  {"extinction", P::Correction::Extinction}});
+    out.step_voxel = r.optional_choice<P::VoxelLength>("step_voxel", names::kVoxelLengths);
+    out.correction = r.optional_choice<P::Correction>("correction", names::kCorrections);
     out.correction_floor = r.optional_number("correction_floor", Range::closed(0.0, 1.0));
     out.density_scale = r.optional_number("density_scale", Range::non_negative());
-    out.compositing = r.optional_choice<P::Compositing>("compositing",
-                                                   {{"optical-depth", P::Compositing::OpticalDepth},
-                                                    {"product", P::Compositing::Product},
-                                                    {"opacity-sum", P::Compositing::OpacitySum},
-                                                    {"lerp", P::Compositing::Lerp}});
+    out.compositing = r.optional_choice<P::Compositing>("compositing", names::kCompositings);
     if (const Json* t = r.find("termination")) {  // "none" or {"alpha_above" | "alpha_at_least" | "transmittance_at_most": x}
         if (t->is_object()) {
             ObjectReader tr(*t, r.path("termination"), r.context());
             tr.allow({"alpha_above", "alpha_at_least", "transmittance_at_most"});
             int n = 0;
-            for (auto [key, stop] : {std::pair{"alpha_above", P::Stop::AlphaAbove}, std::pair{"alpha_at_least", P::Stop::AlphaAtLeast},
-                                     std::pair{"transmittance_at_most", P::Stop::TransmittanceAtMost}})
-                if (tr.has(key)) {
-                    out.termination = stop;
-                    out.termination_value = tr.number(key, 1.0, Range::closed(0.0, 1.0));
+            for (const auto& stop : names::kStops)
+                if (tr.has(stop.name)) {
+                    out.termination = stop.value;
+                    out.termination_value = tr.number(stop.name, 1.0, Range::closed(0.0, 1.0));
                     ++n;
                 }
             if (n != 1) tr.fail_here("expected one of alpha_above, alpha_at_least, transmittance_at_most");
@@ -864,19 +831,13 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     }
     if (r.has("table")) out.table_entries = int(r.integer("table", 0, Range::closed(0, 1 << 20)));
     if (out.table_entries == 1) r.fail("table", "expected 0 (the transfer function read exactly) or at least 2 entries");
-    out.table_coordinate = r.optional_choice<P::TableCoordinate>("table_coordinate",
-                                                            {{"data-range", P::TableCoordinate::DataRange},
-                                                             {"data-range-times-transfer-scale", P::TableCoordinate::DataRangeTimesTransferScale}});
-    out.texture_unit = r.optional_choice<ProfileOptions::TextureUnit>("texture_unit",
-                                                                 {{"exact", ProfileOptions::TextureUnit::Exact},
-                                                                  {"h100", ProfileOptions::TextureUnit::H100}});
-    out.arithmetic = r.optional_choice<P::Arithmetic>("arithmetic",
-                                                 {{"double", P::Arithmetic::Double}, {"float32", P::Arithmetic::Float32}});
-    out.normal_along_gradient = r.optional_choice<bool>("normal", {{"-gradient", false}, {"+gradient", true}});
-    out.gradient = r.optional_choice<P::Gradient>("gradient",
-                                             {{"central", P::Gradient::Central},
-                                              {"forward", P::Gradient::Forward},
-                                              {"central-in-domain", P::Gradient::CentralInDomain}});
+    out.table_coordinate = r.optional_choice<P::TableCoordinate>("table_coordinate", names::kTableCoordinates);
+    // The canonical names only: "hardware" is render.profile_options' deprecated alias, not a rule's.
+    out.texture_unit = r.optional_choice<ProfileOptions::TextureUnit>(
+        "texture_unit", std::span<const json_reader::Choice<ProfileOptions::TextureUnit>>(names::kTextureUnits).first(2));
+    out.arithmetic = r.optional_choice<P::Arithmetic>("arithmetic", names::kArithmetics);
+    out.normal_along_gradient = r.optional_choice<bool>("normal", names::kNormals);
+    out.gradient = r.optional_choice<P::Gradient>("gradient", names::kRuleGradients);
     out.gradient_offset = r.optional_number("gradient_offset", Range::positive());
     out.gradient_offset_texture = r.optional_number("gradient_offset_texture", Range::left_open(0.0, 1.0));
     if (out.gradient_offset && out.gradient_offset_texture)
@@ -892,26 +853,13 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
     r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
              "profile", "profile_options", "gain"});
     RenderSpec s;
-    s.projection = r.choice<Projection>("projection", Projection::Composite,
-                                        {{"composite", Projection::Composite},
-                                         {"mip", Projection::Mip},
-                                         {"minip", Projection::Minip},
-                                         {"average", Projection::Average},
-                                         {"first-hit", Projection::FirstHit},
-                                         {"xray", Projection::Xray}});
-    s.order = r.choice<CompositeOrder>("order", CompositeOrder::FrontToBack,
-                                       {{"front-to-back", CompositeOrder::FrontToBack},
-                                        {"back-to-front", CompositeOrder::BackToFront}});
+    s.projection = r.choice<Projection>("projection", Projection::Composite, names::kProjections);
+    s.order = r.choice<CompositeOrder>("order", CompositeOrder::FrontToBack, names::kOrders);
     s.step = r.number("step", 0.5, Range::positive());
-    s.step_units = r.choice<StepUnits>("step_units", StepUnits::Voxel,
-                                       {{"voxel", StepUnits::Voxel}, {"world", StepUnits::World}});
+    s.step_units = r.choice<StepUnits>("step_units", StepUnits::Voxel, names::kStepUnits);
     s.isovalue = r.optional_number("isovalue");
     s.early_termination = r.optional_number("early_termination", Range::left_open(0, 1));
-    // "midpoint" is the fixed-step integrator's earlier name (kept for existing scene files).
-    s.integrator = r.choice<IntegrationMethod>("integrator", IntegrationMethod::Fixed,
-                                               {{"fixed", IntegrationMethod::Fixed},
-                                                {"midpoint", IntegrationMethod::Fixed},
-                                                {"adaptive", IntegrationMethod::Adaptive}});
+    s.integrator = r.choice<IntegrationMethod>("integrator", IntegrationMethod::Fixed, names::kIntegrators);
     s.tolerance = r.number("tolerance", conventions::kAdaptiveDefaultTolerance, Range::positive());
     // render.profile: a preset's name, or an object of rules over a preset (issue 29; read_profile_rules).
     if (const Json* p = r.find("profile"); p && p->is_object()) {
@@ -927,7 +875,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.jitter = po.number("jitter", 1.0, Range::closed(0.01, 1.0));
         s.profile_options.fixed_normal = po.boolean("fixed_normal", false);
         s.profile_options.flip_normal = po.boolean("flip_normal", false);
-        s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, {{"texel", false}, {"domain", true}});
+        s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, names::kVtkJsRayBoxes);
         s.profile_options.mip_correction = po.boolean("mip_correction", true);
         s.profile_options.subpixel_bits = int(po.integer("subpixel_bits", 4, Range::closed(0, 23)));
     } else if (const Json* o = r.find("profile_options")) {
@@ -939,13 +887,13 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format", "kernel", "tricubic"});
         // issue 17: the texture unit's weights (TextureUnit.h) and the band in the "error" channel
         using TU = ProfileOptions::TextureUnit;
-        s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, {{"exact", TU::Exact}, {"h100", TU::H100}, {"hardware", TU::H100}});
+        s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, names::kTextureUnits);
         if (po.has("texture_unit") && po.string("texture_unit", "") == "hardware")
             std::cerr << "volref: notice: render.profile_options.texture_unit: \"hardware\" is a deprecated alias of \"h100\"\n";
         s.profile_options.texture_band = po.boolean("texture_band", false);
-        s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, {{"float", false}, {"unorm16", true}});
+        s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, names::kTextureFormats);
         using K = ProfileOptions::Kernel;  // issue 28: seed 001's kernel in float32, or the double profile
-        s.profile_options.kernel = po.choice<K>("kernel", K::Float32, {{"float32", K::Float32}, {"double", K::Double}});
+        s.profile_options.kernel = po.choice<K>("kernel", K::Float32, names::kKernels);
         s.profile_options.tricubic = po.boolean("tricubic", false);  // issue 28: seed 001's --tricubic
         s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());
         s.profile_options.density = po.number("density", 1.0, Range::non_negative());
@@ -1011,7 +959,7 @@ BoundsSpec parse_shell(const std::string& json_text, const std::string& name) {
     const Json json = json_reader::parse_json(json_text, name);
     ObjectReader r(json, "", ctx);
     BoundsSpec b;
-    b.type = r.required_choice<T>("type", {{"cylindrical", T::Cylindrical}, {"spherical", T::Spherical}});
+    b.type = r.required_choice<T>("type", std::span<const json_reader::Choice<T>>(names::kBounds).subspan(2));  // the shells
     read_shell(r, b);
     return b;
 }
@@ -1021,46 +969,6 @@ ProfileRules parse_profile_rules(const nlohmann::json& object, ProfileId base, c
     if (!object.is_object()) ctx.fail("render.profile", "expected an object, got " + describe(object));
     ObjectReader r(object, "render.profile", ctx);
     return read_profile_rules(r, base);
-}
-
-nlohmann::json profile_rules_object(const ProfileRules& r) {
-    using P = ProfileRules;
-    Json j = Json::object();
-    static const char* const placement[] = {"midpoints", "from-entry", "from-exit"};
-    static const char* const correction[] = {"pow", "none", "extinction", "exact"};
-    static const char* const compositing[] = {"optical-depth", "product", "opacity-sum", "lerp"};
-    if (r.placement) j["placement"] = placement[int(*r.placement)];
-    if (r.first) j["first"] = *r.first;
-    if (r.step_count) j["step_count"] = *r.step_count == P::StepCount::ThroughExit ? "through-exit" : "before-exit";
-    if (r.ray_box == P::RayBox::Given && r.box)
-        j["ray_box"] = {{"min", {(*r.box)[0].x, (*r.box)[0].y, (*r.box)[0].z}}, {"max", {(*r.box)[1].x, (*r.box)[1].y, (*r.box)[1].z}}};
-    else if (r.ray_box)
-        j["ray_box"] = *r.ray_box == P::RayBox::Domain ? "domain" : "texel";
-    if (r.step_voxel) j["step_voxel"] = *r.step_voxel == P::VoxelLength::Spacing ? "spacing" : "extent-over-samples";
-    if (r.correction) j["correction"] = correction[int(*r.correction)];
-    if (r.correction_floor) j["correction_floor"] = *r.correction_floor;
-    if (r.density_scale) j["density_scale"] = *r.density_scale;
-    if (r.compositing) j["compositing"] = compositing[int(*r.compositing)];
-    if (r.termination) {
-        switch (*r.termination) {
-            case P::Stop::None: j["termination"] = "none"; break;
-            case P::Stop::AlphaAbove: j["termination"] = {{"alpha_above", r.termination_value}}; break;
-            case P::Stop::AlphaAtLeast: j["termination"] = {{"alpha_at_least", r.termination_value}}; break;
-            case P::Stop::TransmittanceAtMost: j["termination"] = {{"transmittance_at_most", r.termination_value}}; break;
-        }
-    }
-    if (r.table_entries) j["table"] = *r.table_entries;
-    if (r.table_coordinate)
-        j["table_coordinate"] = *r.table_coordinate == P::TableCoordinate::DataRange ? "data-range" : "data-range-times-transfer-scale";
-    if (r.texture_unit) j["texture_unit"] = *r.texture_unit == ProfileOptions::TextureUnit::H100 ? "h100" : "exact";
-    if (r.arithmetic) j["arithmetic"] = *r.arithmetic == P::Arithmetic::Float32 ? "float32" : "double";
-    if (r.normal_along_gradient) j["normal"] = *r.normal_along_gradient ? "+gradient" : "-gradient";
-    static const char* const gradient[] = {"central", "forward", "central-in-domain"};
-    if (r.gradient) j["gradient"] = gradient[int(*r.gradient)];
-    if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
-    if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
-    if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;
-    return j;
 }
 
 Scene parse_scene(const std::string& json_text, const std::filesystem::path& base_dir, const std::string& name,

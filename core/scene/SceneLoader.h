@@ -30,7 +30,6 @@ BoundsSpec parse_shell(const std::string& json_text, const std::string& name);
 // render.profile's rules (issue 29) from a JSON object of its keys ("base" ignored), over the preset
 // `base`, as a scene's render.profile object is read; `name` starts messages.
 ProfileRules parse_profile_rules(const nlohmann::json& object, ProfileId base, const std::string& name);
-// The rules set in `rules`, as render.profile's object writes them (no "base"): parse_profile_rules's inverse.
-nlohmann::json profile_rules_object(const ProfileRules& rules);
+// Its inverse: profile_rules_object (SceneWriter.h).
 
 }  // namespace volref

@@ -3,7 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
-#include "core/scene/SceneLoader.h"
+#include "core/scene/SceneNames.h"
+#include "core/scene/SceneWriter.h"
 
 namespace volref {
 
@@ -155,9 +156,7 @@ const std::vector<ProfileId>& preset_ids() {
 
 namespace {
 
-std::string preset_name(ProfileId id) {
-    return id == ProfileId::Fast ? "fast" : profile(id).name;
-}
+std::string preset_name(ProfileId id) { return scene_names::name_of(scene_names::kProfiles, id); }
 
 }  // namespace
 
@@ -247,6 +246,15 @@ nlohmann::json profile_rules_json(const Profile& p) {
     r.clamp_shaded = p.clamp_shaded;
     j.update(profile_rules_object(r));
     j["jitter"] = "off";
+    return j;
+}
+
+nlohmann::json resolved_profile_json(const RenderSpec& render) {
+    nlohmann::json j = profile_rules_json(resolve_profile(render));
+    const ProfileRules& rules = render.profile_rules;
+    // The two rules that are render.profile_options too (the base's options otherwise).
+    if (rules.texture_unit) j["texture_unit"] = scene_names::name_of(scene_names::kTextureUnits, *rules.texture_unit);
+    if (rules.arithmetic) j["arithmetic"] = scene_names::name_of(scene_names::kArithmetics, *rules.arithmetic);
     return j;
 }
 

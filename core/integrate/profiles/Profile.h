@@ -151,6 +151,11 @@ Profile resolve_profile(const RenderSpec& render);
 // give {"base": name} alone.
 nlohmann::json profile_rules_json(const Profile& p);
 
+// The resolved scene's render.profile (SceneWriter.h writes the scene's own form; python/SceneInput.cpp
+// puts this in its place): every rule of resolve_profile(render), texture_unit and arithmetic where the
+// scene set them as rules.
+nlohmann::json resolved_profile_json(const RenderSpec& render);
+
 // The presets, in the order `volref info` lists them.
 const std::vector<ProfileId>& preset_ids();
 

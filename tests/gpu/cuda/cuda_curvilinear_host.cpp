@@ -60,8 +60,8 @@ int run(int argc, char** argv) {
     // name it as data files).
     VolumeModel model;
     build_volume_model(vs, model);
-    const std::unique_ptr<Classifier> classifier = make_classifier(vs, model.volume);
-    const volref::Seed001Frame k = seed001_frame(model.volume, vs.bounds, *classifier, r, r.step);
+    const std::unique_ptr<Classifier> classifier = make_classifier(vs, model.volume());
+    const volref::Seed001Frame k = seed001_frame(model.volume(), vs.bounds, *classifier, r, r.step);
     ::Seed001Frame f;
     f.geomType = k.geom_type;
     for (int a = 0; a < 3; ++a) f.geomSize[a] = k.geom_size[std::size_t(a)], f.dims[a] = int(k.dims[std::size_t(a)]);

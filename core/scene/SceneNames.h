@@ -1,0 +1,146 @@
+// SceneNames: the scene format's one list of names for each enumerated value (docs/scene-format.md).
+//
+// The loader reads them (SceneLoader.cpp: ObjectReader::choice over these tables), the writer writes
+// them (SceneWriter.h: a resolved Scene back to the format), and trace / explain print them. A name
+// is written in one place only: a new value, or a renamed one, is one line here. Where a table lists
+// an alias (an earlier name still read, e.g. integrator "midpoint"), the canonical name comes first:
+// name_of returns the first name of a value.
+#pragma once
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "core/Error.h"
+#include "core/scene/JsonReader.h"
+#include "core/scene/Scene.h"
+
+namespace volref::scene_names {
+
+using json_reader::Choice;
+
+inline constexpr Choice<FieldSpec::Kind> kFields[] = {{"constant", FieldSpec::Kind::Constant},
+                                                      {"linear", FieldSpec::Kind::Linear},
+                                                      {"radial", FieldSpec::Kind::Radial},
+                                                      {"marschner-lobb", FieldSpec::Kind::MarschnerLobb},
+                                                      {"gaussian", FieldSpec::Kind::Gaussian},
+                                                      {"cells", FieldSpec::Kind::Cells}};
+inline constexpr Choice<BoundsSpec::Type> kBounds[] = {{"box", BoundsSpec::Type::Box},
+                                                       {"mesh", BoundsSpec::Type::Mesh},
+                                                       {"cylindrical", BoundsSpec::Type::Cylindrical},
+                                                       {"spherical", BoundsSpec::Type::Spherical}};
+// A spherical shell's "axes": the data's axis order (SphericalShell::axes holds these indices).
+inline constexpr Choice<int> kSphericalAxes[] = {{"longitude", 0}, {"latitude", 1}, {"radius", 2}};
+inline constexpr Choice<TransferSpec::Domain> kTransferDomains[] = {{"data", TransferSpec::Domain::Data},
+                                                                    {"normalized", TransferSpec::Domain::Normalized}};
+inline constexpr Choice<ClassificationSpec::Type> kClassifications[] = {{"isovalue", ClassificationSpec::Type::Isovalue},
+                                                                        {"boundary", ClassificationSpec::Type::Boundary}};
+inline constexpr Choice<ShadingSpec::Model> kShadingModels[] = {{"blinn-phong", ShadingSpec::Model::BlinnPhong},
+                                                                {"phong", ShadingSpec::Model::Phong},
+                                                                {"nodal", ShadingSpec::Model::Nodal}};
+// GradientSpec::Scheme::Default has no name: the key absent.
+inline constexpr Choice<GradientSpec::Scheme> kGradientSchemes[] = {{"central", GradientSpec::Scheme::Central},
+                                                                    {"forward", GradientSpec::Scheme::Forward},
+                                                                    {"analytic", GradientSpec::Scheme::Analytic}};
+inline constexpr Choice<Interpolation> kInterpolations[] = {{"nearest", Interpolation::Nearest},
+                                                            {"trilinear", Interpolation::Trilinear},
+                                                            {"tricubic-bspline", Interpolation::TricubicBSpline},
+                                                            {"tricubic-catmull-rom", Interpolation::TricubicCatmullRom}};
+inline constexpr Choice<VolumeSpec::Classify> kClassify[] = {{"post", VolumeSpec::Classify::Post},
+                                                             {"pre", VolumeSpec::Classify::Pre}};
+inline constexpr Choice<LightSpec::Type> kLights[] = {{"headlight", LightSpec::Type::Headlight},
+                                                      {"directional", LightSpec::Type::Directional}};
+// CameraSpec::Type::Default has no name: the key "camera" absent.
+inline constexpr Choice<CameraSpec::Type> kCameras[] = {{"perspective", CameraSpec::Type::Perspective},
+                                                        {"orthographic", CameraSpec::Type::Orthographic},
+                                                        {"matrices", CameraSpec::Type::Matrices}};
+inline constexpr Choice<Projection> kProjections[] = {{"composite", Projection::Composite}, {"mip", Projection::Mip},
+                                                      {"minip", Projection::Minip},         {"average", Projection::Average},
+                                                      {"first-hit", Projection::FirstHit},  {"xray", Projection::Xray}};
+inline constexpr Choice<CompositeOrder> kOrders[] = {{"front-to-back", CompositeOrder::FrontToBack},
+                                                     {"back-to-front", CompositeOrder::BackToFront}};
+inline constexpr Choice<StepUnits> kStepUnits[] = {{"voxel", StepUnits::Voxel}, {"world", StepUnits::World}};
+// "midpoint": the fixed-step integrator's earlier name (kept for existing scene files).
+inline constexpr Choice<IntegrationMethod> kIntegrators[] = {{"fixed", IntegrationMethod::Fixed},
+                                                             {"adaptive", IntegrationMethod::Adaptive},
+                                                             {"midpoint", IntegrationMethod::Fixed}};
+inline constexpr Choice<ProfileId> kProfiles[] = {{"reference", ProfileId::Reference},
+                                                  {"vtk-gpu", ProfileId::VtkGpu},
+                                                  {"glsl-basic", ProfileId::GlslBasic},
+                                                  {"ospray", ProfileId::Ospray},
+                                                  {"cuda-curvilinear", ProfileId::CudaCurvilinear},
+                                                  {"vtk-cpu", ProfileId::VtkCpu},
+                                                  {"fast", ProfileId::Fast},
+                                                  {"vtk-js", ProfileId::VtkJs}};
+// TextureUnit::Admissible has no name (tests only). "hardware": a deprecated alias of "h100".
+inline constexpr Choice<ProfileOptions::TextureUnit> kTextureUnits[] = {{"exact", ProfileOptions::TextureUnit::Exact},
+                                                                       {"h100", ProfileOptions::TextureUnit::H100},
+                                                                       {"hardware", ProfileOptions::TextureUnit::H100}};
+inline constexpr Choice<ProfileOptions::Kernel> kKernels[] = {{"float32", ProfileOptions::Kernel::Float32},
+                                                              {"double", ProfileOptions::Kernel::Double}};
+inline constexpr Choice<bool> kTextureFormats[] = {{"float", false}, {"unorm16", true}};  // data_unorm16
+inline constexpr Choice<bool> kVtkJsRayBoxes[] = {{"texel", false}, {"domain", true}};   // ray_box_domain
+
+// render.profile's rules (ProfileRules).
+using Rules = ProfileRules;
+inline constexpr Choice<Rules::Placement> kPlacements[] = {{"midpoints", Rules::Placement::Midpoints},
+                                                           {"from-entry", Rules::Placement::FromEntry},
+                                                           {"from-exit", Rules::Placement::FromExit}};
+inline constexpr Choice<Rules::StepCount> kStepCounts[] = {{"through-exit", Rules::StepCount::ThroughExit},
+                                                           {"before-exit", Rules::StepCount::BeforeExit}};
+// RayBox::Given is written as {"min", "max"}.
+inline constexpr Choice<Rules::RayBox> kRayBoxes[] = {{"domain", Rules::RayBox::Domain}, {"texel", Rules::RayBox::Texel}};
+inline constexpr Choice<Rules::VoxelLength> kVoxelLengths[] = {{"spacing", Rules::VoxelLength::Spacing},
+                                                               {"extent-over-samples", Rules::VoxelLength::ExtentOverSamples}};
+inline constexpr Choice<Rules::Correction> kCorrections[] = {{"pow", Rules::Correction::Power},
+                                                             {"exact", Rules::Correction::Exact},
+                                                             {"none", Rules::Correction::None},
+                                                             {"extinction", Rules::Correction::Extinction}};
+inline constexpr Choice<Rules::Compositing> kCompositings[] = {{"optical-depth", Rules::Compositing::OpticalDepth},
+                                                               {"product", Rules::Compositing::Product},
+                                                               {"opacity-sum", Rules::Compositing::OpacitySum},
+                                                               {"lerp", Rules::Compositing::Lerp}};
+// Stop::None is "none"; the others are written {"<name>": value}.
+inline constexpr Choice<Rules::Stop> kStops[] = {{"alpha_above", Rules::Stop::AlphaAbove},
+                                                 {"alpha_at_least", Rules::Stop::AlphaAtLeast},
+                                                 {"transmittance_at_most", Rules::Stop::TransmittanceAtMost}};
+inline constexpr Choice<Rules::TableCoordinate> kTableCoordinates[] = {
+    {"data-range", Rules::TableCoordinate::DataRange},
+    {"data-range-times-transfer-scale", Rules::TableCoordinate::DataRangeTimesTransferScale}};
+inline constexpr Choice<Rules::Arithmetic> kArithmetics[] = {{"double", Rules::Arithmetic::Double},
+                                                             {"float32", Rules::Arithmetic::Float32}};
+inline constexpr Choice<Rules::Gradient> kRuleGradients[] = {{"central", Rules::Gradient::Central},
+                                                             {"forward", Rules::Gradient::Forward},
+                                                             {"central-in-domain", Rules::Gradient::CentralInDomain}};
+inline constexpr Choice<bool> kNormals[] = {{"-gradient", false}, {"+gradient", true}};  // normal_along_gradient
+
+// The name `value` is written as: the table's first entry for it. A value with no name (a Default, a
+// tests-only value) is a programming error: it throws.
+template <class E>
+const char* name_of(std::span<const Choice<E>> table, E value) {
+    for (const Choice<E>& c : table)
+        if (c.value == value) return c.name.data();  // every name is a string literal (NUL-terminated)
+    throw Error("internal: a value with no name in the scene format");
+}
+template <class E, std::size_t N>
+const char* name_of(const Choice<E> (&table)[N], E value) {
+    return name_of(std::span<const Choice<E>>(table), value);
+}
+
+// The value named `name` in `table` (aliases included), or nothing.
+template <class E, std::size_t N>
+std::optional<E> value_of(const Choice<E> (&table)[N], std::string_view name) {
+    for (const Choice<E>& c : table)
+        if (c.name == name) return c.value;
+    return std::nullopt;
+}
+
+// The table's names for a message: "a, b or c" (aliases included).
+template <class E, std::size_t N>
+std::string listing(const Choice<E> (&table)[N]) {
+    std::string s;
+    for (std::size_t i = 0; i < N; ++i) s += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(table[i].name);
+    return s;
+}
+
+}  // namespace volref::scene_names

@@ -167,6 +167,16 @@ def test_numpy_volume_equals_the_same_volume_read_from_a_file(tmp_path, dtype):
     assert from_array.scene["volume"]["source"] is a
 
 
+def test_numpy_volume_on_a_shell_equals_the_same_file(tmp_path):
+    # A shell places the samples itself (beam space): the array is its data as a file's would be.
+    a = toy_volume("float32", shape=(6, 5, 7))
+    shell = {"type": "cylindrical", "center": [3, 2.5, 0], "radius": [1, 4], "angle": [0, 120], "height": [0, 5]}
+    from_file = volref.render(volume_scene(str(write_raw(tmp_path / "s.raw", a)), bounds=shell))
+    from_array = volref.render(volume_scene(a, bounds=shell))
+    assert from_array.rgba[..., 3].max() > 0.05  # something is drawn
+    assert np.array_equal(from_array.pixels, from_file.pixels)
+
+
 def test_numpy_volume_in_any_layout_and_byte_order(tmp_path):
     a = toy_volume("float32", shape=(6, 5, 7))
     reference = volref.render(volume_scene(a)).pixels

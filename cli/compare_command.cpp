@@ -80,9 +80,9 @@ std::vector<ConventionVariant> convention_variants(const std::filesystem::path& 
                                           : "a ray box half a voxel smaller (the grid's domain, not the texel box)";
     out[2].description = o.mip_correction ? "MIP without opacity correction" : "opacity correction applied to MIP";
     const bool vtk_js = base.render.profile == ProfileId::VtkJs;
-    const bool mip = base.render.projection == Projection::Mip || base.render.projection == Projection::Minip;
+    const bool mip = is_extremum(base.render.projection);
     const VolumeSpec& vs = base.volumes.front();
-    const bool one_sided_shaded = base.render.projection == Projection::Composite && vs.shading && !vs.shading->two_sided;
+    const bool one_sided_shaded = is_composite(base.render.projection) && vs.shading && !vs.shading->two_sided;
     for (ConventionVariant& v : out) v.note = "only the vtk-js profile's conventions are re-rendered (render.profile)";
     if (!vtk_js) return out;
     out[0].applicable = one_sided_shaded;

@@ -21,7 +21,7 @@ int run_trace(const TraceArgs& args) {
     if (!args.output.empty()) check_output_folder(args.output);  // fail before any work
     const Scene scene = load_scene(args.scene, args.overrides);
     const auto pixel = explain::parse_pixel(args.pixel, scene.image.width, scene.image.height);
-    if (scene.render.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+    if (is_first_hit(scene.render.projection)) throw Error("trace: first-hit is not supported yet");
     RenderOptions options;
     options.empty_space_skipping = !args.no_skipping;
     const PreparedScene prepared(scene, options);

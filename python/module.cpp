@@ -624,7 +624,7 @@ py::object trace(py::object scene, py::object pixel, py::object overrides, bool 
     const MemoryScope memory(max_memory);
     const std::unique_ptr<SceneInput> in = read_scene_input(scene, overrides);
     const auto p = pixel_of(pixel, in->scene.image.width, in->scene.image.height);
-    if (in->scene.render.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+    if (is_first_hit(in->scene.render.projection)) throw Error("trace: first-hit is not supported yet");
     explain::PixelTrace t;
     with_scene_messages(*in, [&] {
         run_cancellable([&] {
@@ -759,7 +759,7 @@ py::object explain_topic(const std::string& topic, py::kwargs kwargs) {
         allow({"pixel", "no_skipping"});
         if (option("pixel").is_none()) throw Error("--pixel: required by explain ray");
         const auto p = pixel_of(option("pixel"), in->scene.image.width, in->scene.image.height, "--pixel");
-        if (in->scene.render.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+        if (is_first_hit(in->scene.render.projection)) throw Error("trace: first-hit is not supported yet");
         const py::object skip = option("no_skipping");
         const bool no_skipping = !skip.is_none() && skip.cast<bool>();
         with_scene_messages(*in, [&] {

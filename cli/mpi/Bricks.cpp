@@ -129,8 +129,7 @@ void voxels_for(const Brick& b, const Lattice& lattice, const GridBox& first, co
 int ghost_voxels(const VolumeSpec& vs, const RenderSpec& render) {
     const bool tricubic =
         vs.interpolation == Interpolation::TricubicBSpline || vs.interpolation == Interpolation::TricubicCatmullRom;
-    const bool shades = vs.shading.has_value() &&
-                        (render.projection == Projection::Composite || render.projection == Projection::FirstHit);
+    const bool shades = vs.shading.has_value() && shades_samples(render.projection);
     const bool gradient = shades || vs.classification.has_value() || !vs.transfer.gradient_opacity.empty();
     GradientSpec::Scheme scheme = vs.gradient.scheme;
     if (scheme == GradientSpec::Scheme::Default) scheme = tricubic ? GradientSpec::Scheme::Analytic : GradientSpec::Scheme::Central;

@@ -336,7 +336,7 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
 }  // namespace
 
 bool chained(const Frame& frame) {
-    if (frame.scene.render.projection != Projection::Composite) return false;
+    if (!is_composite(frame.scene.render.projection)) return false;
     if (frame.adaptive()) return true;
     return frame.mixed() ? frame.multi->composite_spans_in_order() : frame.members[0].prepared->integrator->spans_in_order();
 }

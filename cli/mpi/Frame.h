@@ -60,10 +60,10 @@ struct Frame {
     std::size_t pixels() const { return std::size_t(width()) * std::size_t(height()); }
     std::size_t volumes() const { return members.size(); }
     bool adaptive() const { return scene.render.integrator == IntegrationMethod::Adaptive; }
-    bool first_hit() const { return scene.render.projection == Projection::FirstHit; }
+    bool first_hit() const { return is_first_hit(scene.render.projection); }
     // Several volumes composite as one mixed medium (one slot); other projections keep one slot per
     // volume, combined after the ranks' parts (MultiVolumeIntegrator::combine).
-    bool mixed() const { return volumes() > 1 && scene.render.projection == Projection::Composite; }
+    bool mixed() const { return volumes() > 1 && is_composite(scene.render.projection); }
     std::size_t slots() const { return volumes() > 1 && !mixed() ? volumes() : 1; }
     // The image's channels: R G B A, Z (first hit), error (adaptive), as `volref render` writes them.
     int channels() const { return 4 + (first_hit() ? 1 : 0) + (adaptive() ? 1 : 0); }
@@ -84,8 +84,7 @@ struct Frame {
     // Whether finishing a pixel reads its intervals: several volumes' combination (MultiVolumeIntegrator::
     // combine) and the line integrals (an empty ray is (0, 0, 0, 0); average divides by the length).
     bool finish_reads_intervals() const {
-        const Projection p = scene.render.projection;
-        return slots() > 1 || p == Projection::Average || p == Projection::Xray;
+        return slots() > 1 || is_line_integral(scene.render.projection);
     }
     // A pixel from its slots' finished values (several volumes: combined), as R G B A [Z] [error].
     void write_pixel(const PixelValue* values, const std::vector<Interval>* intervals, double* out) const;

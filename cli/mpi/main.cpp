@@ -172,7 +172,7 @@ void prepare(const Args& args, Frame& f, bool swap) {
         f.scene.volumes[k].source.memory = std::make_shared<const Volume>(std::move(m.brick));
         m.prepared = std::make_unique<PreparedVolume>(f.scene, k, options, held);
         held += m.prepared->bytes;
-        if (!m.prepared->integrator->resumable() && !(f.adaptive() && f.scene.render.projection == Projection::Composite))
+        if (!m.prepared->integrator->resumable() && !(f.adaptive() && is_composite(f.scene.render.projection)))
             throw Error("render: volref-mpi cannot integrate this projection or integrator in parts yet");
         // The whole volume's box (bounds AND domain): the intervals and the default camera of the
         // single-process render.

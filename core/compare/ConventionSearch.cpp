@@ -191,7 +191,7 @@ std::vector<double> apply_image_model(const std::string& model, const Image& r) 
 
 std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    const bool composite = r.projection == Projection::Composite;
+    const bool composite = is_composite(r.projection);
     const bool shaded = composite && scene.volume().shading.has_value();
     const bool box = scene.volume().bounds.type == BoundsSpec::Type::Box && !scene.volume().bounds.min && !scene.volume().bounds.max;
     std::vector<std::vector<json>> d;

@@ -336,7 +336,7 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         o.flag("--no-skipping");
         const Scene scene = scene_of(o);
         const auto p = parse_pixel(o.one("--pixel"), scene.image.width, scene.image.height);
-        if (scene.render.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+        if (is_first_hit(scene.render.projection)) throw Error("trace: first-hit is not supported yet");
         RenderOptions options;
         options.empty_space_skipping = !o.has("--no-skipping");
         const PreparedScene prepared(scene, options);

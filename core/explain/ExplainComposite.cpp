@@ -50,8 +50,7 @@ Run run(const std::vector<CompositeSample>& samples, CompositeOrder order, doubl
     SampleNumberField field(d);
     SampleListClassifier classifier(samples, l);
     SamplePipeline pipeline(field, classifier, nullptr, nullptr, nullptr);
-    RenderSpec render;
-    render.projection = Projection::Composite;
+    RenderSpec render;  // projection: composite, the default
     render.order = order;
     const IntegrationContext ctx{pipeline, d, render, nullptr};
     const CompositeIntegrator integrator(ctx);

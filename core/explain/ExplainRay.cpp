@@ -52,14 +52,14 @@ Explanation ray(const PreparedScene& scene, int x, int y) {
     pl.notes.push_back("each weighted by its own length (the last one ends at t1)");
     if (t.skipping) pl.notes.push_back("empty-space skipping is on: segments in empty macrocells are not listed (opacity 0)");
 
-    const bool composite = t.projection == Projection::Composite;
+    const bool composite = is_composite(t.projection);
     std::string title = std::string("samples (") + projection_name(t.projection);
     if (composite) title += t.order == CompositeOrder::FrontToBack ? ", front to back)" : ", back to front: far end first)";
     else title += ")";
     Section& sm = e.section(title);
     sm.columns = {"sample", "t", "x", "y", "z", "value"};
     if (t.has_gradient) sm.columns.push_back("|grad f|");
-    const bool line = t.projection == Projection::Average || t.projection == Projection::Xray;
+    const bool line = is_line_integral(t.projection);
     if (line) sm.columns.push_back("s(v)");
     else sm.columns.insert(sm.columns.end(), {"c_r", "c_g", "c_b", "a"});
     if (composite) sm.columns.insert(sm.columns.end(), {"alpha", "T_before", "T_after"});

@@ -60,9 +60,9 @@ struct Collector final : SampleRecorder {
     void record(const SampleRecord& r) override { out.push_back({r, locate(scene, r.sample.position)}); }
 };
 
-bool composite(const PixelTrace& t) { return t.projection == Projection::Composite; }
-bool extremum(const PixelTrace& t) { return t.projection == Projection::Mip || t.projection == Projection::Minip; }
-bool line_integral(const PixelTrace& t) { return t.projection == Projection::Average || t.projection == Projection::Xray; }
+bool composite(const PixelTrace& t) { return is_composite(t.projection); }
+bool extremum(const PixelTrace& t) { return is_extremum(t.projection); }
+bool line_integral(const PixelTrace& t) { return is_line_integral(t.projection); }
 
 }  // namespace
 
@@ -87,7 +87,7 @@ std::array<int, 2> parse_pixel(const std::string& text, int width, int height) {
 
 PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     const RenderSpec& r = scene.scene.render;
-    if (r.projection == Projection::FirstHit) throw Error("trace: first-hit is not supported yet");
+    if (is_first_hit(r.projection)) throw Error("trace: first-hit is not supported yet");
     if (r.integrator == IntegrationMethod::Adaptive)
         throw Error("trace: render.integrator \"adaptive\" is not supported yet (trace the fixed-step integrator)");
     if (x < 0 || x >= scene.scene.image.width || y < 0 || y >= scene.scene.image.height)
@@ -112,9 +112,9 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.projection = r.projection;
     t.order = r.order;
     t.has_gradient = v.gradient != nullptr;
-    t.shaded = v.shader != nullptr && t.projection == Projection::Composite;
+    t.shaded = v.shader != nullptr && is_composite(t.projection);
     t.lights = t.shaded ? v.shader->lights().size() : 0;
-    t.skipping = v.macrocells != nullptr && t.projection == Projection::Composite;  // the traced mip / minip loop does not skip
+    t.skipping = v.macrocells != nullptr && is_composite(t.projection);  // the traced mip / minip loop does not skip
     Collector collector(scene, t.samples);
     t.pixel = scene.trace_pixel(x, y, collector);
     for (TracedSample& s : t.samples) {  // issue 29: the rows' interval and step from its entry

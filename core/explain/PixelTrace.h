@@ -49,7 +49,7 @@ struct PixelTrace {
     std::vector<Interval> intervals;
     double step = 0.0;           // world units
     double unit_distance = 1.0;  // the classifier's opacity unit distance l
-    Projection projection = Projection::Composite;
+    Projection projection{};  // set from the scene
     CompositeOrder order = CompositeOrder::FrontToBack;
     bool has_gradient = false;   // the scene computes gradients (shading or classification)
     bool shaded = false;

@@ -62,7 +62,7 @@ void PreparedScene::integrate(const Ray* rays, int count, PixelValue* out, bool 
     for (std::size_t k = 0; k < n; ++k) {
         const PreparedVolume& v = *volumes[k];
         v.intervals(rays, count, scratch.rays[k].data(), scratch.intervals[k].data());
-        if (multi && scene.render.projection == Projection::Composite) continue;  // mixed below
+        if (multi && is_composite(scene.render.projection)) continue;  // mixed below
         PixelValue* values = n == 1 ? out : scratch.values[k].data();
         if (simd && v.packets)
             v.integrator->integrate_packet(scratch.rays[k].data(), scratch.intervals[k].data(), values, count);
@@ -82,7 +82,7 @@ void PreparedScene::integrate(const Ray* rays, int count, PixelValue* out, bool 
             interval_list[k].swap(scratch.intervals[k][std::size_t(i)]);
             value_list[k] = scratch.values[k][std::size_t(i)];
         }
-        out[i] = scene.render.projection == Projection::Composite ? multi->composite(ray_list.data(), interval_list.data())
+        out[i] = is_composite(scene.render.projection) ? multi->composite(ray_list.data(), interval_list.data())
                                                                   : multi->combine(value_list.data(), interval_list.data());
         for (std::size_t k = 0; k < n; ++k) interval_list[k].swap(scratch.intervals[k][std::size_t(i)]);
     }

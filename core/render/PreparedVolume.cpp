@@ -42,7 +42,7 @@ bool is_shell(const BoundsSpec& b) {
 // be tiny).
 bool skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const Classifier& classifier, const Volume& volume) {
     if (is_shell(vs.bounds)) return false;  // macrocells are Cartesian
-    if (render.projection != Projection::Composite) return false;
+    if (!is_composite(render.projection)) return false;
     if (vs.classification && vs.classification->type == ClassificationSpec::Type::Isovalue) return false;
     if (!classifier.needs_gradient()) return true;
     const auto [vmin, vmax] = volume.value_range();
@@ -64,7 +64,7 @@ bool skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const Clas
 bool extremum_skipping_applies(const VolumeSpec& vs, const RenderSpec& render, const RenderOptions& options,
                                const VolumeSampler* sampler) {
     if (is_shell(vs.bounds) || !sampler || !options.simd) return false;
-    if (render.projection != Projection::Mip && render.projection != Projection::Minip) return false;
+    if (!is_extremum(render.projection)) return false;
     if (render.integrator != IntegrationMethod::Fixed) return false;
     if (!render.reference_integrators() && render.profile != ProfileId::Fast) return false;
     return sampler->interpolation() == Interpolation::Trilinear;
@@ -219,15 +219,14 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     if (scene.render.profile == ProfileId::Fast) {
         // The fast profile's float packets (FastProfile.h); the integrators check the volume.
         const Projection p = scene.render.projection;
-        if (p != Projection::Composite && p != Projection::Mip && p != Projection::Minip)
+        if (!is_composite(p) && !is_extremum(p))
             fast_profile_unavailable("this scene's projection is not one of them");
         if (scene.render.integrator != IntegrationMethod::Fixed) fast_profile_unavailable("this scene asks for the adaptive integrator");
     }
 
     // Only what the scene uses is built: gradients for shading or gradient-based classification,
     // the pre-classified volume for classify "pre", the shader for shading.
-    const bool shades = vs.shading.has_value() &&
-                        (scene.render.projection == Projection::Composite || scene.render.projection == Projection::FirstHit);
+    const bool shades = vs.shading.has_value() && shades_samples(scene.render.projection);
     // Memory (core/MemoryLimit.h): what is held (earlier volumes, this volume) plus what is about to
     // be allocated.
     // The voxels are held in the file's type (VoxelArray); the derived grids (gradient cache,
@@ -288,7 +287,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     // A rule set to another value than its preset's that this scene never reads is said, not dropped.
     if (const ProfileRules& rules = scene.render.profile_rules; !rules.empty()) {
         const nlohmann::json base = profile_rules_json(profile(scene.render.profile)), mine = profile_rules_json(resolved);
-        const bool composite = scene.render.projection == Projection::Composite;
+        const bool composite = is_composite(scene.render.projection);
         const bool shaded = composite && vs.shading.has_value();
         for (const std::string& k : rules.keys) {
             const bool compositing_rule = k == "correction" || k == "correction_floor" || k == "density_scale" || k == "compositing" || k == "termination";

@@ -13,6 +13,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "core/scene/Projection.h"
 #include "core/scene/ShellSpec.h"
 
 namespace volref {
@@ -168,7 +169,6 @@ struct ImageSpec {
     glm::dvec4 background{0.0, 0.0, 0.0, 0.0};  // RGBA, not premultiplied, each in [0, 1]
 };
 
-enum class Projection { Composite, Mip, Minip, Average, FirstHit, Xray };
 enum class CompositeOrder { FrontToBack, BackToFront };
 enum class StepUnits { Voxel, World };
 // How a ray's integral is computed: `Fixed` steps of render.step (conventions section 4), or

@@ -853,7 +853,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
     r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
              "profile", "profile_options", "gain"});
     RenderSpec s;
-    s.projection = r.choice<Projection>("projection", Projection::Composite, names::kProjections);
+    s.projection = r.choice<Projection>("projection", s.projection, names::kProjections);  // the default: RenderSpec's
     s.order = r.choice<CompositeOrder>("order", CompositeOrder::FrontToBack, names::kOrders);
     s.step = r.number("step", 0.5, Range::positive());
     s.step_units = r.choice<StepUnits>("step_units", StepUnits::Voxel, names::kStepUnits);
@@ -916,7 +916,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
                                                                                       : ProfileOptions::Kernel::Double;
     }
     s.gain = r.number("gain", 1.0, Range::positive());
-    if (s.projection == Projection::FirstHit && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
+    if (is_first_hit(s.projection) && !s.isovalue) r.fail("isovalue", "required by projection first-hit");
     return s;
 }
 

@@ -139,7 +139,7 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     f.xray_brightness = to_f(o.brightness);
     f.iso = to_f(o.iso_threshold);
     f.transfer_scale = to_f(o.transfer_scale);
-    f.xray = render.projection == Projection::Xray;
+    f.xray = is_line_integral(render.projection);  // the kernel runs composite or x-ray (ProfileIntegrator)
     f.tricubic = o.tricubic;
     return f;
 }

@@ -136,10 +136,10 @@ std::array<double, 2> clipping_range(const glm::dvec3& eye, const glm::dvec3& fo
 VtkFixedPointRenderer::VtkFixedPointRenderer(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
                double step, const CameraSpec& camera, const ImageSpec& image, Interpolation interpolation)
     : dims_(volume.dims), origin_(volume.origin), spacing_(volume.spacing), projection_(projection),
-      shaded_(shader != nullptr && projection == Projection::Composite), step_(step), width_(image.width),
+      shaded_(shader != nullptr && is_composite(projection)), step_(step), width_(image.width),
       height_(image.height) {
     const std::string where = kWhere;
-    if (projection != Projection::Composite && projection != Projection::Mip && projection != Projection::Minip)
+    if (!is_composite(projection) && !is_extremum(projection))
         throw Error(where + "renders composite, mip and minip only (VTK 9.1's fixed-point mapper renders neither "
                             "average, x-ray nor isosurfaces): render.projection");
     if (interpolation != Interpolation::Trilinear)
@@ -203,7 +203,7 @@ VtkFixedPointRenderer::VtkFixedPointRenderer(const Volume& volume, const Classif
             color_[3 * std::size_t(e) + std::size_t(ch)] =
                 static_cast<unsigned short>(double(float(std::clamp(c.color[ch], 0.0, 1.0))) * kScale + 0.5);
         float a = float(std::clamp(c.opacity, 0.0, 1.0));
-        if (projection_ == Projection::Composite && a > 0.0001f) a = float(1.0 - std::pow(1.0 - double(a), factor));
+        if (is_composite(projection_) && a > 0.0001f) a = float(1.0 - std::pow(1.0 - double(a), factor));
         opacity_[std::size_t(e)] = static_cast<unsigned short>(double(a) * kScale + 0.5);
     }
 
@@ -589,7 +589,7 @@ Pixel15 VtkFixedPointRenderer::cast(int i, int j, Recording* rec) const {
     unsigned short remaining = 0x7fff;
     bool defined = false;
     unsigned short extreme = 0;
-    const bool minimum = projection_ == Projection::Minip;
+    const bool minimum = !takes_maximum(projection_);
     // The sample's position on the ray (world) for the record: fixed point / 32768 voxels.
     auto record = [&](const unsigned pos[3], unsigned val, const Sample15* s, const glm::dvec4& acc, double before,
                       double after, bool composited) {
@@ -623,7 +623,7 @@ Pixel15 VtkFixedPointRenderer::cast(int i, int j, Recording* rec) const {
         for (int c = 0; c < 8; ++c) corners[std::size_t(c)] = scalars_[base + inc[c]];
         const std::array<unsigned, 8> w = trilinear_weights(info.pos);
         const unsigned val = interpolate(corners, w);
-        if (projection_ != Projection::Composite) {
+        if (!is_composite(projection_)) {
             if (!defined || (minimum ? val < extreme : val > extreme)) extreme = static_cast<unsigned short>(val);
             defined = true;
             if (rec) {
@@ -668,7 +668,7 @@ Pixel15 VtkFixedPointRenderer::cast(int i, int j, Recording* rec) const {
         }
         if (stop) break;
     }
-    if (projection_ != Projection::Composite) {
+    if (!is_composite(projection_)) {
         if (!defined) return out;
         const Sample15 m = lookup(color_.data(), opacity_.data(), extreme);
         out.rgba = {m.rgb[0], m.rgb[1], m.rgb[2], m.a};

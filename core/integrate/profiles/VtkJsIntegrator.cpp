@@ -50,7 +50,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
     const Profile& p = profile(ProfileId::VtkJs);
     check_profile_applies(p, ctx.pipeline, ctx.render);
     const Projection proj = ctx.render.projection;
-    if (proj != Projection::Composite && proj != Projection::Mip && proj != Projection::Minip)
+    if (!is_composite(proj) && !is_extremum(proj))
         throw Error(kWhere + "mirrors the composite, mip and minip projections only");
     if (!ctx.pipeline.cartesian_sampler()) throw Error(kWhere + "needs a Cartesian grid");
     if (spec.bounds.type != BoundsSpec::Type::Box || spec.bounds.min || spec.bounds.max || spec.crop ||
@@ -68,7 +68,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
         throw Error(kWhere + "builds its tables over the transfer function's node range: volume.transfer.color "
                              "and .opacity need at least two rows with different values");
     const ProfileOptions& o = ctx.render.profile_options;
-    if (proj != Projection::Composite && ctx.pipeline.shader())
+    if (!is_composite(proj) && ctx.pipeline.shader())
         throw Error(kWhere + "does not mirror vtk.js's shaded mip/minip (remove volume.shading)");
     if (ctx.pipeline.shader()) {
         if (spec.shading->kl != 0.0 || spec.shading->kc != 1.0)
@@ -154,7 +154,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
         opacity_table_[std::size_t(i)] = double(float(1.0 - std::pow(1.0 - a, factor)));
         opacity_raw_table_[std::size_t(i)] = a;
     }
-    if (!o.mip_correction && proj != Projection::Composite) opacity_table_ = opacity_raw_table_;
+    if (!o.mip_correction && !is_composite(proj)) opacity_table_ = opacity_raw_table_;
 }
 
 VtkJsIntegrator::~VtkJsIntegrator() = default;
@@ -310,7 +310,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         }
     };
 
-    if (ctx_.render.projection == Projection::Composite) {
+    if (is_composite(ctx_.render.projection)) {
         const glm::dvec3 d = ray.direction;
         Sample first = color_at(ray.at(t0), d);
         if (R <= 1.0) {  // "handle very thin volumes": the entry sample alone, alpha for R steps
@@ -359,7 +359,7 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
     }
 
     // mip / minip: the same positions (entry; entry + (j + k) h while j + k + 1 < R; exit).
-    const bool maximum = ctx_.render.projection == Projection::Mip;
+    const bool maximum = takes_maximum(ctx_.render.projection);
     auto better = [&](double v, double best) { return maximum ? v > best : v < best; };
     double best = value(ray.at(t0));
     record(t0, 0.0, glm::dvec4(0.0));

@@ -7,7 +7,7 @@
 #include <limits>
 #include <type_traits>
 
-#include "core/integrate/march/SegmentWalk.h"
+#include "core/integrate/march/March.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/SpanStates.h"
 
@@ -36,50 +36,6 @@ PipelineSample composite_sample(const SamplePipeline& pipeline, const Ray& ray, 
 void record_opacity(SampleRecord& r, const SampleOpacity<Scalar>& o) {
     r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
     r.alpha = o.alpha;
-}
-
-// for_each_segment_reversed over the segments `span` owns, without those in empty macrocells.
-template <typename Fn>
-void for_each_segment_reversed_skipping(const MacrocellGrid* grid, const Ray& ray,
-                                        const std::vector<Interval>& intervals, double step, const RaySpan& span, Fn&& fn) {
-    for (auto it = intervals.rbegin(); it != intervals.rend(); ++it) {
-        const Interval& iv = *it;
-        const std::int64_t n = segment_count(iv, step);
-        const auto [first, end] = owned_segments(iv, step, n, span);
-        std::int64_t k = end - 1;
-        if (!grid) {
-            for (; k >= first; --k)
-                if (!fn(segment(iv, step, k, n))) return;
-            continue;
-        }
-        while (k >= first) {
-            const MacrocellGrid::Index m = macrocell_of(*grid, ray, iv, step, k, n);
-            // The estimate: segments begin .. k have their midpoints after the ray enters m.
-            const std::int64_t begin =
-                std::clamp<std::int64_t>(segment_at_or_after(iv, step, grid->entry_distance(ray, m), n), first, k);
-            if (grid->empty(m)) {
-                // Indices mirrored (j -> k - j) so that the run again starts at 0 and grows.
-                auto in_m = [&](std::int64_t j) { return macrocell_of(*grid, ray, iv, step, k - j, n) == m; };
-                std::int64_t in = k - begin, out = k - first + 1;
-                if (in > 0 && !in_m(in)) {
-                    out = in;  // the estimate is too long
-                    in = 0;
-                } else {  // too short? gallop backward
-                    for (std::int64_t d = 1; in + d <= k - first; d *= 2) {
-                        if (!in_m(in + d)) {
-                            out = in + d;
-                            break;
-                        }
-                        in += d;
-                    }
-                }
-                k -= last_in_run(in, out, in_m) + 1;  // every segment down to there lies in m: opacity 0
-                continue;
-            }
-            for (; k >= begin; --k)
-                if (!fn(segment(iv, step, k, n))) return;
-        }
-    }
 }
 
 }  // namespace
@@ -173,9 +129,9 @@ bool CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interv
                                         FrontToBack<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
     const Termination& stop = termination_;
-    ForwardSegmentWalk walk(ctx_.macrocells, ray, intervals, ctx_.step, span);
-    Segment s;
-    while (walk.next(s)) {
+    bool stopped = false;
+    march(intervals, {.step = ctx_.step, .span = span, .skip = ctx_.macrocells, .ray = &ray}, [&](const MarchSample& m) {
+        const Segment& s = m.s;
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
         if (!(p.opacity > 0.0)) {
@@ -184,7 +140,7 @@ bool CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interv
                 r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.partial_alpha());
                 rec.recorder.record(r);
             }
-            continue;
+            return true;
         }
         const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
         const double c[3] = {p.color.r, p.color.g, p.color.b};
@@ -195,9 +151,10 @@ bool CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interv
             r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
             rec.recorder.record(r);
         }
-        if (o.solid || acc.stops(o.partial, stop)) return true;  // opaque: nothing behind is visible
-    }
-    return false;
+        stopped = o.solid || acc.stops(o.partial, stop);  // opaque: nothing behind is visible
+        return !stopped;
+    });
+    return stopped;
 }
 
 template <class Rec>
@@ -205,7 +162,9 @@ void CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interv
                                         BackToFront<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
     [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
-    for_each_segment_reversed_skipping(ctx_.macrocells, ray, intervals, ctx_.step, span, [&](const Segment& s) {
+    const MarchOptions o{.step = ctx_.step, .span = span, .order = MarchOrder::BackToFront, .skip = ctx_.macrocells, .ray = &ray};
+    march(intervals, o, [&](const MarchSample& m) {
+        const Segment& s = m.s;
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
         if (p.opacity > 0.0) {

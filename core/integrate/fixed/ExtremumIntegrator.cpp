@@ -2,7 +2,7 @@
 
 #include "core/integrate/packet/FastProfile.h"
 #include "core/integrate/packet/PacketGrid.h"
-#include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/march/March.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/SpanStates.h"
 
@@ -77,7 +77,8 @@ Extremum<Scalar> ExtremumIntegrator::extremum(const Ray& ray, const std::vector<
                                               Rec& rec) const {
     Extremum<Scalar> acc(maximum_);
     [[maybe_unused]] glm::dvec4 so_far(0.0);
-    for_each_owned_segment(intervals, ctx_.step, span, [&](const Segment& s) {
+    march(intervals, {.step = ctx_.step, .span = span}, [&](const MarchSample& m) {
+        const Segment& s = m.s;
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
         double v;
         if constexpr (Rec::kOn) {

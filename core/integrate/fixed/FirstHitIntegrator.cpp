@@ -11,7 +11,7 @@
 #include "core/Error.h"
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/CellCubic.h"
-#include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/march/March.h"
 #include "core/sample/VolumeSampler.h"
 
 namespace volref {
@@ -89,27 +89,30 @@ void FirstHitIntegrator::integrate_span(const Ray& ray, const std::vector<Interv
     const double iso = *ctx_.render.isovalue;
     auto g = [&](double t) { return ctx_.field(ray, t) - iso; };
     std::optional<double> hit;
-    for (const Interval& iv : intervals) {
-        if (adaptive_) {
-            hit = first_crossing_exact(*trilinear_, ray, iv.t0, iv.t1, iso, span);
-            if (hit) break;
-            continue;
-        }
-        const std::int64_t n = segment_count(iv, ctx_.step);
-        const auto [first, end] = owned_segments(iv, ctx_.step, n, span);
-        if (first >= end) continue;
-        double ta = segment(iv, ctx_.step, first, n).t0, ga = g(ta);
-        if (first == 0 && ga == 0.0) {
-            hit = ta;
-            break;
-        }
-        for (std::int64_t k = first; k < end && !hit && !cancel_polled(k); ++k) {
-            const double tb = segment(iv, ctx_.step, k, n).t1, gb = g(tb);
-            hit = bracket_crossing(g, trilinear_, ray, ta, ga, tb, gb, iso, iv.length());
+    if (adaptive_) {
+        for (const Interval& iv : intervals)
+            if ((hit = first_crossing_exact(*trilinear_, ray, iv.t0, iv.t1, iso, span))) break;
+    } else {
+        // The sign of g at the owned segments' ends, bracketed segment by segment from each interval's
+        // first owned segment's start (a crossing exactly at an interval's entry is a hit there).
+        std::size_t current = intervals.size();
+        double ta = 0.0, ga = 0.0;
+        march(intervals, {.step = ctx_.step, .span = span}, [&](const MarchSample& m) {
+            if (m.interval != current) {
+                current = m.interval;
+                ta = m.s.t0;
+                ga = g(ta);
+                if (m.k == 0 && ga == 0.0) {
+                    hit = ta;
+                    return false;
+                }
+            }
+            const double tb = m.s.t1, gb = g(tb);
+            hit = bracket_crossing(g, trilinear_, ray, ta, ga, tb, gb, iso, intervals[m.interval].length());
             ta = tb;
             ga = gb;
-        }
-        if (hit) break;
+            return !hit;
+        });
     }
     if (hit) hit_state::save(*hit, ctx_.pipeline.sample(ray, *hit, SamplePipeline::Use::Surface).color, state);
 }

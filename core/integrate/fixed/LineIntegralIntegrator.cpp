@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/integrate/march/CompensatedSum.h"
-#include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/march/March.h"
 #include "core/integrate/march/Accumulators.h"
 
 namespace volref {
@@ -32,7 +32,8 @@ template <class Rec>
 void LineIntegralIntegrator::line(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                                   LineIntegral<CompensatedSum>& acc, Rec& rec) const {
     [[maybe_unused]] auto result = [&] { return this->result(acc); };
-    for_each_owned_segment(intervals, ctx_.step, span, [&](const Segment& s) {
+    march(intervals, {.step = ctx_.step, .span = span}, [&](const MarchSample& m) {
+        const Segment& s = m.s;
         const double v = ctx_.field(ray, s.midpoint());
         const double coordinate = ctx_.pipeline.classifier().coordinate(v);
         acc.add(std::isfinite(coordinate) ? coordinate * s.length() : 0.0, s.length());  // non-finite: 0 (docs/accuracy.md)

@@ -51,18 +51,6 @@ inline std::pair<std::int64_t, std::int64_t> owned_segments(const Interval& iv, 
     return {first, std::max(first, first_at_or_after(span.t1))};
 }
 
-// Calls fn(segment) front to back over the segments `span` owns of every interval; fn returns false to
-// stop early (for_each_segment, SamplePlacement.h, restricted to the span).
-template <typename Fn>
-void for_each_owned_segment(const std::vector<Interval>& intervals, double step, const RaySpan& span, Fn&& fn) {
-    for (const Interval& iv : intervals) {
-        const std::int64_t n = segment_count(iv, step);
-        const auto [first, end] = owned_segments(iv, step, n, span);
-        for (std::int64_t k = first; k < end; ++k)
-            if (!fn(segment(iv, step, k, n))) return;
-    }
-}
-
 // A ray's integration state between spans: kValues doubles in the integrator's own layout, and
 // whether the ray has ended (opaque, terminated early, hit): later spans change nothing then.
 // Plain doubles, so that volref-mpi sends states as MPI_DOUBLE arrays (kDoubles per ray).

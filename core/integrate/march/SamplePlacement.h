@@ -49,23 +49,14 @@ inline double from_entry_sample(const Interval& iv, double step, double first, d
     return iv.t0 + (first + k) * step;
 }
 
-// Calls fn(segment) front to back over every interval; fn returns false to stop early.
+// Calls fn(segment) front to back over every interval; fn returns false to stop early. The plain
+// enumeration the tests check march() (March.h) against; the integrators march.
 template <typename Fn>
 void for_each_segment(const std::vector<Interval>& intervals, double step, Fn&& fn) {
     for (const Interval& iv : intervals) {
         const std::int64_t n = segment_count(iv, step);
         for (std::int64_t k = 0; k < n; ++k)
             if (!fn(segment(iv, step, k, n))) return;
-    }
-}
-
-// The same segments, back to front.
-template <typename Fn>
-void for_each_segment_reversed(const std::vector<Interval>& intervals, double step, Fn&& fn) {
-    for (auto it = intervals.rbegin(); it != intervals.rend(); ++it) {
-        const std::int64_t n = segment_count(*it, step);
-        for (std::int64_t k = n - 1; k >= 0; --k)
-            if (!fn(segment(*it, step, k, n))) return;
     }
 }
 

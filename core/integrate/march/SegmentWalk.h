@@ -85,13 +85,19 @@ public:
 
     // The next segment to visit; false after the last, or once SIGINT / SIGTERM is requested (polled every
     // conventions::kCancellationPollSamples segments: the render is then abandoned, Cancellation.h).
-    bool next(Segment& s) {
+    bool next(Segment& s) { return next(s, nullptr, nullptr, nullptr); }
+    // The same, with the segment's interval (its index in `intervals`), its index k and the interval's
+    // segment count n (march(), March.h).
+    bool next(Segment& s, std::size_t* interval, std::int64_t* k, std::int64_t* n) {
         if (++polled_ >= conventions::kCancellationPollSamples) {
             polled_ = 0;
             if (cancel_requested()) return false;
         }
         if (k_ >= end_ && !advance()) return false;
         s = segment((*intervals_)[iv_], step_, k_, n_);
+        if (interval) *interval = iv_;
+        if (k) *k = k_;
+        if (n) *n = n_;
         ++k_;
         return true;
     }

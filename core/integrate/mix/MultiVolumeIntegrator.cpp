@@ -12,7 +12,7 @@
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/march/CompensatedSum.h"
 #include "core/integrate/march/SamplePipeline.h"
-#include "core/integrate/march/SamplePlacement.h"
+#include "core/integrate/march/March.h"
 #include "core/integrate/fixed/CompositeIntegrator.h"
 #include "core/integrate/march/Accumulators.h"
 
@@ -198,6 +198,8 @@ void MultiVolumeIntegrator::composite_span(const Ray* rays, const std::vector<In
                                            RayState& state) const {
     if (state.stopped != 0.0) return;
     const std::vector<Piece> ps = pieces(intervals, volumes_.size());
+    std::vector<Interval> spans(ps.size());  // the pieces' spans: what march() walks
+    for (std::size_t i = 0; i < ps.size(); ++i) spans[i] = ps[i].span;
     MixScratch scratch;
     auto mix = [&](const std::vector<int>& present, const Segment& s) { return this->mix(rays, present, s, scratch); };
 
@@ -212,29 +214,22 @@ void MultiVolumeIntegrator::composite_span(const Ray* rays, const std::vector<In
         FrontToBack<Scalar> acc;
         composite_state::load(acc, state);
         bool done = false;
-        for (const Piece& p : ps) {
-            const std::int64_t n = segment_count(p.span, step_);
-            const auto [first, end] = owned_segments(p.span, step_, n, span);
-            for (std::int64_t k = first; k < end && !done && !cancel_polled(k); ++k) {
-                const MixedSegment m = mix(p.present, segment(p.span, step_, k, n));
-                if (!m.opaque && !(m.tau > 0.0)) continue;
-                add(acc, m);
-                done = m.opaque || acc.stops(true, stop);
-            }
-            if (done) break;
-        }
+        march(spans, {.step = step_, .span = span}, [&](const MarchSample& s) {
+            const MixedSegment m = mix(ps[s.interval].present, s.s);
+            if (!m.opaque && !(m.tau > 0.0)) return true;
+            add(acc, m);
+            done = m.opaque || acc.stops(true, stop);
+            return !done;
+        });
         composite_state::save(acc, state);
         state.stopped = done ? 1.0 : 0.0;
     } else {
         BackToFront<Scalar> acc;
-        for (auto it = ps.rbegin(); it != ps.rend(); ++it) {
-            const std::int64_t n = segment_count(it->span, step_);
-            const auto [first, end] = owned_segments(it->span, step_, n, span);
-            for (std::int64_t k = end - 1; k >= first && !cancel_polled(end - 1 - k); --k) {
-                const MixedSegment m = mix(it->present, segment(it->span, step_, k, n));
-                if (m.opaque || m.tau > 0.0) add(acc, m);
-            }
-        }
+        march(spans, {.step = step_, .span = span, .order = MarchOrder::BackToFront}, [&](const MarchSample& s) {
+            const MixedSegment m = mix(ps[s.interval].present, s.s);
+            if (m.opaque || m.tau > 0.0) add(acc, m);
+            return true;
+        });
         RayState part;
         composite_state::save_part(glm::dvec3(acc.color(0), acc.color(1), acc.color(2)), acc.optical_depth(), acc.opaque(),
                                    part);

@@ -6,11 +6,13 @@
 //
 // A lane type L provides V (a value per lane), M (a mask per lane) and, on them:
 //   splat(x), all_lanes(), no_lanes(), select(m, a, b), select_zero(m, a), and_(a, b), or_(a, b), and_not(a, b) = !a && b,
-//   none(m), gt/ge/lt/le/eq(a, b), is_finite(a), neg(a), abs(a), exp(a), expm1(a), log1p(a);
+//   none(m), gt/ge/lt/le/eq(a, b), is_finite(a), neg(a), abs(a), exp(a), expm1(a), log1p(a), min(a, b),
+//   max(a, b), floor(a), sqrt(a), pow(a, n) (a >= 0, n a double);
 // and V's own +, -, *, /. The scalar lanes call the C library (glibc: < 1 ulp); the SIMD lanes call
 // Highway's vector functions (exp, expm1 and log1p within 1, 4 and 2 ulp; conventions section 12).
 // No operation fuses a multiply and an add (-ffp-contract=off).
 #pragma once
+#include <algorithm>
 #include <cmath>
 
 namespace volref {
@@ -39,6 +41,13 @@ struct ScalarLanes {
     static V exp(V a) { return std::exp(a); }
     static V expm1(V a) { return std::expm1(a); }
     static V log1p(V a) { return std::log1p(a); }
+    // std::min / std::max (NaN in a comes through: the comparisons are false) and floor.
+    static V min(V a, V b) { return std::min(a, b); }
+    static V max(V a, V b) { return std::max(a, b); }
+    static V floor(V a) { return std::floor(a); }
+    static V sqrt(V a) { return std::sqrt(a); }
+    // a^n for a >= 0 (the C library's pow).
+    static V pow(V a, double n) { return std::pow(a, T(n)); }
 };
 
 using Scalar = ScalarLanes<double>;

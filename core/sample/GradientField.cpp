@@ -9,6 +9,8 @@
 
 namespace volref {
 
+#include "core/sample/GradientDifference-inl.h"
+
 struct GradientField::Cache {
     Volume components[3];
     std::unique_ptr<VolumeSampler> samplers[3];
@@ -54,26 +56,15 @@ glm::dvec3 GradientField::gradient(const glm::dvec3& world) const {
 
 glm::dvec3 GradientField::on_the_fly(const glm::dvec3& x) const {
     if (scheme_ == GradientSpec::Scheme::Analytic) return sampler_.tricubic_gradient(x);
+    // GradientDifference-inl.h on one lane (the SIMD packets run the same template).
     const Volume& v = sampler_.volume();
+    const double X[3] = {x.x, x.y, x.z};
+    auto f = [&](const double P[3]) { return sampler_.value(glm::dvec3(P[0], P[1], P[2])); };
+    auto fx = [&] { return sampler_.value(x); };
+    const bool central = scheme_ == GradientSpec::Scheme::Central;
     glm::dvec3 g(0.0);
-    for (int a = 0; a < 3; ++a) {
-        if (v.dims[a] == 1) continue;
-        const double h = v.spacing[a];
-        const double c = std::max(x[a] - h, lo_[a]);
-        glm::dvec3 pc = x, pb = x;
-        if (scheme_ == GradientSpec::Scheme::Central) {
-            const double b = std::min(x[a] + h, hi_[a]);
-            pc[a] = c;
-            pb[a] = b;
-            g[a] = (sampler_.value(pb) - sampler_.value(pc)) / (b - c);
-        } else if (x[a] + h <= hi_[a]) {
-            pb[a] = x[a] + h;
-            g[a] = (sampler_.value(pb) - sampler_.value(x)) / h;
-        } else {
-            pc[a] = c;
-            g[a] = (sampler_.value(x) - sampler_.value(pc)) / (x[a] - c);
-        }
-    }
+    for (int a = 0; a < 3; ++a)
+        if (v.dims[a] > 1) g[a] = difference<Scalar>(central, X, a, v.spacing[a], lo_[a], hi_[a], f, fx);
     return g;
 }
 

@@ -5,10 +5,16 @@
 //   f = f1 (1-p)(1-q)(1-r) + f2 p(1-q)(1-r) + f3 p q (1-r) + f4 (1-p) q (1-r)
 //     + f5 (1-p)(1-q) r     + f6 p(1-q) r     + f7 p q r     + f8 (1-p) q r.
 // The sum is evaluated term by term in this order, so a hand calculation reproduces it bit for bit.
+// The arithmetic is Trilinear-inl.h's lane templates (clamped_index, cell_of, trilinear_sum), shared
+// with the SIMD packets; here the scalar lanes.
 #pragma once
 #include <array>
 
+#include "core/Lanes.h"
+
 namespace volref {
+
+#include "core/sample/Trilinear-inl.h"
 
 // The eight weights, in corner order f1..f8.
 inline std::array<double, 8> trilinear_weights(double p, double q, double r) {
@@ -18,10 +24,7 @@ inline std::array<double, 8> trilinear_weights(double p, double q, double r) {
 
 // f at (p, q, r) from the corner values f1..f8.
 inline double trilinear(const std::array<double, 8>& f, double p, double q, double r) {
-    const std::array<double, 8> w = trilinear_weights(p, q, r);
-    double sum = 0.0;
-    for (int n = 0; n < 8; ++n) sum += f[n] * w[n];
-    return sum;
+    return trilinear_sum<Scalar>(f.data(), p, q, r);
 }
 
 }  // namespace volref

@@ -60,18 +60,19 @@ private:
 };
 
 // The hot path is inline (every sample of every ray goes through it).
+// Both through Trilinear-inl.h's lane templates (the packet kernels' arithmetic too).
 inline glm::dvec3 VolumeSampler::continuous_index(const glm::dvec3& world) const {
-    const glm::dvec3 u = (world - volume_.origin) * inv_spacing_;
-    return glm::dvec3(std::clamp(u.x, 0.0, max_index_.x), std::clamp(u.y, 0.0, max_index_.y),
-                      std::clamp(u.z, 0.0, max_index_.z));
+    glm::dvec3 u;
+    for (int a = 0; a < 3; ++a) u[a] = clamped_index<Scalar>(world[a], volume_.origin[a], inv_spacing_[a], max_index_[a]);
+    return u;
 }
 
 inline void VolumeSampler::locate(const glm::dvec3& u, std::array<std::int64_t, 3>& cell, glm::dvec3& frac) const {
     for (int a = 0; a < 3; ++a) {
         const std::int64_t n = volume_.dims[a];
-        const std::int64_t i = n == 1 ? 0 : std::min<std::int64_t>(std::int64_t(std::floor(u[a])), n - 2);
-        cell[a] = i;
-        frac[a] = n == 1 ? 0.0 : u[a] - double(i);
+        double c;
+        cell_of<Scalar>(u[a], double(n - 2), n == 1, c, frac[a]);
+        cell[a] = std::int64_t(c);  // an integer below 2^53: exact
     }
 }
 

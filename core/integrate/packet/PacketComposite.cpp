@@ -121,89 +121,47 @@ struct PacketGradient {
             for (int a = 0; a < 3; ++a) g[a] = (*cached[a])(X[0], X[1], X[2]);
             return;
         }
+        // GradientField's differences: the same template (GradientDifference-inl.h) on lanes.
+        auto field = [&](const V P[3]) HWY_ATTR { return f(P[0], P[1], P[2]); };
+        auto at_x = [&]() HWY_ATTR { return fx; };
+        const bool central = in.gradient == PacketCompositeInputs::Gradient::Central;
         for (int a = 0; a < 3; ++a) {
             g[a] = hn::Zero(d);
             if (f.flat[a]) continue;
             const V h = hn::Set(d, T(in.spacing[a]));
             const V lo = hn::Set(d, T(shift ? in.domain_lo[a] - shift[a] : in.domain_lo[a]));
             const V hi = hn::Set(d, T(shift ? in.domain_hi[a] - shift[a] : in.domain_hi[a]));
-            const V c = hn::Max(hn::Sub(X[a], h), lo);
-            V P[3] = {X[0], X[1], X[2]};
-            if (in.gradient == PacketCompositeInputs::Gradient::Central) {
-                const V b = hn::Min(hn::Add(X[a], h), hi);
-                P[a] = b;
-                const V fb = f(P[0], P[1], P[2]);
-                P[a] = c;
-                const V fc = f(P[0], P[1], P[2]);
-                g[a] = hn::Div(hn::Sub(fb, fc), hn::Sub(b, c));
-            } else {  // forward where x + h <= hi, else backward over x - c
-                const V xh = hn::Add(X[a], h);
-                P[a] = xh;
-                const V forward = hn::Div(hn::Sub(f(P[0], P[1], P[2]), fx), h);
-                P[a] = c;
-                const V backward = hn::Div(hn::Sub(fx, f(P[0], P[1], P[2])), hn::Sub(X[a], c));
-                g[a] = hn::IfThenElse(hn::Le(xh, hi), forward, backward);
-            }
+            g[a] = difference<SimdLanes<T>>(central, X, a, h, lo, hi, field, at_x);
         }
     }
 };
 
-template <class V>
-HWY_INLINE V dot3(const V a[3], const V b[3]) {
-    return hn::Add(hn::Add(hn::Mul(a[0], b[0]), hn::Mul(a[1], b[1])), hn::Mul(a[2], b[2]));
-}
-
-// Shader::shade for a packet: m = the material colour, g = grad f, view = -direction, depth = t.
+// Shader::shade for a packet (the same template, transfer/Shading-inl.h): m = the material colour,
+// g = grad f, view = -direction, depth = t.
 template <typename T>
 HWY_INLINE void shade(const PacketCompositeInputs& in, VT<T> m[3], const VT<T> g[3], const VT<T> view[3], VT<T> depth) {
-    using D = DT<T>;
+    using L = SimdLanes<T>;
     using V = VT<T>;
-    using M = MT<T>;
-    const D d;
-    const V zero = hn::Zero(d), one = hn::Set(d, T(1));
-    const V glen = hn::Sqrt(dot3(g, g));
-    const M lit = hn::Gt(glen, hn::Set(d, T(in.zero_gradient_tolerance)));
-    if (hn::AllFalse(d, lit)) return;
-    const V N[3] = {hn::Div(hn::Neg(g[0]), glen), hn::Div(hn::Neg(g[1]), glen), hn::Div(hn::Neg(g[2]), glen)};
-    auto clamp_dot = [&](V x) { return in.two_sided ? hn::Abs(x) : hn::Max(x, zero); };
-    const V cue = hn::Div(one, hn::Add(hn::Set(d, T(in.kc)), hn::Mul(hn::Set(d, T(in.kl)), depth)));
-    V out[3] = {zero, zero, zero};
-    for (int li = 0; li < in.light_count; ++li) {
-        const PacketCompositeInputs::Light& light = in.lights[li];
-        V L[3];
-        for (int c = 0; c < 3; ++c) L[c] = light.headlight ? view[c] : hn::Set(d, T(light.direction[c]));
-        const V n_dot_l_raw = dot3(N, L);
-        const V n_dot_l = clamp_dot(n_dot_l_raw);
-        V spec_dot;
-        if (in.phong) {
-            const V s2 = hn::Mul(hn::Set(d, T(2)), n_dot_l_raw);
-            const V R[3] = {hn::Sub(hn::Mul(s2, N[0]), L[0]), hn::Sub(hn::Mul(s2, N[1]), L[1]),
-                            hn::Sub(hn::Mul(s2, N[2]), L[2])};
-            spec_dot = hn::Max(dot3(R, view), zero);
-        } else {
-            V H[3] = {hn::Add(L[0], view[0]), hn::Add(L[1], view[1]), hn::Add(L[2], view[2])};
-            const V inv = hn::Div(one, hn::Sqrt(dot3(H, H)));
-            for (int c = 0; c < 3; ++c) H[c] = hn::Mul(H[c], inv);
-            spec_dot = clamp_dot(dot3(N, H));
-        }
-        V specular = zero;
-        if (in.ks != 0.0) {
-            // s^n = exp(n log s) for s > 0; 0^n = 0 (n > 0), s^0 = 1.
-            const V power = in.n == 0.0 ? one
-                                        : hn::IfThenElseZero(hn::Gt(spec_dot, zero),
-                                                             hn::Exp(d, hn::Mul(hn::Set(d, T(in.n)), hn::Log(d, spec_dot))));
-            specular = hn::Mul(hn::Mul(hn::Set(d, T(in.ks)), power), cue);
-        }
+    ShadingConstants k;
+    k.ka = in.ka;
+    k.kd = in.kd;
+    k.ks = in.ks;
+    k.n = in.n;
+    k.kc = in.kc;
+    k.kl = in.kl;
+    k.two_sided = in.two_sided;
+    k.phong = in.phong;
+    auto light_at = [&](int i, V* Ld, double* I) HWY_ATTR {
+        const PacketCompositeInputs::Light& light = in.lights[i];
         for (int c = 0; c < 3; ++c) {
-            const V I = hn::Set(d, T(light.color[c]));
-            const V ambient = hn::Mul(I, hn::Mul(hn::Set(d, T(in.ka)), m[c]));
-            const V diffuse = hn::Mul(I, hn::Mul(hn::Mul(hn::Mul(hn::Set(d, T(in.kd)), m[c]), n_dot_l), cue));
-            V term = hn::Add(ambient, diffuse);
-            if (in.ks != 0.0) term = hn::Add(term, hn::Mul(I, specular));
-            out[c] = hn::Add(out[c], term);
+            Ld[c] = light.headlight ? view[c] : L::splat(light.direction[c]);
+            I[c] = light.color[c];
         }
-    }
-    for (int c = 0; c < 3; ++c) m[c] = hn::IfThenElse(lit, out[c], m[c]);
+    };
+    V N[3];
+    typename L::M lit;
+    shade_lanes<L>(k, in.zero_gradient_tolerance, in.light_count, light_at, m, g, view, depth, N, lit,
+                   [](int, const LightLanes<L>&) HWY_ATTR {});
 }
 
 template <typename T>
@@ -284,7 +242,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             // a = clamp(a factor(|grad f|), 0, 1)
             gradient(P, v, g);
             have_gradient = true;
-            const V glen = hn::Sqrt(dot3(g, g));
+            const V glen = hn::Sqrt(dot3<SL>(g, g));
             const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen, gradient_reg);
             const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, gradient_reg);
             a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);

@@ -73,11 +73,23 @@ struct SimdLanes {
     static HWY_INLINE V exp(V a) { return hn::Exp(D(), a); }
     static HWY_INLINE V expm1(V a) { return hn::Expm1(D(), a); }
     static HWY_INLINE V log1p(V a) { return hn::Log1p(D(), a); }
+    static HWY_INLINE V min(V a, V b) { return hn::Min(a, b); }
+    static HWY_INLINE V max(V a, V b) { return hn::Max(a, b); }
+    static HWY_INLINE V floor(V a) { return hn::Floor(a); }
+    static HWY_INLINE V sqrt(V a) { return hn::Sqrt(a); }
+    // a^n for a >= 0: exp(n log a) where a > 0, 0 where a = 0 (n > 0), 1 for n = 0.
+    static HWY_INLINE V pow(V a, double n) {
+        if (n == 0.0) return splat(1.0);
+        return hn::IfThenElseZero(hn::Gt(a, hn::Zero(D())), hn::Exp(D(), hn::Mul(splat(n), hn::Log(D(), a))));
+    }
 };
 
 // The optical model and the accumulators, compiled for this target.
 #include "transfer/OpacityCorrection-inl.h"
 #include "core/integrate/march/Accumulators-inl.h"
+#include "core/sample/Trilinear-inl.h"
+#include "core/sample/GradientDifference-inl.h"
+#include "transfer/Shading-inl.h"
 
 // The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
 // segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
@@ -424,35 +436,15 @@ struct PacketTrilinearT {
         return hn::Load(d, out);
     }
 
+    // VolumeSampler::trilinear on lanes: the same templates (Trilinear-inl.h), the corners gathered.
     HWY_INLINE V operator()(V x, V y, V z) const {
-        const D d;
-        const V zero = hn::Zero(d), one = hn::Set(d, T(1));
+        using L = SimdLanes<T>;
         const V X[3] = {x, y, z};
         V cell[3], frac[3];
-        for (int a = 0; a < 3; ++a) {
-            const V u = hn::Min(hn::Max(hn::Mul(hn::Sub(X[a], org[a]), inv[a]), zero), maxi[a]);
-            if (flat[a]) {
-                cell[a] = zero;
-                frac[a] = zero;
-            } else {
-                cell[a] = hn::Min(hn::Floor(u), top[a]);
-                frac[a] = hn::Sub(u, cell[a]);
-            }
-        }
+        for (int a = 0; a < 3; ++a) cell_of<L>(clamped_index<L>(X[a], org[a], inv[a], maxi[a]), top[a], flat[a], cell[a], frac[a]);
         V f[8];
         corners(cell[0], cell[1], cell[2], f);
-        const V p = frac[0], q = frac[1], r = frac[2];
-        const V P = hn::Sub(one, p), Q = hn::Sub(one, q), R = hn::Sub(one, r);
-        V v = zero;
-        v = hn::Add(v, hn::Mul(f[0], hn::Mul(hn::Mul(P, Q), R)));
-        v = hn::Add(v, hn::Mul(f[1], hn::Mul(hn::Mul(p, Q), R)));
-        v = hn::Add(v, hn::Mul(f[2], hn::Mul(hn::Mul(p, q), R)));
-        v = hn::Add(v, hn::Mul(f[3], hn::Mul(hn::Mul(P, q), R)));
-        v = hn::Add(v, hn::Mul(f[4], hn::Mul(hn::Mul(P, Q), r)));
-        v = hn::Add(v, hn::Mul(f[5], hn::Mul(hn::Mul(p, Q), r)));
-        v = hn::Add(v, hn::Mul(f[6], hn::Mul(hn::Mul(p, q), r)));
-        v = hn::Add(v, hn::Mul(f[7], hn::Mul(hn::Mul(P, q), r)));
-        return v;
+        return trilinear_sum<L>(f, frac[0], frac[1], frac[2]);
     }
 };
 using PacketTrilinear = PacketTrilinearT<double>;

@@ -10,7 +10,11 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/Lanes.h"
+
 namespace volref {
+
+#include "transfer/PiecewiseLinear-inl.h"
 
 template <std::size_t N>
 class PiecewiseLinear {
@@ -24,9 +28,9 @@ public:
         if (it == x_.begin()) return y_.front();
         if (it == x_.end()) return y_.back();
         const std::size_t k = std::size_t(it - x_.begin());
-        const double w = (v - x_[k - 1]) / (x_[k] - x_[k - 1]);
+        const double w = row_weight<Scalar>(v, x_[k - 1], x_[k]);  // PiecewiseLinear-inl.h, shared with the packets
         Value out;
-        for (std::size_t c = 0; c < N; ++c) out[c] = y_[k - 1][c] + w * (y_[k][c] - y_[k - 1][c]);
+        for (std::size_t c = 0; c < N; ++c) out[c] = between_rows<Scalar>(w, y_[k - 1][c], y_[k][c]);
         return out;
     }
     const std::vector<double>& xs() const { return x_; }

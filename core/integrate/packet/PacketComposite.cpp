@@ -83,7 +83,7 @@ HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v, c
         t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
         t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
     }
-    t.w = hn::Div(hn::Sub(v, t.lo_x), hn::Sub(t.hi_x, t.lo_x));
+    t.w = row_weight<SimdLanes<T>>(v, t.lo_x, t.hi_x);  // PiecewiseLinear's formula (PiecewiseLinear-inl.h)
     return t;
 }
 
@@ -100,7 +100,7 @@ HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, in
         y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));
         y1 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.hi_row, s), c)));
     }
-    const VT<T> inner = hn::Add(y0, hn::Mul(t.w, hn::Sub(y1, y0)));
+    const VT<T> inner = between_rows<SimdLanes<T>>(t.w, y0, y1);
     const VT<T> first = hn::Set(d, ys[channel]), last = hn::Set(d, ys[(rows - 1) * stride + channel]);
     return hn::IfThenElse(t.below, first, hn::IfThenElse(t.above, last, inner));
 }

@@ -90,6 +90,7 @@ struct SimdLanes {
 #include "core/sample/Trilinear-inl.h"
 #include "core/sample/GradientDifference-inl.h"
 #include "transfer/Shading-inl.h"
+#include "transfer/PiecewiseLinear-inl.h"
 
 // The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
 // segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`

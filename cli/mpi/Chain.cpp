@@ -201,8 +201,12 @@ bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& b
     const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
     if (frame.rank != 0) return true;
     pixels.assign(P * 4, 0.0);
+    // The slot's own finish (the reference's composite_state, the fast profile's product_state); a
+    // composite's does not read the ray or its intervals (Frame::finish_reads_intervals).
+    const Ray no_ray{};
+    const std::vector<Interval> no_intervals;
     for (std::size_t px = 0; px < P; ++px) {
-        const glm::dvec4 rgba = composite_state::rgba(RayState::read(&final_state[px * S]));
+        const glm::dvec4 rgba = frame.finish(0, &no_ray, &no_intervals, RayState::read(&final_state[px * S])).rgba;
         for (int c = 0; c < 4; ++c) pixels[px * 4 + std::size_t(c)] = rgba[c];
     }
     return true;

@@ -44,8 +44,8 @@ using namespace volref::mpi;
 // What volref-mpi does not render yet (docs/conventions.md §14): one-line errors naming the key.
 void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    if (!r.reference_integrators())
-        throw Error("render.profile: volref-mpi supports \"reference\" only (mirror and fast profiles are not supported yet)");
+    if (!r.reference_integrators() && !(r.profile == ProfileId::Fast && r.profile_rules.empty()))
+        throw Error("render.profile: volref-mpi supports \"reference\" and \"fast\" only (mirror profiles are not supported yet)");
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];
         const std::string key = volume_key(scene, k);

@@ -77,7 +77,7 @@ PixelValue CompositeIntegrator::whole_ray(const Ray& ray, const std::vector<Inte
 void CompositeIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                                          RayState& state) const {
     if (state.stopped != 0.0) return;
-    if (packet_ && packet_->fast) return composite_packet(*packet_, &ray, &intervals, nullptr, 1, &span, &state);  // throws
+    if (packet_ && packet_->fast) return composite_packet(*packet_, &ray, &intervals, nullptr, 1, &span, &state);
     NoRecording rec;
     if (ctx_.render.order == CompositeOrder::FrontToBack) {
         FrontToBack<Scalar> acc;
@@ -101,11 +101,14 @@ void CompositeIntegrator::integrate_span_packet(const Ray* rays, const std::vect
     else Integrator::integrate_span_packet(rays, intervals, spans, states, count);
 }
 
-void CompositeIntegrator::merge_spans(RayState& front, const RayState& back) const { composite_state::merge(front, back); }
+void CompositeIntegrator::merge_spans(RayState& front, const RayState& back) const {
+    if (packet_ && packet_->fast) product_state::merge(front, back);
+    else composite_state::merge(front, back);
+}
 
 PixelValue CompositeIntegrator::finish(const Ray&, const std::vector<Interval>&, const RayState& state) const {
     PixelValue out;
-    out.rgba = composite_state::rgba(state);
+    out.rgba = packet_ && packet_->fast ? product_state::rgba(state) : composite_state::rgba(state);
     return out;
 }
 

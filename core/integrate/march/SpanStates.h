@@ -54,6 +54,33 @@ inline glm::dvec4 rgba(const RayState& s) {
 
 }  // namespace composite_state
 
+// The fast profile's composite (FrontToBack<SimdLanes<float>, Product>, packet/FastProfile.h): v[0] the
+// transmittance T (a float), v[2..4] the colour (floats), v[8] opaque, v[9] 1 once the state holds a
+// T (a fresh RayState, all zeros, stands for T = 1). Resumed in order, spans give the whole ray's
+// floats bit for bit; merged, a part behind is put in double: C = C_f + T_f C_b, T = T_f T_b.
+namespace product_state {
+
+// State value k as the float lanes load it.
+inline double load_value(const RayState& s, int k) { return k == 0 && s.v[9] == 0.0 ? 1.0 : s.v[k]; }
+
+inline void merge(RayState& front, const RayState& back) {
+    if (front.stopped != 0.0) return;
+    const double Tf = load_value(front, 0), Tb = load_value(back, 0);
+    for (int i = 0; i < 3; ++i) front.v[2 + i] = front.v[2 + i] + Tf * back.v[2 + i];
+    front.v[0] = Tf * Tb;
+    front.v[9] = 1.0;
+    front.v[8] = back.v[8];
+    front.stopped = back.stopped;
+}
+
+// The pixel as the float lanes give it: (C, A) with A = 1 where opaque, else 1 - T in float.
+inline glm::dvec4 rgba(const RayState& s) {
+    const double A = s.v[8] != 0.0 ? 1.0 : double(1.0f - float(load_value(s, 0)));
+    return glm::dvec4(s.v[2], s.v[3], s.v[4], A);
+}
+
+}  // namespace product_state
+
 // MIP / MinIP: v[0] the extremum, v[1] where, v[2] seen (0 / 1), v[3..6] the pixel there (classified by
 // whoever holds the sample: the span that took it).
 namespace extremum_state {

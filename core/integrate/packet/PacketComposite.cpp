@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "core/Error.h"
+#include "core/integrate/march/SpanStates.h"
 #include "core/integrate/packet/PacketComposite.h"
 #include "core/integrate/packet/PacketKernels-inl.h"
 
@@ -210,11 +211,12 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     // takes no sample.
     bool stopped[RayPacketT<T>::kLanes] = {};
     constexpr int kState = FrontToBack<SL, kRule>::kStateValues;
-    if constexpr (!kFast) {
-        if (states) {
+    {
+        if (states) {  // the reference's composite_state, the fast profile's product_state (march/SpanStates.h)
             V init[kState];
             for (int k = 0; k < kState; ++k) {
-                for (std::size_t l = 0; l < L; ++l) buf[l] = int(l) < count ? T(states[l].v[k]) : T(0);
+                for (std::size_t l = 0; l < L; ++l)
+                    buf[l] = int(l) < count ? T(kFast ? product_state::load_value(states[l], k) : states[l].v[k]) : T(kFast && k == 0);
                 init[k] = hn::Load(d, buf);
             }
             for (std::size_t l = 0; l < L; ++l) buf[l] = int(l) < count && states[l].v[8] != 0.0 ? T(1) : T(0);
@@ -271,7 +273,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             }
         }
     }
-    if constexpr (!kFast) {
+    {
         if (states) {  // each lane's state out
             V saved[kState];
             M opaque;
@@ -284,6 +286,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
             for (int l = 0; l < count && l < int(L); ++l) {
                 states[l].v[8] = buf[l] != T(0) ? 1.0 : 0.0;
                 states[l].stopped = stopped[l] ? 1.0 : 0.0;
+                if constexpr (kFast) states[l].v[9] = 1.0;  // holds a T
             }
             return;
         }
@@ -327,7 +330,6 @@ HWY_EXPORT(CompositePacket);
 
 void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                       PixelValue* out, int count, const RaySpan* spans, RayState* states) {
-    if (states && in.fast) throw Error("render.profile: the fast profile cannot be integrated in spans");
     HWY_DYNAMIC_DISPATCH(CompositePacket)(in, rays, intervals, out, count, spans, states);
 }
 }  // namespace volref

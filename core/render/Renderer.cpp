@@ -68,6 +68,13 @@ Volume load_volume(const VolumeSpec& spec) {
     return v;
 }
 
+int tile_side(int width, int height, int threads) {
+    int T = conventions::kTileSize;
+    auto tiles = [&](int side) { return std::int64_t((width + side - 1) / side) * std::int64_t((height + side - 1) / side); };
+    while (T > conventions::kMinTileSize && tiles(T) < std::int64_t(conventions::kTilesPerThread) * std::max(1, threads)) T /= 2;
+    return T;
+}
+
 double world_step(const RenderSpec& render, const Volume& volume) {
     if (render.step_units == StepUnits::World) return render.step;
     return render.step * std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
@@ -199,7 +206,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     if (prepared.writes_fault()) channels.push_back("fault");  // issue 28: 1 where the mirrored program does not finish
     Image image(W, H, channels);
 
-    const int T = options.tile_size > 0 ? options.tile_size : conventions::kTileSize;
+    const int T = options.tile_size > 0 ? options.tile_size : tile_side(W, H, arena.max_concurrency());
     const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
     for (int frame = 0; frame < std::max(1, options.frames); ++frame) {
     const auto frame_start = Clock::now();

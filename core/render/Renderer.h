@@ -27,7 +27,7 @@ struct RenderOptions {
     // Fixed-step integrator: also render at step / 2 and write the step-doubling estimate as the
     // "error" channel (StepDoubling.h). The adaptive integrator always writes its own estimate.
     bool error_estimate = false;
-    int tile_size = 0;      // pixels per tile side; 0: conventions::kTileSize (the image does not depend on it)
+    int tile_size = 0;      // pixels per tile side; 0: tile_side() (the image does not depend on it)
     int frames = 1;         // render the frame this many times after one set-up (volref render --repeat)
     bool count_samples = false;  // fill RenderStats::sample_positions (one extra pass, not timed)
 };
@@ -38,6 +38,10 @@ struct RenderOptions {
 Volume load_volume(const VolumeSpec& spec);
 // The same, shared: the volume in memory itself (not copied), or a new one.
 std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec);
+
+// The tile side render_scene uses for a width x height image on `threads` threads: conventions::kTileSize,
+// halved down to kMinTileSize while there are fewer than kTilesPerThread tiles per thread.
+int tile_side(int width, int height, int threads);
 
 // The world-space step: render.step, times the smallest spacing when step_units is voxel.
 double world_step(const RenderSpec& render, const Volume& volume);

@@ -51,8 +51,8 @@ public:
 
     // Resumable (march/RaySpan.h): front to back resumes FrontToBack's state (the packet path where it
     // applies); back to front puts each span's part behind the state (composite_state, SpanStates.h).
-    // (Not the fast profile: its float transmittance product has no state in this layout yet.)
-    bool resumable() const override { return true; }  // the fast profile too (SpanStates.h, product_state)
+    // The fast profile resumes its float transmittance product (product_state, SpanStates.h).
+    bool resumable() const override { return true; }
     void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                         RayState& state) const override;
     void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,

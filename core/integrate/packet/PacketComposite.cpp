@@ -137,12 +137,8 @@ struct PacketGradient {
     }
 };
 
-// Shader::shade for a packet (the same template, transfer/Shading-inl.h): m = the material colour,
-// g = grad f, view = -direction, depth = t.
-template <typename T>
-HWY_INLINE void shade(const PacketCompositeInputs& in, VT<T> m[3], const VT<T> g[3], const VT<T> view[3], VT<T> depth) {
-    using L = SimdLanes<T>;
-    using V = VT<T>;
+// The packet's shading coefficients as the shading template reads them (built once per packet).
+HWY_INLINE ShadingConstants shading_constants(const PacketCompositeInputs& in) {
     ShadingConstants k;
     k.ka = in.ka;
     k.kd = in.kd;
@@ -152,6 +148,16 @@ HWY_INLINE void shade(const PacketCompositeInputs& in, VT<T> m[3], const VT<T> g
     k.kl = in.kl;
     k.two_sided = in.two_sided;
     k.phong = in.phong;
+    return k;
+}
+
+// Shader::shade for a packet (the same template, transfer/Shading-inl.h): m = the material colour,
+// g = grad f, view = -direction, depth = t.
+template <typename T>
+HWY_INLINE void shade(const PacketCompositeInputs& in, const ShadingConstants& k, VT<T> m[3], const VT<T> g[3],
+                      const VT<T> view[3], VT<T> depth) {
+    using L = SimdLanes<T>;
+    using V = VT<T>;
     auto light_at = [&](int i, V* Ld, double* I) HWY_ATTR {
         const PacketCompositeInputs::Light& light = in.lights[i];
         for (int c = 0; c < 3; ++c) {
@@ -196,6 +202,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                                  in.grid.dims, origin, in.grid.inv_spacing);
     const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}, local};
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
+    const ShadingConstants shading = shading_constants(in);
 
     const V zero = hn::Zero(d), one = hn::Set(d, T(1));
     // The reference composites with the compensated optical depth, the fast profile with a
@@ -259,7 +266,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                       table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, color_reg)};
             if (in.shaded) {
                 if (!have_gradient) gradient(P, v, g);
-                shade<T>(in, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
+                shade<T>(in, shading, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
             }
             acc.add(o.visible, o.solid, o.tau, o.alpha, m);
             const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));

@@ -210,7 +210,11 @@ private:
         using adaptive_detail::max_abs;
         const double T0 = acc_.transmittance();
         const double budget = tolerance_ * (b - a) / total_;
-        std::vector<Candidate> open{candidate(a, b, 0, evaluate(a, b))};
+        // The candidates live in a vector kept by the ray (cleared, its capacity reused): one allocation
+        // per ray rather than several per piece; many threads allocating at once share the allocator.
+        std::vector<Candidate>& open = open_;
+        open.clear();
+        open.push_back(candidate(a, b, 0, evaluate(a, b)));
         for (;;) {
             double sum = 0.0, worst = -1.0;
             std::size_t at = 0;
@@ -248,6 +252,7 @@ private:
     Accumulator acc_;
     double colour_bound_ = 1.0;  // K: the largest colour seen (at least 1), for the tau part of the budget
     std::vector<LeafRecord> leaves_;
+    std::vector<Candidate> open_;  // integrate_piece's candidates (scratch)
     long rules_left_ = conventions::kAdaptiveMaxRulesPerRay;  // work bound of the ray
     double unresolved_T_ = 0.0;  // the transmittance in front of the first piece accepted unresolved
     bool opaque_ = false;

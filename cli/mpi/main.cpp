@@ -46,6 +46,9 @@ void check_supported(const Scene& scene) {
     const RenderSpec& r = scene.render;
     if (!r.reference_integrators() && !(r.profile == ProfileId::Fast && r.profile_rules.empty()))
         throw Error("render.profile: volref-mpi supports \"reference\" and \"fast\" only (mirror profiles are not supported yet)");
+    // Each rank would build its table over its own brick's values, so ranks would read different tables.
+    if (r.profile_options.preintegration > 0)
+        throw Error("render.profile_options.preintegration: volref-mpi does not render pre-integrated segments yet");
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];
         const std::string key = volume_key(scene, k);

@@ -20,6 +20,7 @@
 #include "core/integrate/profiles/VtkJsIntegrator.h"
 #include "core/integrate/profiles/VtkFixedPointRenderer.h"
 #include "core/io/VolumeReader.h"
+#include "core/scene/SceneNames.h"
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
 #include "geometry/ShellTessellation.h"
@@ -222,6 +223,9 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         if (!is_composite(p) && !is_extremum(p))
             fast_profile_unavailable("this scene's projection is not one of them");
         if (scene.render.integrator != IntegrationMethod::Fixed) fast_profile_unavailable("this scene asks for the adaptive integrator");
+        if (scene.render.profile_options.preintegration > 0 && !is_composite(p))
+            throw Error("render.profile_options.preintegration: pre-integrated segments composite (the projection "
+                        "\"composite\"); this scene's projection is \"" + std::string(scene_names::name_of(scene_names::kProjections, p)) + "\"");
     }
 
     // Only what the scene uses is built: gradients for shading or gradient-based classification,

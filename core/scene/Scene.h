@@ -218,6 +218,9 @@ struct ProfileOptions {
     // data range to unsigned shorts (rounded to nearest) read as v / 65535 (render.profile_options.
     // texture_format "unorm16"), or the values themselves ("float", the default).
     bool data_unorm16 = false;
+    // fast (issue 31; transfer/PreIntegration.h): pre-integrated segments, the table's intervals per axis
+    // (render.profile_options.preintegration); 0: off, samples at the segments' midpoints.
+    int preintegration = 0;
 };
 
 // render.profile written as an object (issue 29): a preset (`base`) and the rules the scene sets over it.

@@ -22,6 +22,7 @@
 #include "core/io/InputFile.h"
 #include "core/scene/JsonReader.h"
 #include "core/scene/SceneNames.h"
+#include "transfer/PreIntegration.h"
 
 namespace volref {
 
@@ -878,9 +879,14 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, names::kVtkJsRayBoxes);
         s.profile_options.mip_correction = po.boolean("mip_correction", true);
         s.profile_options.subpixel_bits = int(po.integer("subpixel_bits", 4, Range::closed(0, 23)));
+    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::Fast) {  // issue 31
+        ObjectReader po(*o, r.path("profile_options"), ctx);
+        po.allow({"preintegration"});
+        s.profile_options.preintegration =
+            int(po.integer("preintegration", 0, Range::closed(2, kPreIntegrationMaxIntervals)));
     } else if (const Json* o = r.find("profile_options")) {
         if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic && s.profile != ProfileId::VtkGpu)
-            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu and vtk-js profiles have options");
+            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu, vtk-js and fast profiles have options");
         ObjectReader po(*o, r.path("profile_options"), ctx);
         if (s.profile == ProfileId::GlslBasic) po.allow({"intensity", "texture_unit", "texture_band"});
         else if (s.profile == ProfileId::VtkGpu) po.allow({"texture_unit", "texture_band"});

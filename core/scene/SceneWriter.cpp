@@ -230,6 +230,7 @@ json profile_options_json(const RenderSpec& r) {
     if (r.profile == ProfileId::CudaCurvilinear && o.kernel == ProfileOptions::Kernel::Double && !rules.arithmetic)
         j["kernel"] = name_of(names::kKernels, o.kernel);  // issue 28
     if (r.profile == ProfileId::CudaCurvilinear && o.tricubic) j["tricubic"] = true;
+    if (r.profile == ProfileId::Fast && o.preintegration > 0) j["preintegration"] = o.preintegration;  // issue 31
     if (r.profile == ProfileId::VtkJs)  // issue 22
         j = {{"jitter", o.jitter},
              {"fixed_normal", o.fixed_normal},

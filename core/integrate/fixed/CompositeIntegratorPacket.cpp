@@ -104,6 +104,8 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();
         make_fast(in, v, cached, *fast_copies_);
+        if (ctx.render.profile_options.preintegration > 0)
+            make_preintegrated(in, *tf, v, ctx.render.profile_options.preintegration, *fast_copies_);
     }
     packet_ = in;
 }

@@ -1,5 +1,7 @@
 #include "core/integrate/packet/FastProfile.h"
 
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -7,6 +9,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
+#include "transfer/TransferFunction.h"
 
 namespace volref {
 
@@ -89,6 +92,37 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
     in.fast = true;
     in.termination.test_transmittance = true;
     in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;
+}
+
+void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, const Volume& volume, int n, FloatCopies& copies) {
+    auto refuse = [](const std::string& why) {
+        throw Error("render.profile_options.preintegration: pre-integrated segments " + why +
+                    " (remove preintegration, or use render.profile \"reference\")");
+    };
+    if (in.shaded) refuse("do not shade (the table integrates the transfer function of the value alone)");
+    if (in.gradient_opacity_rows > 0) refuse("do not take gradient-magnitude opacity");
+    // Every coordinate a sample can take: the trilinear field stays within the voxels' range; the rows
+    // beyond it are included so that the table's ends are the transfer function's.
+    const std::array<double, 2> range = volume.value_range();
+    double lo = std::min(tf.coordinate(range[0]), tf.coordinate(range[1]));
+    double hi = std::max(tf.coordinate(range[0]), tf.coordinate(range[1]));
+    for (const auto* xs : {&tf.opacity_function().xs(), &tf.color_function().xs()})
+        if (!xs->empty()) {
+            lo = std::min(lo, xs->front());
+            hi = std::max(hi, xs->back());
+        }
+    const std::size_t entries = (std::size_t(n) + 1) * (std::size_t(n) + 1) * 4;
+    check_memory(entries * sizeof(float), "render.profile_options.preintegration: the pre-integration table");
+    copies.preintegration = build_preintegration_table(tf, lo, hi, in.step, n);
+    const PreIntegrationTable& t = copies.preintegration;
+    in.preintegration = t.entries.data();
+    in.pre_n = t.n;
+    in.pre_x0 = t.x0;
+    in.pre_inv_dx = 1.0 / t.dx;
+    // Empty space is skipped only where a segment's ends lie in empty macrocells too: h / 2 is within
+    // pre_skip_margin macrocell edges of the midpoint (ForwardSegmentWalk::set_skip_margin).
+    const double edge = conventions::kMacrocellSize * std::min({volume.spacing[0], volume.spacing[1], volume.spacing[2]});
+    in.pre_skip_margin = std::max(1, int(std::ceil(0.5 * in.step / edge)));
 }
 
 }  // namespace volref

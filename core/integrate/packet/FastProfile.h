@@ -19,6 +19,7 @@
 
 #include "core/grid/Volume.h"
 #include "core/integrate/packet/PacketComposite.h"
+#include "transfer/PreIntegration.h"
 
 namespace volref {
 
@@ -26,6 +27,7 @@ struct FloatCopies {
     std::vector<float> voxels;                      // empty when the volume's own storage serves
     std::vector<float> color_x, color_y, opacity_x, opacity_y, gradient_opacity_x, gradient_opacity_y;
     std::vector<float> cached_gradient[3];
+    PreIntegrationTable preintegration;  // render.profile_options.preintegration
 };
 
 // The voxels the float kernels gather: the volume's own storage when it is a 32-bit-gathered type
@@ -37,6 +39,13 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
 // Fills in.tables_float (and the float voxels and cached gradients) from the double inputs; sets
 // in.fast and the transmittance cutoff of in.termination. `cached` are the cached gradient components (Cached) or null.
 void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies);
+
+// Pre-integrated segments (render.profile_options.preintegration = n > 0; transfer/PreIntegration.h):
+// builds the table over the coordinates the volume's values can take and the transfer function's rows,
+// for segments of the render's step, into `copies`, and points `in` at it. Refuses (an error naming
+// render.profile_options.preintegration) a shaded scene or gradient-magnitude opacity: the table
+// integrates a(x) and c(x) of the value alone.
+void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, const Volume& volume, int n, FloatCopies& copies);
 
 // "render.profile: \"fast\" ...: <reason>; use \"reference\"" (the one-line error of a scene the
 // fast path does not take).

@@ -6,6 +6,7 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+#include <limits>
 #include <type_traits>
 
 #include "core/Error.h"
@@ -171,6 +172,65 @@ HWY_INLINE void shade(const PacketCompositeInputs& in, const ShadingConstants& k
                    [](int, const LightLanes<L>&) HWY_ATTR {});
 }
 
+// One pre-integrated segment per lane (transfer/PreIntegration.h; conventions section 9b): the values
+// at its ends a = t - len / 2 and b = t + len / 2 (the back end's trilinear sample; the front end's is
+// the lane's previous back value where the segment starts within 1e-3 len of where the previous one
+// ended, else sampled), their coordinates x_f, x_b, the table read bilinearly at (x_f, x_b) (indices
+// clamped to [0, n]), tau = max(sigma_bar, 0) len, and the colour c_bar. Float lanes only.
+template <typename T>
+struct PreSample {
+    hn::Mask<DT<T>> visible;
+    VT<T> tau, colour[3];
+};
+
+template <typename T, class Trilinear>
+HWY_INLINE PreSample<T> pre_sample(const PacketCompositeInputs& in, const Trilinear& trilinear, VT<T> Ox, VT<T> Oy, VT<T> Oz,
+                                   VT<T> Dx, VT<T> Dy, VT<T> Dz, VT<T> t, VT<T> seg, hn::Mask<DT<T>> alive, VT<T>& prev_end,
+                                   VT<T>& prev_value) {
+    using D = DT<T>;
+    using V = VT<T>;
+    const D d;
+    const hn::RebindToSigned<D> di;
+    const V half = hn::Set(d, T(0.5)), zero = hn::Zero(d);
+    const V ta = hn::Sub(t, hn::Mul(half, seg)), tb = hn::Add(t, hn::Mul(half, seg));
+    const V vb = trilinear(hn::Add(Ox, hn::Mul(tb, Dx)), hn::Add(Oy, hn::Mul(tb, Dy)), hn::Add(Oz, hn::Mul(tb, Dz)));
+    const auto joined = hn::Le(hn::Abs(hn::Sub(ta, prev_end)), hn::Mul(hn::Set(d, T(1e-3)), seg));
+    V vf = prev_value;
+    if (!hn::AllTrue(d, hn::Or(joined, hn::Not(alive)))) {
+        const V va = trilinear(hn::Add(Ox, hn::Mul(ta, Dx)), hn::Add(Oy, hn::Mul(ta, Dy)), hn::Add(Oz, hn::Mul(ta, Dz)));
+        vf = hn::IfThenElse(joined, prev_value, va);
+    }
+    prev_end = hn::IfThenElse(alive, tb, prev_end);
+    prev_value = hn::IfThenElse(alive, vb, prev_value);
+    auto coordinate = [&](V v) HWY_ATTR {
+        const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
+        return hn::Min(hn::Max(hn::Mul(hn::Sub(x, hn::Set(d, T(in.pre_x0))), hn::Set(d, T(in.pre_inv_dx))), zero),
+                       hn::Set(d, T(in.pre_n)));
+    };
+    const V fi = coordinate(vf), fj = coordinate(vb);
+    const V last = hn::Set(d, T(in.pre_n - 1));
+    const V i0 = hn::Min(hn::Floor(fi), last), j0 = hn::Min(hn::Floor(fj), last);
+    const V wi = hn::Sub(fi, i0), wj = hn::Sub(fj, j0);
+    const int row = 4 * (in.pre_n + 1);
+    const auto idx = hn::Add(hn::Mul(hn::ConvertTo(di, i0), hn::Set(di, row)), hn::Mul(hn::ConvertTo(di, j0), hn::Set(di, 4)));
+    const auto idx_down = hn::Add(idx, hn::Set(di, row));
+    const auto next = hn::Set(di, 4);
+    V e[4];
+    for (int c = 0; c < 4; ++c) {
+        const T* base = in.preintegration + c;
+        const V e00 = hn::GatherIndex(d, base, idx), e01 = hn::GatherIndex(d, base, hn::Add(idx, next));
+        const V e10 = hn::GatherIndex(d, base, idx_down), e11 = hn::GatherIndex(d, base, hn::Add(idx_down, next));
+        const V top = hn::Add(e00, hn::Mul(wj, hn::Sub(e01, e00)));
+        const V bottom = hn::Add(e10, hn::Mul(wj, hn::Sub(e11, e10)));
+        e[c] = hn::Add(top, hn::Mul(wi, hn::Sub(bottom, top)));
+    }
+    PreSample<T> s;
+    s.tau = hn::Mul(hn::Max(e[0], zero), seg);
+    s.visible = hn::And(alive, hn::Gt(s.tau, zero));
+    for (int c = 0; c < 3; ++c) s.colour[c] = e[1 + c];
+    return s;
+}
+
 template <typename T>
 void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count, const RaySpan* spans, RayState* states) {
@@ -184,7 +244,9 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const double* local = kFast ? in.grid.origin : nullptr;
     const double zero_origin[3] = {0.0, 0.0, 0.0};
     const double* origin = kFast ? zero_origin : in.grid.origin;
-    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local, spans);
+    const bool pre = kFast && in.preintegration != nullptr;  // pre-integrated segments (FastProfile.h)
+    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local, spans,
+                         pre ? in.pre_skip_margin : 0);
     const std::size_t L = packet.lanes;
     HWY_ALIGN T buf[RayPacketT<T>::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
@@ -236,9 +298,29 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         }
     }
 
+    // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
+    V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
         const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+        if constexpr (kFast) {
+            if (pre) {
+                const PreSample<T> s = pre_sample<T>(in, trilinear, Ox, Oy, Oz, Dx, Dy, Dz, t, seg, alive, prev_end, prev_value);
+                if (hn::AllFalse(d, s.visible)) continue;
+                const V alpha = segment_alpha<SL>(s.tau);
+                acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
+                const M stop = acc.stops(s.visible, in.termination);
+                if (!hn::AllFalse(d, stop)) {
+                    hn::Store(hn::IfThenElseZero(stop, one), d, buf);
+                    for (std::size_t l = 0; l < L; ++l)
+                        if (buf[l] != T(0)) {
+                            stopped[l] = true;
+                            packet.retire(l);
+                        }
+                }
+                continue;
+            }
+        }
         const V P[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
         const V v = trilinear(P[0], P[1], P[2]);
         // Transfer function.

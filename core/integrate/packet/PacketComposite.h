@@ -103,6 +103,13 @@ struct PacketCompositeInputs {
     double zero_gradient_tolerance = 0;
     int light_count = 0;
     Light lights[kMaxPacketLights];
+
+    // The fast profile's pre-integrated segments (FastProfile.h, transfer/PreIntegration.h): the table's
+    // entries (4 floats per node pair), its n + 1 nodes per axis at pre_x0 + i / pre_inv_dx; null: off.
+    const float* preintegration = nullptr;
+    int pre_n = 0;
+    double pre_x0 = 0.0, pre_inv_dx = 1.0;
+    int pre_skip_margin = 0;  // ForwardSegmentWalk::set_skip_margin for the segments' ends
 };
 
 // Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count). With `states`

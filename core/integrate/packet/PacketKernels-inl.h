@@ -119,7 +119,7 @@ struct RayPacketT {
     // kLanes values the caller keeps up to date (NaN before a lane's first sample).
     RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
                const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true,
-               const double* local_origin = nullptr, const RaySpan* spans = nullptr) {
+               const double* local_origin = nullptr, const RaySpan* spans = nullptr, int skip_margin = 0) {
         lanes = hn::Lanes(hn::ScalableTag<T>());
         this->step = step;
         for (std::size_t l = 0; l < lanes; ++l) {
@@ -145,6 +145,7 @@ struct RayPacketT {
             if (real)
                 walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span)
                                    : ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
+            if (real && skip_margin > 0) walk[l].set_skip_margin(skip_margin);
         }
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live

@@ -47,6 +47,10 @@ ap.add_argument("--threads", default="1 2")
 ap.add_argument("--ref-step", type=float, default=0.125)
 ap.add_argument("--reference-steps", default="0.5 1 2 3 4")
 ap.add_argument("--fast-steps", default="1 2 3 4 6")
+# issue 31: the fast profile with pre-integrated segments (render.profile_options.preintegration = the table's
+# intervals per axis), named "pre<table>-<step>"
+ap.add_argument("--pre-steps", default="2 3 4 6")
+ap.add_argument("--pre-table", type=int, default=256)
 ap.add_argument("--command", default="bench/speed_at_equal_error.sh")
 a = ap.parse_args()
 
@@ -56,7 +60,15 @@ for sub in ("bin", "images", "runs"):
     os.makedirs(os.path.join(out, sub))
 scene = os.path.join(HERE, "scenes", "composite.json")
 threads = [int(t) for t in a.threads.split()]
-settings = [("reference", float(s)) for s in a.reference_steps.split()] + [("fast", float(s)) for s in a.fast_steps.split()]
+PRE = "pre%d" % a.pre_table
+settings = [("reference", float(s)) for s in a.reference_steps.split()] + [("fast", float(s)) for s in a.fast_steps.split()] + \
+    [(PRE, float(s)) for s in a.pre_steps.split()]
+
+
+def profile_args(profile):
+    if profile == PRE:
+        return ["--set", "render.profile=fast", "--set", "render.profile_options.preintegration=%d" % a.pre_table]
+    return ["--set", "render.profile=" + profile]
 start = time.time()
 
 
@@ -113,8 +125,8 @@ for rep in range(1, a.reps + 1):
         for profile, step in settings:
             name = "%s-%s" % (profile, step_text(step))
             r = volref(["render", scene, "-o", os.path.join(out, "images", "%s-t%d.exr" % (name, t)), "--threads", str(t),
-                        "--timing", "--repeat", str(a.frames), "--set", "render.profile=" + profile,
-                        "--set", "render.step=%g" % step] + source)
+                        "--timing", "--repeat", str(a.frames)] + profile_args(profile) +
+                       ["--set", "render.step=%g" % step] + source)
             frames.setdefault((name, t), []).extend(r["frames_s"])
             samples[name] = r["samples"]
             with open(os.path.join(out, "runs", "%s-t%d-%d.json" % (name, t, rep)), "w") as f:
@@ -194,7 +206,7 @@ if len(threads) >= 2:
     t1, t2 = threads[0], threads[1]
     sc = ["%s %.2fx" % (n, med(n, t1) / med(n, t2)) for n in names]
     summary.append("- **Threads %d -> %d** (target at least 1.8x): %s; VTK %.2fx." % (t1, t2, "; ".join(sc), med("vtk", t1) / med("vtk", t2)))
-for profile in ("reference", "fast"):
+for profile in ("reference", "fast", PRE):
     steps = [s for p, s in settings if p == profile]
     pairs = [(x, y) for x in steps for y in steps if abs(y - 2 * x) < 1e-12]
     if pairs:

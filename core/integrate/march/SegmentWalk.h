@@ -130,7 +130,7 @@ public:
     static constexpr std::int64_t kMaxRun = 16 * conventions::kCancellationPollSamples;
 
 private:
-    static constexpr std::int64_t kMinVisitedRun = 16;
+    static constexpr std::int64_t kMinVisitedRun = 48;
 
     // Moves to the next non-empty run [k_, end_) of segments to visit; false when there is none.
     bool advance() {

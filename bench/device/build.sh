@@ -16,7 +16,7 @@ P=$(cd "$(dirname "$0")/../.." && pwd); B=$(cd "${1:-$P/build}" && pwd); D=$P/be
 S=$(mktemp -d); trap 'rm -rf "$S"' EXIT
 mkdir -p "$S/bin" "$S/lib" "$S/root" "$C"
 CXX="g++ -O3 -DNDEBUG -ffp-contract=off -std=c++20 -I$P"
-$CXX -o "$S/bin/probe" "$D/probe.cpp" -L"$B" -lvolref_core -Wl,-rpath,'$ORIGIN/../lib'
+$CXX -o "$S/bin/probe" "$D/probe.cpp" -L"$B" -lvolref_core -lhwy -Wl,-rpath,'$ORIGIN/../lib'
 $CXX -DOMPI_SKIP_MPICXX=1 -I/usr/lib/x86_64-linux-gnu/openmpi/include -o "$S/bin/volref-mpi" "$P"/cli/mpi/*.cpp \
   "$D/no_writer.cpp" -L"$B" -lvolref_core -ltbb -lmpi -Wl,-rpath,'$ORIGIN/../lib'
 cp /usr/bin/orterun /usr/bin/orted "$S/bin/"

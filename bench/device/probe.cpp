@@ -1,5 +1,7 @@
 // Thread scaling of render_scene: scale_probe of ../shared/gpu/h100/tools with a per-job tile side.
 //   probe FRAMES THREADS(1,2,..) SCENE [--set k=v]... [--tile N] [-- SCENE ...]
+// PROBE_NO_AVX512=1: Highway's dispatch leaves out AVX-512 (hwy::SetSupportedTargetsForTest), so the
+// packets run on AVX2 (8 float / 4 double lanes) on a CPU that has AVX-512 (16 / 8).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -7,6 +9,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include <hwy/targets.h>
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 int main(int argc, char** argv) {
@@ -24,6 +27,8 @@ int main(int argc, char** argv) {
         jobs.push_back({a, {}, 0});
     }
     std::fprintf(stderr, "hardware_concurrency %u\n", std::thread::hardware_concurrency());
+    if (std::getenv("PROBE_NO_AVX512")) hwy::SetSupportedTargetsForTest(hwy::SupportedTargets() & ~(HWY_AVX3 | HWY_AVX3_DL));
+    const long long targets = hwy::SupportedTargets();
     for (const Job& j : jobs) {
         const volref::Scene scene = volref::load_scene(j.scene, j.sets);
         std::string label = j.scene; for (auto& s : j.sets) label += " " + s;
@@ -32,8 +37,8 @@ int main(int argc, char** argv) {
             volref::RenderStats st;
             volref::render_scene(scene, o, &st);
             std::vector<double> f = st.frames_s; std::sort(f.begin(), f.end());
-            std::printf("{\"scene\": \"%s\", \"tile\": %d, \"threads\": %d, \"setup_s\": %.4f, \"median_s\": %.5f, \"min_s\": %.5f}\n",
-                        label.c_str(), j.tile ? j.tile : volref::tile_side(scene.image.width, scene.image.height, t), t, st.setup_s, f[f.size() / 2], f[0]);
+            std::printf("{\"targets\": %lld, \"scene\": \"%s\", \"tile\": %d, \"threads\": %d, \"setup_s\": %.4f, \"median_s\": %.5f, \"min_s\": %.5f}\n",
+                        targets, label.c_str(), j.tile ? j.tile : volref::tile_side(scene.image.width, scene.image.height, t), t, st.setup_s, f[f.size() / 2], f[0]);
             std::fflush(stdout);
         }
     }

@@ -72,6 +72,8 @@ public:
     // kMaxEmptyRadius (also when no macrocell is non-empty).
     std::int64_t empty_radius(const Index& m) const { return inside(m) ? empty_radius_[linear(m)] : 0; }
     static constexpr std::int64_t kMaxEmptyRadius = 255;
+    // Every macrocell's empty_radius, at m0 + counts0 (m1 + counts1 m2) (the fast profile's packets).
+    const std::vector<std::uint8_t>& empty_radii() const { return empty_radius_; }
     // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
     // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
     // integrator checks it against macrocell_at. exit_distance with r > 1: where the ray leaves the box

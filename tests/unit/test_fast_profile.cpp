@@ -191,6 +191,35 @@ TEST(FastProfile, SameImageForAnySimdOptionThreadsAndSkipping) {
     }
 }
 
+// Skipping on the float lanes (PacketKernels-inl.h, VectorSkip) passes over samples in empty boxes
+// only: the image is the image without skipping, bit for bit, at steps shorter and longer than a
+// macrocell, with an origin and spacings that are not 1, a clip plane that cuts rays into two
+// intervals, and bounds larger than the grid (samples beyond it clamp into its boundary cells).
+TEST(FastProfile, VectorSkipIsExact) {
+    Scene s = ml_scene();
+    s.volume().transfer.opacity = {{0.0, 0.0}, {0.46, 0.0}, {0.5, 0.7}, {0.54, 0.0}};
+    s.render.profile = ProfileId::Fast;
+    s.render.step_units = StepUnits::Voxel;
+    for (int variant = 0; variant < 3; ++variant) {
+        if (variant == 1) s.volume().clip_planes = {ClipPlaneSpec{glm::dvec3(5.0, 12.0, 10.0), glm::dvec3(0.3, -1.0, 0.2)}};
+        if (variant == 2) {
+            s.volume().clip_planes.clear();
+            s.volume().bounds.type = BoundsSpec::Type::Box;
+            s.volume().bounds.min = glm::dvec3(-6.0, -1.0, 0.0);
+            s.volume().bounds.max = glm::dvec3(16.0, 22.0, 22.0);
+        }
+        for (double step : {0.3, 1.0, 2.5, 7.0, 19.0}) {
+            s.render.step = step;
+            const Image a = render_scene(s, {.threads = 1}), b = render_scene(s, {.threads = 2, .empty_space_skipping = false});
+            double alpha = 0.0;
+            for (std::size_t i = 3; i < a.pixels.size(); i += 4) alpha = std::max(alpha, a.pixels[i]);
+            if (step < 10.0) EXPECT_GT(alpha, 0.05) << "blank image: variant " << variant << ", step " << step;
+            EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(double)), 0)
+                << "variant " << variant << ", step " << step;
+        }
+    }
+}
+
 // Scenes the float packets do not take are one-line errors naming render.profile (no silent fallback).
 TEST(FastProfile, UnservedScenesAreErrors) {
     auto message = [](Scene s) {

@@ -83,14 +83,6 @@ public:
         maximum_ = maximum;
     }
 
-    // Pre-integrated segments (the fast profile's option) read the values at a segment's ends, which may
-    // lie in the macrocells next to its midpoint's: with margin r_m > 0 an empty box is passed over only
-    // where it holds the midpoints' macrocells and r_m more around them (empty_radius(m) > r_m, the box
-    // shrunk by r_m), so every end of a passed segment lies in an empty macrocell when h / 2 is at most
-    // r_m macrocell edges (the caller's choice). The field is continuous, so it then takes no value
-    // with opacity anywhere on the segment, nor does the ramp between its ends.
-    void set_skip_margin(int margin) { margin_ = margin; }
-
     // The next segment to visit; false after the last, or once SIGINT / SIGTERM is requested (polled every
     // conventions::kCancellationPollSamples segments: the render is then abandoned, Cancellation.h).
     bool next(Segment& s) { return next(s, nullptr, nullptr, nullptr); }
@@ -147,15 +139,11 @@ private:
                 continue;
             }
             const MacrocellGrid::Index m = macrocell_of(*grid_, *ray_, iv, step_, k_, n_);
-            bool skip = skippable(m);
+            const bool skip = skippable(m);
             // Composite: an empty m with every macrocell within r - 1 of it empty (empty_radius) is
             // passed over with that whole box; the segments in the box form one run (each axis'
             // macrocell index is monotone in k), so the same segments are visited.
-            std::int64_t r = skip && !extremum_ ? std::max<std::int64_t>(1, grid_->empty_radius(m)) : 1;
-            if (skip && margin_ > 0) {  // set_skip_margin: the box shrunk by the margin, or not passed over
-                skip = r > margin_;
-                r = skip ? r - margin_ : 1;
-            }
+            const std::int64_t r = skip && !extremum_ ? std::max<std::int64_t>(1, grid_->empty_radius(m)) : 1;
             // The estimate: segments k .. end - 1 have their midpoints before the ray leaves the box.
             const std::int64_t end =
                 std::clamp<std::int64_t>(segment_at_or_after(iv, step_, grid_->exit_distance(*ray_, m, r), n_), k_ + 1, lim_);
@@ -210,7 +198,6 @@ private:
     const double* extremum_ = nullptr;  // extremum mode
     bool maximum_ = true;
     int failed_checks_ = 0;  // extremum mode: failed checks in a row
-    int margin_ = 0;         // set_skip_margin
     const Ray* ray_ = nullptr;
     const std::vector<Interval>* intervals_ = nullptr;
     double step_ = 1.0;

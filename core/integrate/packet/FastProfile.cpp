@@ -9,6 +9,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
+#include "core/sample/MacrocellGrid.h"
 #include "transfer/TransferFunction.h"
 
 namespace volref {
@@ -89,6 +90,12 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
             tf.cached_gradient[a] = copies.cached_gradient[a].data();
         }
     }
+    if (in.macrocells) {  // skipping decided on the float lanes (PacketKernels-inl.h, VectorSkip)
+        const auto& radii = in.macrocells->empty_radii();
+        copies.skip_radius.assign(radii.begin(), radii.end());
+        in.skip_radius = copies.skip_radius.data();
+        for (int a = 0; a < 3; ++a) in.macrocells_counts[a] = in.macrocells->counts()[a];
+    }
     in.fast = true;
     in.termination.test_transmittance = true;
     in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;
@@ -119,10 +126,8 @@ void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, c
     in.pre_n = t.n;
     in.pre_x0 = t.x0;
     in.pre_inv_dx = 1.0 / t.dx;
-    // Empty space is skipped only where a segment's ends lie in empty macrocells too: h / 2 is within
-    // pre_skip_margin macrocell edges of the midpoint (ForwardSegmentWalk::set_skip_margin).
-    const double edge = conventions::kMacrocellSize * std::min({volume.spacing[0], volume.spacing[1], volume.spacing[2]});
-    in.pre_skip_margin = std::max(1, int(std::ceil(0.5 * in.step / edge)));
+    // Empty space is skipped only where a segment's ends lie in empty macrocells too (VectorSkip's
+    // end_margin, PacketComposite.cpp).
 }
 
 }  // namespace volref

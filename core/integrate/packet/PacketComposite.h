@@ -109,7 +109,10 @@ struct PacketCompositeInputs {
     const float* preintegration = nullptr;
     int pre_n = 0;
     double pre_x0 = 0.0, pre_inv_dx = 1.0;
-    int pre_skip_margin = 0;  // ForwardSegmentWalk::set_skip_margin for the segments' ends
+    // The fast profile's skipping on float lanes (PacketKernels-inl.h, VectorSkip): each macrocell's
+    // empty_radius as int32 (FastProfile.h's copy); null: the walks skip (double lanes).
+    const std::int32_t* skip_radius = nullptr;
+    std::int64_t macrocells_counts[3] = {1, 1, 1};
 };
 
 // Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count). With `states`

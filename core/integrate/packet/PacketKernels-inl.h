@@ -92,9 +92,32 @@ struct SimdLanes {
 #include "transfer/Shading-inl.h"
 #include "transfer/PiecewiseLinear-inl.h"
 
+// Empty-space skipping on float lanes, decided for all lanes at once (issue 31, part 1): what a packet
+// needs of the macrocell grid (MacrocellGrid.h) in the volume's local index space.
+struct VectorSkip {
+    const std::int32_t* radius = nullptr;  // empty_radius of each macrocell, int32 (FloatCopies)
+    std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
+    std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
+    double inv_spacing[3] = {1, 1, 1};
+    double end_margin = 0.0;  // pre-integrated segments: h / 2 (a skipped segment's ends lie in the box too)
+};
+
 // The rays of a packet (SoA) and each lane's walk over its segments (ForwardSegmentWalk: the same
 // segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
 // never become active. The walk is in double; the lanes hold its values rounded to T.
+//
+// With a VectorSkip (float lanes, composite) the walks do not skip; instead, after every lane's
+// segment k is placed, its float position p = o + t d (the kernel's own arithmetic) gives the cell
+// the kernel's trilinear read uses, cell = min(floor(clamp(p / s, 0, n - 1)), n - 2), and its
+// macrocell m = cell / 8; where empty_radius(m) = r >= 1, every macrocell within r - 1 of m is empty,
+// and the ray stays in that box B for dt = the distance to B's exit face along the ray (index space:
+// B spans cells [(m - r + 1) 8, (m + r) 8) per axis), less 0.01 cell and, for pre-integrated segments,
+// less h / 2. The lane then moves on to the first segment whose midpoint lies at or after t + dt:
+// every segment passed over samples inside B (positions within dt of p), so it reads voxels of
+// empty macrocells only and its opacity is 0 exactly; the image is the image without skipping. The
+// lane's new segment is placed in the same step (and checked again), replacing the empty sample; with
+// pre-integrated segments the segment at p is kept (its ends may lie outside B) and the lane moves on
+// after it. Lanes whose p lies outside the grid's index range (clamped) are not moved.
 template <typename T>
 struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
@@ -119,9 +142,12 @@ struct RayPacketT {
     // kLanes values the caller keeps up to date (NaN before a lane's first sample).
     RayPacketT(const Ray* rays, const std::vector<Interval>* intervals, int count, double step,
                const MacrocellGrid* grid = nullptr, const double* extremum = nullptr, bool maximum = true,
-               const double* local_origin = nullptr, const RaySpan* spans = nullptr, int skip_margin = 0) {
+               const double* local_origin = nullptr, const RaySpan* spans = nullptr,
+               const VectorSkip* vector_skip = nullptr) {
         lanes = hn::Lanes(hn::ScalableTag<T>());
         this->step = step;
+        vskip_ = std::is_same_v<T, float> && grid && !extremum ? vector_skip : nullptr;
+        if (vskip_) grid = nullptr;  // the walks place every segment; next() skips
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
             const Ray& r = rays[real ? l : 0];
@@ -145,7 +171,13 @@ struct RayPacketT {
             if (real)
                 walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span)
                                    : ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
-            if (real && skip_margin > 0) walk[l].set_skip_margin(skip_margin);
+        }
+        if (vskip_) {
+            // Per lane: index units per unit of t along each axis.
+            for (std::size_t l = 0; l < lanes; ++l) {
+                const double dl[3] = {double(dx[l]), double(dy[l]), double(dz[l])};
+                for (int a = 0; a < 3; ++a) rate_[a][l] = T(dl[a] * vskip_->inv_spacing[a]);
+            }
         }
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live
@@ -204,6 +236,13 @@ struct RayPacketT {
                 hn::Store(hn::DemoteTo(dt, hn::IfThenElseZero(on, one)), dt, live + i);
             }
         }
+        if constexpr (std::is_same_v<T, float>) {
+            // A lane moved on takes its new segment in this same step (checked again: it may land in
+            // another empty box), so that no step is spent on a sample known to be empty.
+            if (vskip_)
+                for (int pass = 0; pass < 8 && skip_empty(); ++pass) {
+                }
+        }
         return true;
     }
     // Ends lane l's ray (opaque or terminated early): the lane is inactive from the next step on.
@@ -215,6 +254,94 @@ struct RayPacketT {
     }
 
 private:
+    // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
+    // past the samples that stay in its empty box, placing its new segment (segment()'s arithmetic, as
+    // next() does on vectors; a lane at the end of its run takes no sample this step). True when a
+    // lane was moved.
+    bool skip_empty() {
+        const hn::ScalableTag<T> d;
+        const hn::RebindToSigned<decltype(d)> di;
+        const std::size_t nf = hn::Lanes(d);
+        const VectorSkip& s = *vskip_;
+        const auto zero = hn::Zero(d);
+        static_assert(conventions::kMacrocellSize == 8, "the shift by 3 below is the division by kMacrocellSize");
+        HWY_ALIGN T dt_buf[kLanes] = {};
+        bool any = false;
+        for (std::size_t i = 0; i < lanes; i += nf) {
+            const auto t = hn::Load(d, tm + i);
+            const auto P0 = hn::Add(hn::Load(d, ox + i), hn::Mul(t, hn::Load(d, dx + i)));
+            const auto P1 = hn::Add(hn::Load(d, oy + i), hn::Mul(t, hn::Load(d, dy + i)));
+            const auto P2 = hn::Add(hn::Load(d, oz + i), hn::Mul(t, hn::Load(d, dz + i)));
+            const hn::Vec<decltype(d)> P[3] = {P0, P1, P2};
+            auto inside = hn::Gt(hn::Load(d, live + i), zero);
+            hn::Vec<decltype(di)> mc[3];
+            hn::Vec<decltype(d)> u[3];
+            for (int a = 0; a < 3; ++a) {
+                const T hi = T(s.dims[a] - 1);
+                u[a] = hn::Mul(P[a], hn::Set(d, T(s.inv_spacing[a])));
+                inside = hn::And(inside, hn::And(hn::Ge(u[a], zero), hn::Le(u[a], hn::Set(d, hi))));
+                const auto cell = s.dims[a] == 1 ? zero : hn::Min(hn::Floor(hn::Min(hn::Max(u[a], zero), hn::Set(d, hi))),
+                                                                  hn::Set(d, T(s.dims[a] - 2)));
+                mc[a] = hn::ShiftRight<3>(hn::ConvertTo(di, cell));
+            }
+            if (hn::AllFalse(d, inside)) continue;
+            const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, std::int32_t(s.counts[0])),
+                                                    hn::Add(mc[1], hn::Mul(hn::Set(di, std::int32_t(s.counts[1])), mc[2]))));
+            const auto safe = hn::IfThenElseZero(hn::RebindMask(di, inside), idx);
+            const auto r = hn::IfThenElseZero(hn::RebindMask(di, inside), hn::GatherIndex(di, s.radius, safe));
+            const auto empty = hn::RebindMask(d, hn::Gt(r, hn::Zero(di)));
+            if (hn::AllFalse(d, empty)) continue;
+            // The exit of the box of macrocells within r - 1 of m: per axis the face ahead, in index units.
+            const auto rf = hn::ConvertTo(d, r);
+            auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
+            auto fastest = zero;
+            for (int a = 0; a < 3; ++a) {
+                const auto rate = hn::Load(d, rate_[a] + i);
+                const auto m8 = hn::Mul(hn::ConvertTo(d, mc[a]), hn::Set(d, T(8)));
+                const auto lo = hn::Sub(m8, hn::Mul(hn::Sub(rf, hn::Set(d, T(1))), hn::Set(d, T(8))));
+                const auto hi = hn::Add(m8, hn::Mul(rf, hn::Set(d, T(8))));
+                const auto face = hn::IfThenElse(hn::Lt(rate, zero), lo, hi);
+                const auto speed = hn::Abs(rate);
+                dt = hn::Min(dt, hn::Div(hn::Abs(hn::Sub(face, u[a])), speed));
+                fastest = hn::Max(fastest, speed);
+            }
+            dt = hn::Sub(dt, hn::Add(hn::Div(hn::Set(d, T(0.01)), fastest), hn::Set(d, T(s.end_margin))));
+            const auto jump = hn::And(empty, hn::Gt(dt, zero));
+            if (hn::AllFalse(d, jump)) continue;
+            hn::Store(hn::IfThenElseZero(jump, dt), d, dt_buf + i);
+            any = true;
+        }
+        if (!any) return false;
+        // The first segment whose midpoint is at or after t + dt (double: SamplePlacement's lattice).
+        bool moved = false;
+        for (std::size_t l = 0; l < lanes; ++l) {
+            if (!(dt_buf[l] > T(0)) || run_live[l] == 0.0) continue;
+            const double target = t_ref[l] + double(tm[l]) + double(dt_buf[l]);
+            const double k = std::ceil((target - run_t0[l]) / step - 0.5);
+            if (!(k > run_k[l] - 1.0)) continue;  // not past the segment just placed
+            if (s.end_margin > 0.0) {
+                // Pre-integrated segments: the segment just placed stays (its ends may lie outside the
+                // box although its midpoint is inside); the lane moves on after it.
+                run_k[l] = std::min(k, run_end[l]);
+                continue;
+            }
+            moved = true;
+            if (k >= run_end[l]) {  // the run is used up: no sample this step, the walk refills next step
+                run_k[l] = run_end[l];
+                tm[l] = len[l] = live[l] = T(0);
+                continue;
+            }
+            const double a = run_t0[l] + k * step;
+            const double b = k == run_last[l] ? run_t1[l] : run_t0[l] + (k + 1.0) * step;
+            tm[l] = T(0.5 * (a + b) - t_ref[l]);
+            len[l] = T(b - a);
+            run_k[l] = k + 1.0;
+        }
+        return moved;
+    }
+
+    const VectorSkip* vskip_ = nullptr;
+    HWY_ALIGN T rate_[3][kLanes] = {};
     bool started_ = false;
     std::size_t live_count_ = 0;
 };

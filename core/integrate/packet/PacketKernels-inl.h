@@ -172,6 +172,7 @@ struct RayPacketT {
                 walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span)
                                    : ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
         }
+        for (std::size_t l = 0; l < kLanes; ++l) recheck_[l] = -std::numeric_limits<T>::infinity();
         if (vskip_) {
             // Per lane: index units per unit of t along each axis.
             for (std::size_t l = 0; l < lanes; ++l) {
@@ -201,6 +202,7 @@ struct RayPacketT {
                 if (active[l] && run_k[l] >= run_end[l]) {
                     ForwardSegmentWalk::Run r;
                     if (walk[l].next_run(r)) {
+                        if constexpr (std::is_same_v<T, float>) recheck_[l] = -std::numeric_limits<T>::infinity();
                         run_k[l] = double(r.k);
                         run_end[l] = double(r.end);
                         run_last[l] = double(r.n - 1);
@@ -269,6 +271,8 @@ private:
         bool any = false;
         for (std::size_t i = 0; i < lanes; i += nf) {
             const auto t = hn::Load(d, tm + i);
+            // A lane found in a non-empty macrocell is not checked again before it can have left it.
+            if (hn::AllFalse(d, hn::And(hn::Gt(hn::Load(d, live + i), zero), hn::Ge(t, hn::Load(d, recheck_ + i))))) continue;
             const auto P0 = hn::Add(hn::Load(d, ox + i), hn::Mul(t, hn::Load(d, dx + i)));
             const auto P1 = hn::Add(hn::Load(d, oy + i), hn::Mul(t, hn::Load(d, dy + i)));
             const auto P2 = hn::Add(hn::Load(d, oz + i), hn::Mul(t, hn::Load(d, dz + i)));
@@ -284,15 +288,18 @@ private:
                                                                   hn::Set(d, T(s.dims[a] - 2)));
                 mc[a] = hn::ShiftRight<3>(hn::ConvertTo(di, cell));
             }
-            if (hn::AllFalse(d, inside)) continue;
+            if (hn::AllFalse(d, inside)) {
+                hn::Store(hn::Set(d, -std::numeric_limits<T>::infinity()), d, recheck_ + i);
+                continue;
+            }
             const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, std::int32_t(s.counts[0])),
                                                     hn::Add(mc[1], hn::Mul(hn::Set(di, std::int32_t(s.counts[1])), mc[2]))));
             const auto safe = hn::IfThenElseZero(hn::RebindMask(di, inside), idx);
             const auto r = hn::IfThenElseZero(hn::RebindMask(di, inside), hn::GatherIndex(di, s.radius, safe));
             const auto empty = hn::RebindMask(d, hn::Gt(r, hn::Zero(di)));
-            if (hn::AllFalse(d, empty)) continue;
-            // The exit of the box of macrocells within r - 1 of m: per axis the face ahead, in index units.
-            const auto rf = hn::ConvertTo(d, r);
+            // The exit of the box of macrocells within r - 1 of m (m itself where r = 0): per axis the
+            // face ahead, in index units.
+            const auto rf = hn::Max(hn::ConvertTo(d, r), hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
             auto fastest = zero;
             for (int a = 0; a < 3; ++a) {
@@ -305,6 +312,10 @@ private:
                 dt = hn::Min(dt, hn::Div(hn::Abs(hn::Sub(face, u[a])), speed));
                 fastest = hn::Max(fastest, speed);
             }
+            // Non-empty lanes inside the grid: the next check where they leave m; the others every step.
+            const auto solid = hn::AndNot(empty, inside);
+            hn::Store(hn::IfThenElse(solid, hn::Add(t, dt), hn::Set(d, -std::numeric_limits<T>::infinity())), d, recheck_ + i);
+            if (hn::AllFalse(d, empty)) continue;
             dt = hn::Sub(dt, hn::Add(hn::Div(hn::Set(d, T(0.01)), fastest), hn::Set(d, T(s.end_margin))));
             const auto jump = hn::And(empty, hn::Gt(dt, zero));
             if (hn::AllFalse(d, jump)) continue;
@@ -336,12 +347,16 @@ private:
             tm[l] = T(0.5 * (a + b) - t_ref[l]);
             len[l] = T(b - a);
             run_k[l] = k + 1.0;
+            recheck_[l] = -std::numeric_limits<T>::infinity();
         }
         return moved;
     }
 
     const VectorSkip* vskip_ = nullptr;
     HWY_ALIGN T rate_[3][kLanes] = {};
+    // Where each lane's next check is due (local t): the exit of the non-empty macrocell it was last
+    // found in, -inf when due now (a new run, a moved lane, outside the grid).
+    HWY_ALIGN T recheck_[kLanes];
     bool started_ = false;
     std::size_t live_count_ = 0;
 };

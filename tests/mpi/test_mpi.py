@@ -611,6 +611,11 @@ if a.mode == "refusals":
         s = base_scene("composite", "ortho")
         s[section][k] = v
         expect_refusal(key, s)
+    # The fast profile's pre-integrated segments (each rank would build its own table).
+    s = base_scene("composite", "ortho")
+    s["render"]["profile"] = "fast"
+    s["render"]["profile_options"] = {"preintegration": 64}
+    expect_refusal("render.profile_options.preintegration", s)
     # Several volumes: the key names the volume at fault.
     s = two_volumes("composite", "ortho")
     s["volumes"][1]["gradient"] = {"cache": "auto"}

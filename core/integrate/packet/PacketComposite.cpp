@@ -308,6 +308,16 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         }
     }
 
+    // The lanes in `stop` (opaque, terminated) take no more samples.
+    auto retire = [&](M stop) HWY_ATTR {
+        if (hn::AllFalse(d, stop)) return;
+        hn::Store(hn::IfThenElseZero(stop, one), d, buf);
+        for (std::size_t l = 0; l < L; ++l)
+            if (buf[l] != T(0)) {
+                stopped[l] = true;
+                packet.retire(l);
+            }
+    };
     // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
     V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
     while (packet.next()) {
@@ -320,14 +330,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 const V alpha = segment_alpha<SL>(s.tau);
                 acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
                 const M stop = acc.stops(s.visible, in.termination);
-                if (!hn::AllFalse(d, stop)) {
-                    hn::Store(hn::IfThenElseZero(stop, one), d, buf);
-                    for (std::size_t l = 0; l < L; ++l)
-                        if (buf[l] != T(0)) {
-                            stopped[l] = true;
-                            packet.retire(l);
-                        }
-                }
+                retire(stop);
                 continue;
             }
         }
@@ -361,15 +364,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 shade<T>(in, shading, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
             }
             acc.add(o.visible, o.solid, o.tau, o.alpha, m);
-            const M stop = hn::Or(o.solid, acc.stops(o.partial, in.termination));
-            if (!hn::AllFalse(d, stop)) {
-                hn::Store(hn::IfThenElseZero(stop, one), d, buf);
-                for (std::size_t l = 0; l < L; ++l)
-                    if (buf[l] != T(0)) {
-                        stopped[l] = true;
-                        packet.retire(l);
-                    }
-            }
+            retire(hn::Or(o.solid, acc.stops(o.partial, in.termination)));
         }
     }
     {

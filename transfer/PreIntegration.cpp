@@ -10,11 +10,13 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "core/Conventions.h"
+#include "core/Lanes.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "transfer/TransferFunction.h"
 
 namespace volref {
+
+#include "transfer/PreIntegration-inl.h"
 
 namespace {
 
@@ -152,21 +154,15 @@ PreIntegrationTable build_preintegration_table(const TransferFunction& tf, doubl
 }
 
 void lookup_preintegration(const PreIntegrationTable& t, double x_f, double x_b, double out[4]) {
+    using L = ScalarLanes<double>;
     const std::size_t m = std::size_t(t.n) + 1;
-    auto coord = [&](double x, std::size_t& i, double& w) {
-        const double f = std::clamp((x - t.x0) / t.dx, 0.0, double(t.n));
-        i = std::min(std::size_t(f), std::size_t(t.n - 1));
-        w = f - double(i);
-    };
-    std::size_t i, j;
-    double wi, wj;
-    coord(x_f, i, wi);
-    coord(x_b, j, wj);
+    double fi, fj, wi, wj;
+    preintegration_axis<L>(x_f, t.x0, 1.0 / t.dx, double(t.n), fi, wi);
+    preintegration_axis<L>(x_b, t.x0, 1.0 / t.dx, double(t.n), fj, wj);
+    const std::size_t i = std::size_t(fi), j = std::size_t(fj);
     for (std::size_t c = 0; c < 4; ++c) {
         auto e = [&](std::size_t a, std::size_t b) { return double(t.entries[(a * m + b) * 4 + c]); };
-        const double top = e(i, j) + wj * (e(i, j + 1) - e(i, j));
-        const double bottom = e(i + 1, j) + wj * (e(i + 1, j + 1) - e(i + 1, j));
-        out[c] = top + wi * (bottom - top);
+        out[c] = preintegration_blend<L>(e(i, j), e(i, j + 1), e(i + 1, j), e(i + 1, j + 1), wi, wj);
     }
 }
 

@@ -56,8 +56,8 @@ struct PreIntegrationTable {
 // for segments of length h. Computed in parallel (TBB), each entry by segment_integral.
 PreIntegrationTable build_preintegration_table(const TransferFunction& tf, double x_lo, double x_hi, double h, int n);
 
-// The table read bilinearly at (x_f, x_b), each clamped to the table's range (as the kernel reads it,
-// in double): for tests and `explain`.
+// The table read bilinearly at (x_f, x_b), each clamped to the table's range: the kernel's formula
+// (PreIntegration-inl.h) in double, for the tests.
 void lookup_preintegration(const PreIntegrationTable& t, double x_f, double x_b, double out[4]);
 
 }  // namespace volref

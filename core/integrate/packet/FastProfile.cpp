@@ -94,7 +94,6 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
         const auto& radii = in.macrocells->empty_radii();
         copies.skip_radius.assign(radii.begin(), radii.end());
         in.skip_radius = copies.skip_radius.data();
-        for (int a = 0; a < 3; ++a) in.macrocells_counts[a] = in.macrocells->counts()[a];
     }
     in.fast = true;
     in.termination.test_transmittance = true;

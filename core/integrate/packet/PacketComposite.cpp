@@ -172,6 +172,14 @@ HWY_INLINE void shade(const PacketCompositeInputs& in, const ShadingConstants& k
                    [](int, const LightLanes<L>&) HWY_ATTR {});
 }
 
+// The transfer function's coordinate of the values v: (v - lo) / width on a normalised domain, else v
+// (TransferFunction::coordinate).
+template <typename T>
+HWY_INLINE VT<T> transfer_coordinate(const PacketCompositeInputs& in, VT<T> v) {
+    const DT<T> d;
+    return in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
+}
+
 // One pre-integrated segment per lane (transfer/PreIntegration.h; conventions section 9b): the values
 // at its ends a = t - len / 2 and b = t + len / 2 (the back end's trilinear sample; the front end's is
 // the lane's previous back value where the segment starts within 1e-3 len of where the previous one
@@ -202,15 +210,11 @@ HWY_INLINE PreSample<T> pre_sample(const PacketCompositeInputs& in, const Trilin
     }
     prev_end = hn::IfThenElse(alive, tb, prev_end);
     prev_value = hn::IfThenElse(alive, vb, prev_value);
-    auto coordinate = [&](V v) HWY_ATTR {
-        const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
-        return hn::Min(hn::Max(hn::Mul(hn::Sub(x, hn::Set(d, T(in.pre_x0))), hn::Set(d, T(in.pre_inv_dx))), zero),
-                       hn::Set(d, T(in.pre_n)));
-    };
-    const V fi = coordinate(vf), fj = coordinate(vb);
-    const V last = hn::Set(d, T(in.pre_n - 1));
-    const V i0 = hn::Min(hn::Floor(fi), last), j0 = hn::Min(hn::Floor(fj), last);
-    const V wi = hn::Sub(fi, i0), wj = hn::Sub(fj, j0);
+    using SL = SimdLanes<T>;
+    const V x0 = hn::Set(d, T(in.pre_x0)), inv_dx = hn::Set(d, T(in.pre_inv_dx)), n = hn::Set(d, T(in.pre_n));
+    V i0, j0, wi, wj;
+    preintegration_axis<SL>(transfer_coordinate<T>(in, vf), x0, inv_dx, n, i0, wi);
+    preintegration_axis<SL>(transfer_coordinate<T>(in, vb), x0, inv_dx, n, j0, wj);
     const int row = 4 * (in.pre_n + 1);
     const auto idx = hn::Add(hn::Mul(hn::ConvertTo(di, i0), hn::Set(di, row)), hn::Mul(hn::ConvertTo(di, j0), hn::Set(di, 4)));
     const auto idx_down = hn::Add(idx, hn::Set(di, row));
@@ -218,11 +222,9 @@ HWY_INLINE PreSample<T> pre_sample(const PacketCompositeInputs& in, const Trilin
     V e[4];
     for (int c = 0; c < 4; ++c) {
         const T* base = in.preintegration + c;
-        const V e00 = hn::GatherIndex(d, base, idx), e01 = hn::GatherIndex(d, base, hn::Add(idx, next));
-        const V e10 = hn::GatherIndex(d, base, idx_down), e11 = hn::GatherIndex(d, base, hn::Add(idx_down, next));
-        const V top = hn::Add(e00, hn::Mul(wj, hn::Sub(e01, e00)));
-        const V bottom = hn::Add(e10, hn::Mul(wj, hn::Sub(e11, e10)));
-        e[c] = hn::Add(top, hn::Mul(wi, hn::Sub(bottom, top)));
+        e[c] = preintegration_blend<SL>(hn::GatherIndex(d, base, idx), hn::GatherIndex(d, base, hn::Add(idx, next)),
+                                        hn::GatherIndex(d, base, idx_down), hn::GatherIndex(d, base, hn::Add(idx_down, next)),
+                                        wi, wj);
     }
     PreSample<T> s;
     s.tau = hn::Mul(hn::Max(e[0], zero), seg);
@@ -249,7 +251,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     if (kFast && in.skip_radius) {
         vskip.radius = in.skip_radius;
         for (int a = 0; a < 3; ++a) {
-            vskip.counts[a] = in.macrocells_counts[a];
+            vskip.counts[a] = in.macrocells->counts()[a];
             vskip.dims[a] = in.grid.dims[a];
             vskip.inv_spacing[a] = in.grid.inv_spacing[a];
         }
@@ -337,7 +339,7 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         const V P[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
         const V v = trilinear(P[0], P[1], P[2]);
         // Transfer function.
-        const V x = in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
+        const V x = transfer_coordinate<T>(in, v);
         const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x, opacity_reg);
         V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, opacity_reg);
         V g[3];

@@ -112,7 +112,6 @@ struct PacketCompositeInputs {
     // The fast profile's skipping on float lanes (PacketKernels-inl.h, VectorSkip): each macrocell's
     // empty_radius as int32 (FastProfile.h's copy); null: the walks skip (double lanes).
     const std::int32_t* skip_radius = nullptr;
-    std::int64_t macrocells_counts[3] = {1, 1, 1};
 };
 
 // Composites `count` (<= kMaxPacketRays) rays front to back into out[0 .. count). With `states`

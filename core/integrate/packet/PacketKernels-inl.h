@@ -91,6 +91,7 @@ struct SimdLanes {
 #include "core/sample/GradientDifference-inl.h"
 #include "transfer/Shading-inl.h"
 #include "transfer/PiecewiseLinear-inl.h"
+#include "transfer/PreIntegration-inl.h"
 
 // Empty-space skipping on float lanes, decided for all lanes at once (issue 31, part 1): what a packet
 // needs of the macrocell grid (MacrocellGrid.h) in the volume's local index space.

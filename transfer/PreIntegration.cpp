@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Conventions.h"
 #include "core/Lanes.h"
 #include "core/integrate/adaptive/AdaptiveQuadrature.h"
 #include "transfer/TransferFunction.h"
@@ -87,7 +88,7 @@ SegmentIntegral segment_integral(const TransferFunction& tf, double x_f, double 
         // On the piece a is linear, or constant at the clamp (the cuts above): the closed form holds.
         const double a0 = a_at(u0);
         auto depth = [&](double u) { return log_integral(a0, a_at(u), u0, u); };  // integral_{u0}^{u} sigma l
-        // The colour integral, K15 against G7 on [ua, ub], halved until they agree to 1e-13 (sigma has a
+        // The colour integral, K15 against G7 on [ua, ub], halved until they agree to 1e-13, at most kAdaptiveMaxDepth times (sigma has a
         // logarithmic peak where a nears the clamp; elsewhere one rule is enough).
         auto rule = [&](double ua, double ub, glm::dvec3& k, glm::dvec3& g) {
             const double m = 0.5 * (ua + ub), hh = 0.5 * (ub - ua);
@@ -113,7 +114,7 @@ SegmentIntegral segment_integral(const TransferFunction& tf, double x_f, double 
             glm::dvec3 k, g;
             rule(q.a, q.b, k, g);
             const glm::dvec3 e = glm::abs(k - g);
-            if (std::max({e.x, e.y, e.z}) <= 1e-13 || q.depth >= 48) {
+            if (std::max({e.x, e.y, e.z}) <= 1e-13 || q.depth >= conventions::kAdaptiveMaxDepth) {
                 out.colour += k;
             } else {
                 const double mid = 0.5 * (q.a + q.b);

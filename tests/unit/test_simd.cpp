@@ -131,6 +131,41 @@ Scene shaded_ml_scene();
 void expect_identical_across_instruction_sets(const Scene& s);
 }  // namespace
 
+// Transfer functions of 1 to 40 rows: the packet kernels pick rows from registers (RegisterTable: up
+// to 4 vectors of rows, so 16 rows on 4 double lanes, 32 on 8 float lanes) or gather them (more rows);
+// every count from one part to past the last must give the scalar path's values, and the same bits
+// on every instruction set (2, 4 or 8 lanes: different parts for the same row).
+TEST(Simd, TablesOfManyRowsMatchTheScalarPath) {
+    for (int rows : {1, 3, 4, 5, 8, 9, 16, 17, 31, 33, 40}) {
+        Scene s = ml_scene(23, 17);
+        s.volume().transfer.opacity.clear();
+        s.volume().transfer.color.clear();
+        for (int r = 0; r < rows; ++r) {
+            // irregular abscissae over [0, 1]; values that change from row to row
+            const double x = rows == 1 ? 0.5 : (r + 0.3 * std::sin(1.7 * r) * (r > 0 && r < rows - 1)) / (rows - 1);
+            s.volume().transfer.opacity.push_back({x, 0.45 + 0.4 * std::sin(2.3 * r + 0.5)});
+            s.volume().transfer.color.push_back({x, 0.5 + 0.4 * std::cos(1.1 * r), 0.5 + 0.4 * std::sin(0.7 * r), 0.3 + 0.02 * r});
+        }
+        SCOPED_TRACE(rows);
+        EXPECT_LT(max_difference(s), 1e-13);
+        expect_identical_across_instruction_sets(s);
+        // The fast profile's float lanes on every instruction set against the reference (scalar),
+        // within its bound (conventions 9b: termination at 2^-10 times colours <= 1, plus float
+        // rounding); a wrong row would be about 0.1 off.
+        const Image reference = render_scene(s, {.threads = 1, .simd = false});
+        s.render.profile = ProfileId::Fast;
+        for (std::int64_t target : {HWY_AVX3, HWY_AVX2, HWY_SSE4}) {
+            if ((hwy::SupportedTargets() & target) == 0) continue;
+            hwy::SetSupportedTargetsForTest(target);
+            const Image fast = render_scene(s, {.threads = 1, .simd = true});
+            hwy::SetSupportedTargetsForTest(0);
+            double diff = 0.0;
+            for (std::size_t i = 0; i < fast.pixels.size(); ++i) diff = std::max(diff, std::fabs(fast.pixels[i] - reference.pixels[i]));
+            EXPECT_LT(diff, std::ldexp(1.0, -10) + 2e-5) << hwy::TargetName(target);
+        }
+    }
+}
+
 TEST(Simd, BitwiseIdenticalAcrossInstructionSets) {
     expect_identical_across_instruction_sets(ml_scene(29, 17));
     expect_identical_across_instruction_sets(shaded_ml_scene());

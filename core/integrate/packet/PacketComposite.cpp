@@ -41,29 +41,44 @@ struct TableLookup {
     MT<T> below, above;
 };
 
-// A table of at most as many rows as a vector has lanes, held in registers (x, and y per channel,
-// padded with the last row): its rows are picked by TableLookupLanes instead of gathers (the same
-// values; gathers are microcoded on AMD's CPUs). `rows` > lanes: none (`in_register` false).
+// A table of at most kParts vectors' worth of rows, held in registers (x, and y per channel, in parts
+// of one vector each, the last padded with the last row): its rows are picked by TableLookupLanes
+// within each part and a select between the parts instead of gathers (the same values; gathers are
+// microcoded on AMD's CPUs, and a table of 5 rows is 2 parts on 4 double lanes). More rows: none
+// (`in_register` false, the kernels gather).
 template <typename T>
 struct RegisterTable {
+    static constexpr int kParts = 4;
     bool in_register = false;
-    VT<T> x, y[3];
+    int parts = 0;
+    VT<T> x[kParts], y[3][kParts];
     RegisterTable(DT<T> d, const T* xs, const T* ys, int rows, int stride) {
         const std::size_t n = hn::Lanes(d);
-        if (rows < 1 || std::size_t(rows) > n) return;
+        if (rows < 1 || std::size_t(rows) > kParts * n) return;
         in_register = true;
+        parts = int((std::size_t(rows) + n - 1) / n);
         HWY_ALIGN T buf[hn::MaxLanes(DT<T>())];
-        for (std::size_t i = 0; i < n; ++i) buf[i] = xs[std::min<std::size_t>(i, std::size_t(rows - 1))];
-        x = hn::Load(d, buf);
-        for (int c = 0; c < stride && c < 3; ++c) {
-            for (std::size_t i = 0; i < n; ++i) buf[i] = ys[std::min<std::size_t>(i, std::size_t(rows - 1)) * std::size_t(stride) + std::size_t(c)];
-            y[c] = hn::Load(d, buf);
+        auto row = [&](std::size_t i) { return std::min<std::size_t>(i, std::size_t(rows - 1)); };
+        for (int p = 0; p < parts; ++p) {
+            for (std::size_t i = 0; i < n; ++i) buf[i] = xs[row(p * n + i)];
+            x[p] = hn::Load(d, buf);
+            for (int c = 0; c < stride && c < 3; ++c) {
+                for (std::size_t i = 0; i < n; ++i) buf[i] = ys[row(p * n + i) * std::size_t(stride) + std::size_t(c)];
+                y[c][p] = hn::Load(d, buf);
+            }
         }
     }
-    // Row `row` (exact integers as T) of `v`.
-    static HWY_INLINE VT<T> pick(DT<T> d, VT<T> v, VT<T> row) {
+    // Row `row` (exact integers as T, 0 <= row < rows) of the column `v` (x or y[c]): part row / n,
+    // lane row mod n.
+    HWY_INLINE VT<T> pick(DT<T> d, const VT<T> (&v)[kParts], VT<T> row) const {
         const hn::RebindToSigned<DT<T>> di;
-        return hn::TableLookupLanes(v, hn::IndicesFromVec(d, hn::ConvertTo(di, row)));
+        using TI = hn::TFromD<decltype(di)>;
+        const TI n = TI(hn::Lanes(d));
+        const auto lane = hn::IndicesFromVec(d, hn::And(hn::ConvertTo(di, row), hn::Set(di, TI(n - 1))));
+        VT<T> out = hn::TableLookupLanes(v[0], lane);
+        for (int p = 1; p < parts; ++p)
+            out = hn::IfThenElse(hn::Ge(row, hn::Set(d, T(p * n))), hn::TableLookupLanes(v[p], lane), out);
+        return out;
     }
 };
 
@@ -79,8 +94,8 @@ HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v, c
     t.lo_row = hn::Max(hn::Sub(k, one), hn::Zero(d));
     t.hi_row = hn::Min(k, hn::Set(d, T(rows - 1)));
     if (reg.in_register) {
-        t.lo_x = RegisterTable<T>::pick(d, reg.x, t.lo_row);
-        t.hi_x = RegisterTable<T>::pick(d, reg.x, t.hi_row);
+        t.lo_x = reg.pick(d, reg.x, t.lo_row);
+        t.hi_x = reg.pick(d, reg.x, t.hi_row);
     } else {
         t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
         t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
@@ -95,8 +110,8 @@ HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, in
     const hn::RebindToSigned<DT<T>> di;
     VT<T> y0, y1;
     if (reg.in_register) {
-        y0 = RegisterTable<T>::pick(d, reg.y[channel], t.lo_row);
-        y1 = RegisterTable<T>::pick(d, reg.y[channel], t.hi_row);
+        y0 = reg.pick(d, reg.y[channel], t.lo_row);
+        y1 = reg.pick(d, reg.y[channel], t.hi_row);
     } else {
         const VT<T> s = hn::Set(d, T(stride)), c = hn::Set(d, T(channel));
         y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));

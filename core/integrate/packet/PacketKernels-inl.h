@@ -267,7 +267,9 @@ private:
         const std::size_t nf = hn::Lanes(d);
         const VectorSkip& s = *vskip_;
         const auto zero = hn::Zero(d);
-        static_assert(conventions::kMacrocellSize == 8, "the shift by 3 below is the division by kMacrocellSize");
+        constexpr int kM = conventions::kMacrocellSize;
+        static_assert(std::has_single_bit(unsigned(kM)), "the shift below is the division by kMacrocellSize");
+        constexpr int kShift = std::countr_zero(unsigned(kM));
         HWY_ALIGN T dt_buf[kLanes] = {};
         bool any = false;
         for (std::size_t i = 0; i < lanes; i += nf) {
@@ -287,7 +289,7 @@ private:
                 inside = hn::And(inside, hn::And(hn::Ge(u[a], zero), hn::Le(u[a], hn::Set(d, hi))));
                 const auto cell = s.dims[a] == 1 ? zero : hn::Min(hn::Floor(hn::Min(hn::Max(u[a], zero), hn::Set(d, hi))),
                                                                   hn::Set(d, T(s.dims[a] - 2)));
-                mc[a] = hn::ShiftRight<3>(hn::ConvertTo(di, cell));
+                mc[a] = hn::ShiftRight<kShift>(hn::ConvertTo(di, cell));
             }
             if (hn::AllFalse(d, inside)) {
                 hn::Store(hn::Set(d, -std::numeric_limits<T>::infinity()), d, recheck_ + i);
@@ -305,9 +307,9 @@ private:
             auto fastest = zero;
             for (int a = 0; a < 3; ++a) {
                 const auto rate = hn::Load(d, rate_[a] + i);
-                const auto m8 = hn::Mul(hn::ConvertTo(d, mc[a]), hn::Set(d, T(8)));
-                const auto lo = hn::Sub(m8, hn::Mul(hn::Sub(rf, hn::Set(d, T(1))), hn::Set(d, T(8))));
-                const auto hi = hn::Add(m8, hn::Mul(rf, hn::Set(d, T(8))));
+                const auto low = hn::Mul(hn::ConvertTo(d, mc[a]), hn::Set(d, T(kM)));  // m's first cell
+                const auto lo = hn::Sub(low, hn::Mul(hn::Sub(rf, hn::Set(d, T(1))), hn::Set(d, T(kM))));
+                const auto hi = hn::Add(low, hn::Mul(rf, hn::Set(d, T(kM))));
                 const auto face = hn::IfThenElse(hn::Lt(rate, zero), lo, hi);
                 const auto speed = hn::Abs(rate);
                 dt = hn::Min(dt, hn::Div(hn::Abs(hn::Sub(face, u[a])), speed));

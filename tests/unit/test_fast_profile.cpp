@@ -191,32 +191,51 @@ TEST(FastProfile, SameImageForAnySimdOptionThreadsAndSkipping) {
     }
 }
 
-// Skipping on the float lanes (PacketKernels-inl.h, VectorSkip) passes over samples in empty boxes
+// Skipping on the lanes (PacketKernels-inl.h, VectorSkip; float and double) passes over samples in empty boxes
 // only: the image is the image without skipping, bit for bit, at steps shorter and longer than a
 // macrocell, with an origin and spacings that are not 1, a clip plane that cuts rays into two
 // intervals, and bounds larger than the grid (samples beyond it clamp into its boundary cells).
 TEST(FastProfile, VectorSkipIsExact) {
-    Scene s = ml_scene();
-    s.volume().transfer.opacity = {{0.0, 0.0}, {0.46, 0.0}, {0.5, 0.7}, {0.54, 0.0}};
-    s.render.profile = ProfileId::Fast;
-    s.render.step_units = StepUnits::Voxel;
-    for (int variant = 0; variant < 3; ++variant) {
-        if (variant == 1) s.volume().clip_planes = {ClipPlaneSpec{glm::dvec3(5.0, 12.0, 10.0), glm::dvec3(0.3, -1.0, 0.2)}};
-        if (variant == 2) {
-            s.volume().clip_planes.clear();
-            s.volume().bounds.type = BoundsSpec::Type::Box;
-            s.volume().bounds.min = glm::dvec3(-6.0, -1.0, 0.0);
-            s.volume().bounds.max = glm::dvec3(16.0, 22.0, 22.0);
-        }
+    auto expect_exact = [](const Scene& scene, const std::string& label) {
+        Scene s = scene;
         for (double step : {0.3, 1.0, 2.5, 7.0, 19.0}) {
             s.render.step = step;
             const Image a = render_scene(s, {.threads = 1}), b = render_scene(s, {.threads = 2, .empty_space_skipping = false});
             double alpha = 0.0;
             for (std::size_t i = 3; i < a.pixels.size(); i += 4) alpha = std::max(alpha, a.pixels[i]);
-            if (step < 10.0) EXPECT_GT(alpha, 0.05) << "blank image: variant " << variant << ", step " << step;
+            if (step < 10.0) EXPECT_GT(alpha, 0.05) << "blank image: " << label << ", step " << step;
             EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(double)), 0)
-                << "variant " << variant << ", step " << step;
+                << label << ", step " << step;
         }
+    };
+    for (ProfileId profile : {ProfileId::Fast, ProfileId::Reference}) {  // float lanes; double lanes (world coordinates)
+        SCOPED_TRACE(profile == ProfileId::Fast ? "fast" : "reference");
+        Scene s = ml_scene();
+        s.volume().transfer.opacity = {{0.0, 0.0}, {0.46, 0.0}, {0.5, 0.7}, {0.54, 0.0}};
+        s.render.profile = profile;
+        s.render.step_units = StepUnits::Voxel;
+        expect_exact(s, "marschner-lobb");
+        s.volume().clip_planes = {ClipPlaneSpec{glm::dvec3(5.0, 12.0, 10.0), glm::dvec3(0.3, -1.0, 0.2)}};
+        expect_exact(s, "clip plane");
+        s.volume().clip_planes.clear();
+        s.volume().bounds.type = BoundsSpec::Type::Box;
+        s.volume().bounds.min = glm::dvec3(-6.0, -1.0, 0.0);
+        s.volume().bounds.max = glm::dvec3(16.0, 22.0, 22.0);
+        expect_exact(s, "bounds beyond the grid");
+        // A thin shell (a Gaussian's f = 0.5) in a volume mostly empty, far from the world origin: the
+        // lanes skip most of each ray, so a box misplaced by a cell would change the image.
+        FieldSpec g;
+        g.kind = FieldSpec::Kind::Gaussian;
+        g.dims = {48, 41, 45};
+        const glm::dvec3 origin(-300.0, 120.0, 75.0), spacing(0.5, 0.7, 0.6);
+        g.center = origin + spacing * glm::dvec3(22.0, 21.0, 23.0);
+        g.sigma = 6.0;
+        Scene shell = field_scene(g, origin, spacing);
+        shell.volume().transfer = s.volume().transfer;
+        shell.image = s.image;
+        shell.render.profile = profile;
+        shell.render.step_units = StepUnits::Voxel;
+        expect_exact(shell, "gaussian shell");
     }
 }
 

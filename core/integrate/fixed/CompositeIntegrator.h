@@ -22,6 +22,7 @@
 #pragma once
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/integrate/Integrator.h"
 #include "core/integrate/packet/PacketComposite.h"
@@ -76,6 +77,7 @@ private:
     Termination termination_;  // early_termination(render)
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
     std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
+    std::vector<std::int32_t> skip_radius_;         // the macrocells' empty_radius as int32 (the packets' skipping)
 };
 
 }  // namespace volref

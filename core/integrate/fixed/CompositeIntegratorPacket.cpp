@@ -8,6 +8,7 @@
 #include "core/integrate/packet/FastProfile.h"
 #include "core/integrate/packet/PacketGrid.h"
 #include "core/sample/GradientField.h"
+#include "core/sample/MacrocellGrid.h"
 #include "transfer/Shader.h"
 #include "transfer/TransferFunction.h"
 
@@ -101,6 +102,11 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     in.step = ctx.step;
     in.termination = early_termination(ctx.render);
     in.macrocells = ctx.macrocells;
+    if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
+        const auto& radii = in.macrocells->empty_radii();
+        skip_radius_.assign(radii.begin(), radii.end());
+        in.skip_radius = skip_radius_.data();
+    }
     if (fast) {
         fast_copies_ = std::make_unique<FloatCopies>();
         make_fast(in, v, cached, *fast_copies_);

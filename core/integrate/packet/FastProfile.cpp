@@ -90,11 +90,6 @@ void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* co
             tf.cached_gradient[a] = copies.cached_gradient[a].data();
         }
     }
-    if (in.macrocells) {  // skipping decided on the float lanes (PacketKernels-inl.h, VectorSkip)
-        const auto& radii = in.macrocells->empty_radii();
-        copies.skip_radius.assign(radii.begin(), radii.end());
-        in.skip_radius = copies.skip_radius.data();
-    }
     in.fast = true;
     in.termination.test_transmittance = true;
     in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;

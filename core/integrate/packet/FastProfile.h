@@ -28,7 +28,6 @@ struct FloatCopies {
     std::vector<float> color_x, color_y, opacity_x, opacity_y, gradient_opacity_x, gradient_opacity_y;
     std::vector<float> cached_gradient[3];
     PreIntegrationTable preintegration;  // render.profile_options.preintegration
-    std::vector<std::int32_t> skip_radius;  // the macrocells' empty_radius for the float lanes' skipping
 };
 
 // The voxels the float kernels gather: the volume's own storage when it is a 32-bit-gathered type

@@ -262,18 +262,19 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const double zero_origin[3] = {0.0, 0.0, 0.0};
     const double* origin = kFast ? zero_origin : in.grid.origin;
     const bool pre = kFast && in.preintegration != nullptr;  // pre-integrated segments (FastProfile.h)
-    VectorSkip vskip;  // float lanes: skipping decided on the lanes (PacketKernels-inl.h)
-    if (kFast && in.skip_radius) {
+    VectorSkip vskip;  // skipping decided on the lanes (PacketKernels-inl.h), in the lanes' coordinates
+    if (in.skip_radius) {
         vskip.radius = in.skip_radius;
         for (int a = 0; a < 3; ++a) {
             vskip.counts[a] = in.macrocells->counts()[a];
             vskip.dims[a] = in.grid.dims[a];
+            vskip.origin[a] = origin[a];
             vskip.inv_spacing[a] = in.grid.inv_spacing[a];
         }
         vskip.end_margin = pre ? 0.5 * in.step : 0.0;
     }
     RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, nullptr, true, local, spans,
-                         kFast && in.skip_radius ? &vskip : nullptr);
+                         in.skip_radius ? &vskip : nullptr);
     const std::size_t L = packet.lanes;
     HWY_ALIGN T buf[RayPacketT<T>::kLanes];
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);

@@ -109,8 +109,8 @@ struct PacketCompositeInputs {
     const float* preintegration = nullptr;
     int pre_n = 0;
     double pre_x0 = 0.0, pre_inv_dx = 1.0;
-    // The fast profile's skipping on float lanes (PacketKernels-inl.h, VectorSkip): each macrocell's
-    // empty_radius as int32 (FastProfile.h's copy); null: the walks skip (double lanes).
+    // Skipping decided on the lanes (PacketKernels-inl.h, VectorSkip): each macrocell's empty_radius
+    // as int32 (CompositeIntegrator's copy); null: no skipping.
     const std::int32_t* skip_radius = nullptr;
 };
 

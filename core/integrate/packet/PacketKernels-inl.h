@@ -93,12 +93,13 @@ struct SimdLanes {
 #include "transfer/PiecewiseLinear-inl.h"
 #include "transfer/PreIntegration-inl.h"
 
-// Empty-space skipping on float lanes, decided for all lanes at once (issue 31, part 1): what a packet
-// needs of the macrocell grid (MacrocellGrid.h) in the volume's local index space.
+// Empty-space skipping of the composite packets, decided for all lanes at once (issue 31, part 1):
+// what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
-    const std::int32_t* radius = nullptr;  // empty_radius of each macrocell, int32 (FloatCopies)
+    const std::int32_t* radius = nullptr;  // empty_radius of each macrocell, int32 (CompositeIntegrator's copy)
     std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
     std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
+    double origin[3] = {0, 0, 0};          // the lanes' positions' origin of the grid (0: float lanes' local coordinates)
     double inv_spacing[3] = {1, 1, 1};
     double end_margin = 0.0;  // pre-integrated segments: h / 2 (a skipped segment's ends lie in the box too)
 };
@@ -107,10 +108,10 @@ struct VectorSkip {
 // segments as the scalar path, with empty-space skipping when `grid` is set); lanes beyond `count`
 // never become active. The walk is in double; the lanes hold its values rounded to T.
 //
-// With a VectorSkip (float lanes, composite) the walks do not skip; instead, after every lane's
-// segment k is placed, its float position p = o + t d (the kernel's own arithmetic) gives the cell
-// the kernel's trilinear read uses, cell = min(floor(clamp(p / s, 0, n - 1)), n - 2), and its
-// macrocell m = cell / 8; where empty_radius(m) = r >= 1, every macrocell within r - 1 of m is empty,
+// With a VectorSkip (composite, float or double lanes) the walks do not skip; instead, after every
+// lane's segment k is placed, its position p = o + t d in T (the kernel's own arithmetic) gives the
+// cell the kernel's trilinear read uses, cell = min(floor(clamp((p - origin) / s, 0, n - 1)), n - 2),
+// and its macrocell m = cell / 8; where empty_radius(m) = r >= 1, every macrocell within r - 1 of m is empty,
 // and the ray stays in that box B for dt = the distance to B's exit face along the ray (index space:
 // B spans cells [(m - r + 1) 8, (m + r) 8) per axis), less 0.01 cell and, for pre-integrated segments,
 // less h / 2. The lane then moves on to the first segment whose midpoint lies at or after t + dt:
@@ -147,7 +148,7 @@ struct RayPacketT {
                const VectorSkip* vector_skip = nullptr) {
         lanes = hn::Lanes(hn::ScalableTag<T>());
         this->step = step;
-        vskip_ = std::is_same_v<T, float> && grid && !extremum ? vector_skip : nullptr;
+        vskip_ = grid && !extremum ? vector_skip : nullptr;
         if (vskip_) grid = nullptr;  // the walks place every segment; next() skips
         for (std::size_t l = 0; l < lanes; ++l) {
             const bool real = int(l) < count;
@@ -203,7 +204,7 @@ struct RayPacketT {
                 if (active[l] && run_k[l] >= run_end[l]) {
                     ForwardSegmentWalk::Run r;
                     if (walk[l].next_run(r)) {
-                        if constexpr (std::is_same_v<T, float>) recheck_[l] = -std::numeric_limits<T>::infinity();
+                        recheck_[l] = -std::numeric_limits<T>::infinity();
                         run_k[l] = double(r.k);
                         run_end[l] = double(r.end);
                         run_last[l] = double(r.n - 1);
@@ -239,13 +240,11 @@ struct RayPacketT {
                 hn::Store(hn::DemoteTo(dt, hn::IfThenElseZero(on, one)), dt, live + i);
             }
         }
-        if constexpr (std::is_same_v<T, float>) {
-            // A lane moved on takes its new segment in this same step (checked again: it may land in
-            // another empty box), so that no step is spent on a sample known to be empty.
-            if (vskip_)
-                for (int pass = 0; pass < 8 && skip_empty(); ++pass) {
-                }
-        }
+        // A lane moved on takes its new segment in this same step (checked again: it may land in
+        // another empty box), so that no step is spent on a sample known to be empty.
+        if (vskip_)
+            for (int pass = 0; pass < 8 && skip_empty(); ++pass) {
+            }
         return true;
     }
     // Ends lane l's ray (opaque or terminated early): the lane is inactive from the next step on.
@@ -263,7 +262,7 @@ private:
     // lane was moved.
     bool skip_empty() {
         const hn::ScalableTag<T> d;
-        const hn::RebindToSigned<decltype(d)> di;
+        const hn::Rebind<std::int32_t, decltype(d)> di;  // int32 lanes, as many as d's
         const std::size_t nf = hn::Lanes(d);
         const VectorSkip& s = *vskip_;
         const auto zero = hn::Zero(d);
@@ -285,11 +284,13 @@ private:
             hn::Vec<decltype(d)> u[3];
             for (int a = 0; a < 3; ++a) {
                 const T hi = T(s.dims[a] - 1);
-                u[a] = hn::Mul(P[a], hn::Set(d, T(s.inv_spacing[a])));
+                u[a] = hn::Mul(hn::Sub(P[a], hn::Set(d, T(s.origin[a]))), hn::Set(d, T(s.inv_spacing[a])));
                 inside = hn::And(inside, hn::And(hn::Ge(u[a], zero), hn::Le(u[a], hn::Set(d, hi))));
                 const auto cell = s.dims[a] == 1 ? zero : hn::Min(hn::Floor(hn::Min(hn::Max(u[a], zero), hn::Set(d, hi))),
                                                                   hn::Set(d, T(s.dims[a] - 2)));
-                mc[a] = hn::ShiftRight<kShift>(hn::ConvertTo(di, cell));
+                // the cell (an integer below 2^31) as int32 lanes
+                if constexpr (std::is_same_v<T, float>) mc[a] = hn::ShiftRight<kShift>(hn::ConvertTo(di, cell));
+                else mc[a] = hn::ShiftRight<kShift>(hn::DemoteTo(di, cell));
             }
             if (hn::AllFalse(d, inside)) {
                 hn::Store(hn::Set(d, -std::numeric_limits<T>::infinity()), d, recheck_ + i);
@@ -297,17 +298,21 @@ private:
             }
             const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, std::int32_t(s.counts[0])),
                                                     hn::Add(mc[1], hn::Mul(hn::Set(di, std::int32_t(s.counts[1])), mc[2]))));
-            const auto safe = hn::IfThenElseZero(hn::RebindMask(di, inside), idx);
-            const auto r = hn::IfThenElseZero(hn::RebindMask(di, inside), hn::GatherIndex(di, s.radius, safe));
-            const auto empty = hn::RebindMask(d, hn::Gt(r, hn::Zero(di)));
+            hn::Mask<decltype(di)> inside32;  // `inside` on the int32 lanes
+            if constexpr (std::is_same_v<T, float>) inside32 = hn::RebindMask(di, inside);
+            else inside32 = hn::Ne(hn::DemoteTo(di, hn::IfThenElseZero(inside, hn::Set(d, T(1)))), hn::Zero(di));
+            const auto safe = hn::IfThenElseZero(inside32, idx);
+            const auto r = hn::IfThenElseZero(inside32, hn::GatherIndex(di, s.radius, safe));
+            const auto radius = to_lanes(d, r);  // exact
+            const auto empty = hn::Gt(radius, zero);
             // The exit of the box of macrocells within r - 1 of m (m itself where r = 0): per axis the
             // face ahead, in index units.
-            const auto rf = hn::Max(hn::ConvertTo(d, r), hn::Set(d, T(1)));
+            const auto rf = hn::Max(radius, hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
             auto fastest = zero;
             for (int a = 0; a < 3; ++a) {
                 const auto rate = hn::Load(d, rate_[a] + i);
-                const auto low = hn::Mul(hn::ConvertTo(d, mc[a]), hn::Set(d, T(kM)));  // m's first cell
+                const auto low = hn::Mul(to_lanes(d, mc[a]), hn::Set(d, T(kM)));  // m's first cell
                 const auto lo = hn::Sub(low, hn::Mul(hn::Sub(rf, hn::Set(d, T(1))), hn::Set(d, T(kM))));
                 const auto hi = hn::Add(low, hn::Mul(rf, hn::Set(d, T(kM))));
                 const auto face = hn::IfThenElse(hn::Lt(rate, zero), lo, hi);

@@ -179,7 +179,15 @@ struct RayPacketT {
             // Per lane: index units per unit of t along each axis.
             for (std::size_t l = 0; l < lanes; ++l) {
                 const double dl[3] = {double(dx[l]), double(dy[l]), double(dz[l])};
-                for (int a = 0; a < 3; ++a) rate_[a][l] = T(dl[a] * vskip_->inv_spacing[a]);
+                T fastest = T(0);
+                for (int a = 0; a < 3; ++a) {
+                    rate_[a][l] = T(dl[a] * vskip_->inv_spacing[a]);
+                    const T speed = std::abs(rate_[a][l]);
+                    inv_speed_[a][l] = speed > T(0) ? T(1) / speed : std::numeric_limits<T>::infinity();
+                    fastest = std::max(fastest, speed);
+                }
+                // dt's margin: 0.01 cell at the fastest axis' rate, and the pre-integrated segments' h / 2.
+                margin_[l] = T(0.01) / fastest + T(vskip_->end_margin);
             }
         }
     }
@@ -309,22 +317,19 @@ private:
             // face ahead, in index units.
             const auto rf = hn::Max(radius, hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
-            auto fastest = zero;
             for (int a = 0; a < 3; ++a) {
                 const auto rate = hn::Load(d, rate_[a] + i);
                 const auto low = hn::Mul(to_lanes(d, mc[a]), hn::Set(d, T(kM)));  // m's first cell
                 const auto lo = hn::Sub(low, hn::Mul(hn::Sub(rf, hn::Set(d, T(1))), hn::Set(d, T(kM))));
                 const auto hi = hn::Add(low, hn::Mul(rf, hn::Set(d, T(kM))));
                 const auto face = hn::IfThenElse(hn::Lt(rate, zero), lo, hi);
-                const auto speed = hn::Abs(rate);
-                dt = hn::Min(dt, hn::Div(hn::Abs(hn::Sub(face, u[a])), speed));
-                fastest = hn::Max(fastest, speed);
+                dt = hn::Min(dt, hn::Mul(hn::Abs(hn::Sub(face, u[a])), hn::Load(d, inv_speed_[a] + i)));
             }
             // Non-empty lanes inside the grid: the next check where they leave m; the others every step.
             const auto solid = hn::AndNot(empty, inside);
             hn::Store(hn::IfThenElse(solid, hn::Add(t, dt), hn::Set(d, -std::numeric_limits<T>::infinity())), d, recheck_ + i);
             if (hn::AllFalse(d, empty)) continue;
-            dt = hn::Sub(dt, hn::Add(hn::Div(hn::Set(d, T(0.01)), fastest), hn::Set(d, T(s.end_margin))));
+            dt = hn::Sub(dt, hn::Load(d, margin_ + i));
             const auto jump = hn::And(empty, hn::Gt(dt, zero));
             if (hn::AllFalse(d, jump)) continue;
             hn::Store(hn::IfThenElseZero(jump, dt), d, dt_buf + i);
@@ -362,6 +367,8 @@ private:
 
     const VectorSkip* vskip_ = nullptr;
     HWY_ALIGN T rate_[3][kLanes] = {};
+    HWY_ALIGN T inv_speed_[3][kLanes] = {};  // 1 / |rate| (+inf where the ray is parallel to the axis' planes)
+    HWY_ALIGN T margin_[kLanes] = {};
     // Where each lane's next check is due (local t): the exit of the non-empty macrocell it was last
     // found in, -inf when due now (a new run, a moved lane, outside the grid).
     HWY_ALIGN T recheck_[kLanes];

@@ -111,9 +111,10 @@ struct VectorSkip {
 // With a VectorSkip (composite, float or double lanes) the walks do not skip; instead, after every
 // lane's segment k is placed, its position p = o + t d in T (the kernel's own arithmetic) gives the
 // cell the kernel's trilinear read uses, cell = min(floor(clamp((p - origin) / s, 0, n - 1)), n - 2),
-// and its macrocell m = cell / 8; where empty_radius(m) = r >= 1, every macrocell within r - 1 of m is empty,
-// and the ray stays in that box B for dt = the distance to B's exit face along the ray (index space:
-// B spans cells [(m - r + 1) 8, (m + r) 8) per axis), less 0.01 cell and, for pre-integrated segments,
+// (origin: the grid's on double lanes, 0 on float lanes, whose positions are local), and its macrocell
+// m = cell / M (M = kMacrocellSize, 8); where empty_radius(m) = r >= 1, every macrocell within r - 1 of
+// m is empty, and the ray stays in that box B for dt = the distance to B's exit face along the ray
+// (index space: B spans cells [(m - r + 1) M, (m + r) M) per axis), less 0.01 cell and, for pre-integrated segments,
 // less h / 2. The lane then moves on to the first segment whose midpoint lies at or after t + dt:
 // every segment passed over samples inside B (positions within dt of p), so it reads voxels of
 // empty macrocells only and its opacity is 0 exactly; the image is the image without skipping. The

@@ -1,5 +1,7 @@
 #include "core/sample/Tricubic.h"
 
+#include "core/sample/IndexSpace.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -36,33 +38,6 @@ void cubic_weights(CubicKernel k, double t, std::array<double, 4>& w, std::array
 
 namespace {
 
-// One axis of the tensor product: the 4 weights, their derivatives and the clamped tap indices.
-struct Axis {
-    std::array<double, 4> w;
-    std::array<double, 4> dw;
-    std::array<std::int64_t, 4> idx;
-};
-
-Axis setup_axis(CubicKernel k, double u, std::int64_t n) {
-    Axis a;
-    if (n <= 1) {
-        // The single layer, exactly: all taps clamp to 0, so (0, 1, 0, 0) gives the same value
-        // without the rounding of 1/6 + 4/6 + 1/6; the derivative is 0.
-        a.w = {0.0, 1.0, 0.0, 0.0};
-        a.dw = {0.0, 0.0, 0.0, 0.0};
-        a.idx = {0, 0, 0, 0};
-        return a;
-    }
-    const double hi = double(n - 1);
-    if (!(u > 0.0)) u = 0.0;  // also NaN
-    else if (u > hi) u = hi;
-    const std::int64_t i = std::min<std::int64_t>(std::int64_t(std::floor(u)), n - 2);
-    const double t = u - double(i);
-    cubic_weights(k, t, a.w, a.dw);
-    for (int m = 0; m < 4; ++m) a.idx[m] = std::clamp<std::int64_t>(i - 1 + m, 0, n - 1);
-    return a;
-}
-
 // ((w0 f0 + w1 f1) + w2 f2) + w3 f3: the one summation order used everywhere.
 inline double dot4(const std::array<double, 4>& w, const double* f) {
     double s = w[0] * f[0];
@@ -76,10 +51,8 @@ inline double dot4(const std::array<double, 4>& w, const double* f) {
 // operations as with Gradient = true, so the values agree bit for bit).
 // T: the storage type (one instantiation per type; evaluate() dispatches once per sample).
 template <bool Gradient, class T>
-double evaluate_typed(const Volume& v, const T* data, CubicKernel k, const glm::dvec3& u, glm::dvec3* gradient) {
-    const Axis ax = setup_axis(k, u.x, v.dims[0]);
-    const Axis ay = setup_axis(k, u.y, v.dims[1]);
-    const Axis az = setup_axis(k, u.z, v.dims[2]);
+double evaluate_typed(const Volume& v, const T* data, const CubicAxis& ax, const CubicAxis& ay, const CubicAxis& az,
+                      glm::dvec3* gradient) {
     const std::int64_t nx = v.dims[0], ny = v.dims[1];
 
     // Pass 1 (along i) for the 16 rows, k outer, j inner.
@@ -117,11 +90,22 @@ double evaluate_typed(const Volume& v, const T* data, CubicKernel k, const glm::
 }
 
 template <bool Gradient>
+double evaluate(const Volume& v, const CubicAxis& ax, const CubicAxis& ay, const CubicAxis& az, glm::dvec3* gradient) {
+    return v.values.visit([&](const auto* data) { return evaluate_typed<Gradient>(v, data, ax, ay, az, gradient); });
+}
+
+// Clamped axes (the Cartesian grid).
+template <bool Gradient>
 double evaluate(const Volume& v, CubicKernel k, const glm::dvec3& u, glm::dvec3* gradient) {
-    return v.values.visit([&](const auto* data) { return evaluate_typed<Gradient>(v, data, k, u, gradient); });
+    return evaluate<Gradient>(v, cubic_axis(k, u.x, v.dims[0], false), cubic_axis(k, u.y, v.dims[1], false),
+                              cubic_axis(k, u.z, v.dims[2], false), gradient);
 }
 
 }  // namespace
+
+double tricubic(const Volume& v, const CubicAxis& x, const CubicAxis& y, const CubicAxis& z) {
+    return evaluate<false>(v, x, y, z, nullptr);
+}
 
 double tricubic(const Volume& v, CubicKernel k, const glm::dvec3& u) {
     return evaluate<false>(v, k, u, nullptr);

@@ -47,6 +47,7 @@
 // weights as 0, so that gradient component is exactly 0.
 #pragma once
 #include <array>
+#include <cstdint>
 
 #include <glm/vec3.hpp>
 
@@ -59,6 +60,19 @@ enum class CubicKernel { BSpline, CatmullRom };
 // Weights w of the 4 taps i-1, i, i+1, i+2 at fraction t in [0, 1] of the cell [i, i+1], and their
 // derivatives dw = dw/dt (formulas above).
 void cubic_weights(CubicKernel k, double t, std::array<double, 4>& w, std::array<double, 4>& dw);
+
+// One axis of the tensor product: the 4 weights, their derivatives and the tap indices (IndexSpace.h's
+// cubic_axis: clamped taps on a Cartesian axis, wrapped ones on a shell's periodic axis). The default is
+// the single layer of an axis with n = 1.
+struct CubicAxis {
+    std::array<double, 4> w{0.0, 1.0, 0.0, 0.0};
+    std::array<double, 4> dw{0.0, 0.0, 0.0, 0.0};
+    std::array<std::int64_t, 4> idx{0, 0, 0, 0};
+};
+
+// The tensor-product cubic over the taps of three axes (the nested passes above); the functions below
+// are it on clamped axes, ShellSampler on its own.
+double tricubic(const Volume& v, const CubicAxis& x, const CubicAxis& y, const CubicAxis& z);
 
 // The tensor-product cubic at continuous index u (each component clamped to [0, n - 1]).
 double tricubic(const Volume& v, CubicKernel k, const glm::dvec3& u);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/sample/IndexSpace.h"
 #include "core/sample/Trilinear.h"
 #include "core/sample/Tricubic.h"
 
@@ -29,11 +30,9 @@ glm::dvec3 VolumeSampler::tricubic_gradient(const glm::dvec3& world) const {
 }
 
 double VolumeSampler::nearest(const glm::dvec3& world) const {
-    const glm::dvec3 u = continuous_index(world);
-    std::array<std::int64_t, 3> idx;
-    for (int a = 0; a < 3; ++a)
-        idx[a] = std::min<std::int64_t>(std::int64_t(std::floor(u[a] + 0.5)), volume_.dims[a] - 1);
-    return volume_.at(idx[0], idx[1], idx[2]);
+    const glm::dvec3 u = continuous_index(world);  // clamped: IndexSpace.h's clamp leaves it as it is
+    return volume_.at(nearest_axis(u.x, volume_.dims[0], false), nearest_axis(u.y, volume_.dims[1], false),
+                      nearest_axis(u.z, volume_.dims[2], false));
 }
 
 }  // namespace volref

@@ -17,6 +17,7 @@
 
 #include "core/grid/Volume.h"
 #include "core/sample/FieldSampler.h"
+#include "core/sample/IndexSpace.h"
 #include "core/sample/Trilinear.h"
 #include "core/scene/Scene.h"
 
@@ -77,18 +78,12 @@ inline void VolumeSampler::locate(const glm::dvec3& u, std::array<std::int64_t, 
 }
 
 inline std::array<double, 8> VolumeSampler::corners(const std::array<std::int64_t, 3>& c) const {
-    const std::int64_t i0 = c[0], j0 = c[1], k0 = c[2];
-    const std::int64_t i1 = std::min(i0 + 1, volume_.dims[0] - 1);
-    const std::int64_t j1 = std::min(j0 + 1, volume_.dims[1] - 1);
-    const std::int64_t k1 = std::min(k0 + 1, volume_.dims[2] - 1);
-    const Volume& v = volume_;
-    const std::size_t n[8] = {v.index(i0, j0, k0), v.index(i1, j0, k0), v.index(i1, j1, k0), v.index(i0, j1, k0),
-                              v.index(i0, j0, k1), v.index(i1, j0, k1), v.index(i1, j1, k1), v.index(i0, j1, k1)};
-    // One switch on the storage type per cell, then eight typed loads (exact conversions to double).
-    return v.values.visit([&](const auto* p) -> std::array<double, 8> {
-        return {double(p[n[0]]), double(p[n[1]]), double(p[n[2]]), double(p[n[3]]),
-                double(p[n[4]]), double(p[n[5]]), double(p[n[6]]), double(p[n[7]])};
-    });
+    LinearAxis axis[3];  // the cell's two layers per axis (one where n = 1)
+    for (int a = 0; a < 3; ++a) {
+        axis[a].i0 = c[std::size_t(a)];
+        axis[a].i1 = std::min(c[std::size_t(a)] + 1, volume_.dims[std::size_t(a)] - 1);
+    }
+    return cell_corners(volume_, axis[0], axis[1], axis[2]);
 }
 
 inline double VolumeSampler::trilinear(const glm::dvec3& world) const {

@@ -358,6 +358,40 @@ TEST(ShellSampler, NonPeriodicGridMatchesVolumeSamplerBitForBit) {
     }
 }
 
+// A periodic axis is a clamped one over the wrapped samples (core/sample/IndexSpace.h): the shell
+// sampler at index u on a full turn of n angles equals VolumeSampler, the Cartesian sampler, at u + 2
+// on the same volume padded with two wrapped layers each side (n + 4 angles: j - 2 mod n). Every tap
+// of the cubic (i - 1 .. i + 2) and both corners of the seam's cell lie inside the padding, so nothing
+// clamps there; only the fraction's rounding differs (u - floor(u) against (u + 2) - floor(u + 2)).
+// An error in the wrap (a tap taken as i - 1 + m without mod n, a seam corner clamped) is a difference
+// of the size of the data's (noise in [-1, 1]).
+TEST(ShellSampler, APeriodicAxisIsTheCartesianSamplerOnTheWrappedSamples) {
+    std::mt19937_64 rng(29);
+    std::uniform_real_distribution<double> noise(-1.0, 1.0);
+    constexpr std::int64_t n = 12;
+    const Volume v = make_volume({4, n, 3}, [&](std::int64_t, std::int64_t, std::int64_t) { return noise(rng); });
+    const Volume padded = make_volume({4, n + 4, 3}, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+        return v.at(i, ((j - 2) % n + n) % n, k);
+    });
+    CylindricalShell c;
+    c.r0 = 0.5, c.r1 = 1.0, c.a0 = 0.0, c.a1 = 360.0, c.h0 = 0.0, c.h1 = 1.0;
+    std::uniform_real_distribution<double> radial(-0.5, 3.5), angle(0.0, double(n)), height(-0.5, 2.5);
+    for (Interpolation in : {Interpolation::Nearest, Interpolation::Trilinear, Interpolation::TricubicBSpline,
+                             Interpolation::TricubicCatmullRom}) {
+        const ShellSampler shell(v, c, in);
+        ASSERT_TRUE(shell.grid().axis(1).periodic);
+        const VolumeSampler box(padded, in);
+        double worst = 0.0;
+        for (int m = 0; m < 2000; ++m) {
+            // Every tenth point within 1e-9 of the seam (u = 0 from either side, and the last cell).
+            const double a = m % 10 == 0 ? (m % 20 == 0 ? 1e-9 : double(n) - 1e-9) : angle(rng);
+            const glm::dvec3 u(radial(rng), a, height(rng));
+            worst = std::max(worst, std::abs(shell.index_value(u) - box.value(u + glm::dvec3(0.0, 2.0, 0.0))));
+        }
+        EXPECT_LE(worst, 1e-14) << int(in);
+    }
+}
+
 // The angle field f = cos(theta) on a full-turn grid of 36 angles (10 degrees apart), with the
 // grid's seam at 0 and at 300 degrees.
 class SeamTest : public ::testing::TestWithParam<double> {

@@ -9,9 +9,10 @@
 //
 // The callback gets one MarchSample per sample and returns true to go on, false to stop (opaque, a
 // hit, early termination). Its SIMD form is the packet kernels' walk (packet/PacketKernels-inl.h:
-// ForwardSegmentWalk::next_run, the same segments in the same order); the adaptive integrator and
-// the image-space renderers (vtk-cpu) and mirrored programs (vtk-js's shader loop, seed 001's kernel)
-// place their samples their own way (docs/architecture.md, "One march").
+// ForwardSegmentWalk::next_run, the same segments in the same order); the mirrored programs' loops are
+// placements of it too (vtk.js's shader loop: ShaderEnds; seed 001's float32 kernel: FromExitFloat32).
+// Only the adaptive integrator and vtk-cpu's image-space renderer place their samples their own way
+// (docs/architecture.md, "One march").
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -29,20 +30,31 @@ namespace volref {
 // One sample of the march: its position t and the length d it stands for; for the segment placement
 // also its segment (t = s.midpoint(), d = s.length()), the interval it lies in and its index k of the
 // interval's n segments. A profile's sample from the entry or the exit has s = {t, t}, k and n its count.
+// ShaderEnds also says which sample it is (`end`) and the part of a step it stands for (`steps`).
 struct MarchSample {
+    enum class End { None, Entry, Exit, Only };
     double t = 0.0, d = 0.0;
     Segment s{0.0, 0.0};
     std::size_t interval = 0;
     std::int64_t k = 0, n = 0;
+    End end = End::None;
+    double steps = 1.0;
 };
 
 enum class MarchOrder { FrontToBack, BackToFront };
 
 // Where the samples lie (SamplePlacement.h; conventions sections 4 and 9).
+// ShaderEnds (vtk.js's vtkVolumeFS.glsl, over the hull [t0, t1] of the intervals, R = (t1 - t0) / h):
+// where R <= 1 the entry alone (End::Only, standing for R steps); else the entry (End::Entry, standing
+// for `first` steps), then t0 + c h for c = first, first + 1, ... (the shader's float counter, c += 1)
+// while c + 1 < R, then where R - c > 0 the exit t1 (End::Exit, standing for R - c steps).
+// FromExitFloat32 (seed 001's CUDA kernel, `for (float s = outAbs; s >= inAbs; s -= step)`): s = t1,
+// then s - h, ..., in float32 (t1, t0 and h are floats the caller gives as doubles), while s >= t0;
+// the caller checks first that s - h moves s (else the program does not end).
 struct MarchPlacement {
-    enum class Kind { Midpoints, FromEntry, FromExit };
+    enum class Kind { Midpoints, FromEntry, FromExit, ShaderEnds, FromExitFloat32 };
     Kind kind = Kind::Midpoints;
-    double first = 0.0;  // FromEntry: the first sample's distance from the entry, in steps
+    double first = 0.0;  // FromEntry, ShaderEnds: the first (inner) sample's distance from the entry, in steps
     bool through_exit = true;  // FromEntry / FromExit: sample_count's rule (ThroughExit, else BeforeExit)
 };
 
@@ -121,6 +133,40 @@ template <class Fn>
 void march(const std::vector<Interval>& intervals, const MarchOptions& o, Fn&& on_sample) {
     const double h = o.step;
     using Kind = MarchPlacement::Kind;
+    if (o.placement.kind == Kind::ShaderEnds || o.placement.kind == Kind::FromExitFloat32) {
+        if (intervals.empty()) return;
+        const double t0 = intervals.front().t0, t1 = intervals.back().t1;
+        if (o.placement.kind == Kind::FromExitFloat32) {
+            const float in = float(t0), step = float(h);
+            std::int64_t k = 0;
+            for (float s = float(t1); s >= in; s -= step, ++k)
+                if (cancel_polled(k) || !on_sample(MarchSample{double(s), h, {double(s), double(s)}, 0, k, 0})) return;
+            return;
+        }
+        using End = MarchSample::End;
+        auto at = [&](double t, std::int64_t k, End end, double steps) {
+            MarchSample m{t, h, {t, t}, 0, k, 0};
+            m.end = end;
+            m.steps = steps;
+            return m;
+        };
+        const double R = (t1 - t0) / h;  // raySteps
+        if (R <= 1.0) {  // "handle very thin volumes"
+            on_sample(at(t0, 0, End::Only, R));
+            return;
+        }
+        if (!on_sample(at(t0, 0, End::Entry, o.placement.first))) return;
+        double travelled = o.placement.first;
+        std::int64_t k = 1;
+        while (travelled + 1.0 < R) {
+            if (cancel_polled(std::int64_t(travelled))) return;
+            const double t = t0 + travelled * h;
+            travelled += 1.0;
+            if (!on_sample(at(t, k++, End::None, 1.0))) return;
+        }
+        if (R - travelled > 0.0) on_sample(at(t1, k, End::Exit, R - travelled));
+        return;
+    }
     if (o.placement.kind == Kind::FromExit) {  // seed 001: s = outAbs, outAbs - h, ... >= inAbs, over the whole hull
         if (intervals.empty()) return;
         Interval hull = intervals.front();

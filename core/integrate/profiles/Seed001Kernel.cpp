@@ -16,6 +16,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/grid/Volume.h"
+#include "core/integrate/march/March.h"
 #include "core/integrate/profiles/TextureUnit.h"
 #include "core/scene/Scene.h"
 #include "geometry/ShellTessellation.h"
@@ -327,6 +328,19 @@ std::array<float, 4> Seed001Kernel::table_fetch(float u) const {
 // --- the kernel ------------------------------------------------------------------------------------
 Seed001Pixel Seed001Kernel::pixel(const Ray& ray) const { return pixel(ray, nullptr); }
 
+namespace {
+
+// The kernel's loop over [in, out] by float32 steps from the exit (March.h, FromExitFloat32).
+std::vector<Interval> hull(float in, float out) { return {Interval{double(in), double(out)}}; }
+MarchOptions float_from_exit(float step) {
+    MarchOptions o;
+    o.step = double(step);
+    o.placement.kind = MarchPlacement::Kind::FromExitFloat32;
+    return o;
+}
+
+}  // namespace
+
 Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) const {
     // The host: origin - centre and the unit direction, in double, then float.
     const glm::dvec3 o = ray.origin - f_.center, dv = glm::normalize(ray.direction);
@@ -357,8 +371,9 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
         }
         std::array<float, 4> sum{0.0f, 0.0f, 0.0f, 0.0f};
         float max_val = 0.0f;
-        for (float s = sp.out_abs; s >= in; s -= f_.step) {
-            if (cancel_polled(px.samples)) break;  // SIGINT / SIGTERM: the render is abandoned
+        // The loop `for (float s = outAbs; s >= inAbs; s -= step)`: march()'s FromExitFloat32 placement.
+        march(hull(in, sp.out_abs), float_from_exit(f_.step), [&](const MarchSample& m) {
+            const float s = float(m.t);  // exact: m.t holds the float s
             const F3 point = along(O, s, V);
             const float sample = sample_at(point);
             const bool used = sample >= f_.iso;
@@ -374,7 +389,8 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
                 }
             }
             if (samples) samples->push_back({s, point, sample, used, f_.xray ? std::array<float, 4>{max_val, max_val, max_val, 1.0f} : sum});
-        }
+            return true;
+        });
         if (f_.xray) {
             const float m = max_val * f_.xray_brightness;
             px.rgba = glm::dvec4(m, m, m, 1.0);
@@ -547,15 +563,18 @@ Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Spa
             sum_hi[c] = h;
         }
     };
-    float s = sp.out_abs;
-    float last = s;
+    // The kernel's samples (march()'s FromExitFloat32, as pixel()), at most 2^26.
+    float last = sp.out_abs;
     std::int64_t count = 0;
-    for (; s >= in; s -= f_.step) {
-        last = s;
-        add(s, double(s) - double(in) <= eps_end);
-        if (++count > (std::int64_t(1) << 26)) break;
-    }
-    // one more sample where the end test could pass within rounding
+    bool capped = false;
+    march(hull(in, sp.out_abs), float_from_exit(f_.step), [&](const MarchSample& m) {
+        last = float(m.t);
+        add(last, double(last) - double(in) <= eps_end);
+        capped = ++count > (std::int64_t(1) << 26);
+        return !capped;
+    });
+    // one more sample where the end test could pass within rounding: the loop's next s
+    const float s = capped ? last : last - f_.step;
     if (count > 0 && double(in) - double(s) <= eps_end && s != last) add(s, true);
     const double round = double(n) * 2.0 * kU;  // each lerp's float32 rounding (or the max: exact)
     if (f_.xray) {

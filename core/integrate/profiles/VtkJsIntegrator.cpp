@@ -1,6 +1,7 @@
 #include "core/integrate/profiles/VtkJsIntegrator.h"
 
 #include "core/integrate/march/Accumulators.h"
+#include "core/integrate/march/March.h"
 
 #include <algorithm>
 #include <cmath>
@@ -290,8 +291,6 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
     double t0 = 0.0, t1 = 0.0;
     if (!box(ray, t0, t1)) return out;  // the fragment is discarded: the background stays
     const double h = step_;
-    const double R = (t1 - t0) / h;  // raySteps
-    const double j = jitter_;
     auto record = [&](double t, double alpha, const glm::dvec4& acc) {
         if constexpr (Rec::kOn) {
             SampleRecord r{};
@@ -310,15 +309,16 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         }
     };
 
+    // The samples: march()'s ShaderEnds placement over [t0, t1] (the entry, t0 + (j + k) h while
+    // j + k + 1 < R, the exit; R = (t1 - t0) / h; R <= 1: the entry alone).
+    MarchOptions o;
+    o.step = h;
+    o.placement.kind = MarchPlacement::Kind::ShaderEnds;
+    o.placement.first = jitter_;
+    const std::vector<Interval> hull{Interval{t0, t1}};
+    using End = MarchSample::End;
     if (is_composite(ctx_.render.projection)) {
         const glm::dvec3 d = ray.direction;
-        Sample first = color_at(ray.at(t0), d);
-        if (R <= 1.0) {  // "handle very thin volumes": the entry sample alone, alpha for R steps
-            const double a = 1.0 - glsl_pow(1.0 - first.alpha, R);
-            out.rgba = glm::dvec4(first.color * a, a);
-            record(t0, a, out.rgba);
-            return out;
-        }
         // Front to back with the opacity sum (march/Accumulators.h): C += (1 - A) a c, A += (1 - A) a.
         FrontToBack<Scalar, TransmittanceRule::OpacitySum> acc;
         auto add = [&](const Sample& s, double a) {
@@ -326,30 +326,38 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
             acc.add(true, false, 0.0, a, c);
         };
         auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
-        add(first, 1.0 - glsl_pow(1.0 - first.alpha, j));  // the first sample counts for `jitter` of a step
-        record(t0, acc.alpha(), accumulated());
-        double travelled = j;
-        bool stopped = false;
-        while (travelled + 1.0 < R) {
-            if (cancel_polled(std::int64_t(travelled))) break;  // SIGINT / SIGTERM: the render is abandoned
-            const double t = t0 + travelled * h;
-            const Sample s = color_at(ray.at(t), d);
+        bool thin = false;
+        march(hull, o, [&](const MarchSample& m) {
+            const Sample s = color_at(ray.at(m.t), d);
+            if (m.end == End::Only) {  // "handle very thin volumes": alpha for R steps, the pixel (a c, a)
+                const double a = 1.0 - glsl_pow(1.0 - s.alpha, m.steps);
+                out.rgba = glm::dvec4(s.color * a, a);
+                record(m.t, a, out.rgba);
+                thin = true;
+                return false;
+            }
+            if (m.end == End::Entry) {  // the first sample counts for `jitter` of a step
+                add(s, 1.0 - glsl_pow(1.0 - s.alpha, m.steps));
+                record(m.t, acc.alpha(), accumulated());
+                return true;
+            }
+            if (m.end == End::Exit) {  // the exit sample, for the remaining fraction, unless A reached 0.99
+                if (!(acc.alpha() < 0.99)) return false;
+                const double a = 1.0 - glsl_pow(1.0 - s.alpha, m.steps);
+                add(s, a);
+                record(m.t, a, accumulated());
+                return false;
+            }
             add(s, s.alpha);
-            travelled += 1.0;
-            record(t, s.alpha, accumulated());
-            if (acc.alpha() > 0.99) {  // alpha set to 1, the colour kept
+            record(m.t, s.alpha, accumulated());
+            if (acc.alpha() > 0.99) {  // alpha set to 1, the colour kept; the loop ends
                 const double C[3] = {acc.color(0), acc.color(1), acc.color(2)};
                 acc.resume(C, 1.0);
-                stopped = true;
-                break;
+                return false;
             }
-        }
-        if (!stopped && acc.alpha() < 0.99 && R - travelled > 0.0) {  // the exit sample, for the remaining fraction
-            const Sample s = color_at(ray.at(t1), d);
-            const double a = 1.0 - glsl_pow(1.0 - s.alpha, R - travelled);
-            add(s, a);
-            record(t1, a, accumulated());
-        }
+            return true;
+        });
+        if (thin) return out;
         const glm::dvec3 C(acc.color(0), acc.color(1), acc.color(2));
         const double A = acc.alpha();
         // gl_FragData = (C / A, A), blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) over the cleared
@@ -358,24 +366,16 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         return out;
     }
 
-    // mip / minip: the same positions (entry; entry + (j + k) h while j + k + 1 < R; exit).
+    // mip / minip: the same positions, every one read alike.
     const bool maximum = takes_maximum(ctx_.render.projection);
     auto better = [&](double v, double best) { return maximum ? v > best : v < best; };
-    double best = value(ray.at(t0));
-    record(t0, 0.0, glm::dvec4(0.0));
-    if (R > 1.0) {
-        double travelled = j;
-        while (travelled + 1.0 < R) {
-            if (cancel_polled(std::int64_t(travelled))) break;
-            const double v = value(ray.at(t0 + travelled * h));
-            if (better(v, best)) best = v;
-            record(t0 + travelled * h, 0.0, glm::dvec4(0.0));
-            travelled += 1.0;
-        }
-        const double v = value(ray.at(t1));
-        if (better(v, best)) best = v;
-        record(t1, 0.0, glm::dvec4(0.0));
-    }
+    double best = 0.0;
+    march(hull, o, [&](const MarchSample& m) {
+        const double v = value(ray.at(m.t));
+        if (m.end == End::Entry || m.end == End::Only || better(v, best)) best = v;
+        record(m.t, 0.0, glm::dvec4(0.0));
+        return true;
+    });
     if (!std::isfinite(best)) return out;
     const double a = table_opacity(best);
     if (a < 0.001) return out;  // getColorForDependentComponents returns vec4(0)

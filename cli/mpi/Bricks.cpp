@@ -13,7 +13,40 @@ namespace volref::mpi {
 
 namespace {
 
-void split(const Brick& box, int count, std::vector<Brick>& out) {
+// The work of each cell of `box` along `axis` (WorkBins' rule, Bricks.h); empty when there is none.
+std::vector<double> work_along(const Brick& box, int axis, const Lattice& lattice, const WorkBins& w) {
+    const std::int64_t n = box.hi[axis] - box.lo[axis];
+    std::vector<double> per_bin(std::size_t(w.bins[std::size_t(axis)]), 0.0);
+    // The part of bin b on axis a that the box covers (cells of the bin inside the box / its cells).
+    auto covered = [&](int a, std::int64_t b) {
+        const std::int64_t lo = lattice.lo[std::size_t(a)] + b * w.width[std::size_t(a)];
+        const std::int64_t hi = std::min(lo + w.width[std::size_t(a)], lattice.hi[std::size_t(a)]);
+        const std::int64_t in = std::min(hi, box.hi[std::size_t(a)]) - std::max(lo, box.lo[std::size_t(a)]);
+        return hi > lo ? double(std::max<std::int64_t>(in, 0)) / double(hi - lo) : 1.0;
+    };
+    double total = 0.0;
+    for (std::int64_t k = 0; k < w.bins[2]; ++k)
+        for (std::int64_t j = 0; j < w.bins[1]; ++j)
+            for (std::int64_t i = 0; i < w.bins[0]; ++i) {
+                const std::int64_t b[3] = {i, j, k};
+                double f = w.work[std::size_t(i + w.bins[0] * (j + w.bins[1] * k))];
+                for (int a = 0; a < 3; ++a)
+                    if (a != axis) f *= covered(a, b[a]);
+                per_bin[std::size_t(b[axis])] += f;
+                total += f;
+            }
+    if (!(total > 0.0)) return {};
+    std::vector<double> cell(std::size_t(std::max<std::int64_t>(n, 0)), 0.0);
+    for (std::int64_t c = 0; c < n; ++c) {
+        const std::int64_t b = std::min((box.lo[axis] + c - lattice.lo[axis]) / w.width[std::size_t(axis)], w.bins[std::size_t(axis)] - 1);
+        const std::int64_t blo = lattice.lo[axis] + b * w.width[std::size_t(axis)];
+        const std::int64_t bhi = std::min(blo + w.width[std::size_t(axis)], lattice.hi[axis]);
+        cell[std::size_t(c)] = per_bin[std::size_t(b)] / double(std::max<std::int64_t>(bhi - blo, 1));
+    }
+    return cell;
+}
+
+void split(const Brick& box, int count, const Lattice& lattice, const WorkBins* work, std::vector<Brick>& out) {
     if (count == 1) {
         out.push_back(box);
         return;
@@ -25,17 +58,51 @@ void split(const Brick& box, int count, std::vector<Brick>& out) {
     const int first = count / 2;
     // Cells in proportion to the ranks (the other axes are shared): balanced by voxel count.
     std::int64_t cut = box.lo[axis] + (cells * first + count / 2) / count;
+    if (work) {
+        // Balanced by work: the first cell boundary where the work before it reaches first / count.
+        const std::vector<double> w = work_along(box, axis, lattice, *work);
+        if (!w.empty()) {
+            double total = 0.0;
+            for (double x : w) total += x;
+            const double target = total * double(first) / double(count);
+            double before = 0.0;
+            std::int64_t c = 0;
+            while (c < cells && before + w[std::size_t(c)] <= target) before += w[std::size_t(c++)];
+            // the nearer of the boundaries around the target
+            if (c < cells && target - before > before + w[std::size_t(c)] - target) ++c;
+            cut = box.lo[axis] + c;
+        }
+    }
     cut = std::clamp<std::int64_t>(cut, box.lo[axis] + first, box.hi[axis] - (count - first));
     Brick a = box, b = box;
     a.hi[axis] = cut;
     b.lo[axis] = cut;
-    split(a, first, out);
-    split(b, count - first, out);
+    split(a, first, lattice, work, out);
+    split(b, count - first, lattice, work, out);
 }
 
 }  // namespace
 
-std::vector<Brick> split_lattice(const Lattice& cells_box, int count) {
+WorkBins::WorkBins(const Lattice& cells, std::int64_t bins_per_axis) {
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t n = std::max<std::int64_t>(cells.hi[a] - cells.lo[a], 1);
+        bins[a] = std::clamp<std::int64_t>(bins_per_axis, 1, n);
+        width[a] = (n + bins[a] - 1) / bins[a];
+        bins[a] = (n + width[a] - 1) / width[a];
+    }
+    work.assign(std::size_t(bins[0] * bins[1] * bins[2]), 0.0);
+}
+
+std::size_t WorkBins::bin_of(const Lattice& cells, const glm::dvec3& u) const {
+    std::int64_t b[3];
+    for (int a = 0; a < 3; ++a) {
+        const double c = std::floor(u[a]) - double(cells.lo[a]);
+        b[a] = c > 0.0 ? std::min(std::int64_t(std::min(c, 9e18)) / width[a], bins[a] - 1) : 0;  // NaN: 0
+    }
+    return std::size_t(b[0] + bins[0] * (b[1] + bins[1] * b[2]));
+}
+
+std::vector<Brick> split_lattice(const Lattice& cells_box, int count, const WorkBins* work) {
     Brick whole;
     std::int64_t cells = 1;
     for (int a = 0; a < 3; ++a) {
@@ -47,7 +114,7 @@ std::vector<Brick> split_lattice(const Lattice& cells_box, int count) {
         throw Error("volume: " + std::to_string(count) + " ranks but the longest axis has only " + std::to_string(cells) +
                     " cells; use at most that many ranks");
     std::vector<Brick> out;
-    split(whole, count, out);
+    split(whole, count, cells_box, work, out);
     return out;
 }
 

@@ -21,6 +21,7 @@ struct Brick {
     // The cells [lo, hi) on each axis (indices of the first volume's lattice; a cell a spans its
     // planes a and a + 1). An axis of one voxel has the one "cell" [0, 0).
     std::array<std::int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+    bool operator==(const Brick&) const = default;
 };
 
 // The cells [lo, hi) of the lattice of the first volume's grid, extended beyond that
@@ -30,7 +31,22 @@ struct Brick {
 struct Lattice {
     std::array<std::int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
 };
-std::vector<Brick> split_lattice(const Lattice& cells, int count);
+// Work measured over the lattice in bins (WorkBins: each axis' cells in `bins` equal runs of `width`
+// cells, the last shorter). With it each cut balances the work of the two halves (in proportion to
+// their ranks) instead of their cell counts: the box's work per cell along the axis (each bin's work
+// spread evenly over its cells, the bins the box covers only in part counted by the fraction it
+// covers), the cut at the first cell where the work before it reaches first / count of the box's
+// work. No work in the box: the cell rule.
+struct WorkBins {
+    std::array<std::int64_t, 3> bins{1, 1, 1}, width{1, 1, 1};
+    std::vector<double> work;  // bins[0] bins[1] bins[2] values, x fastest
+    // `bins_per_axis` bins on each axis of `cells` (fewer where an axis has fewer cells).
+    WorkBins(const Lattice& cells, std::int64_t bins_per_axis);
+    WorkBins() = default;
+    // The bin of a continuous lattice index (clamped to the lattice).
+    std::size_t bin_of(const Lattice& cells, const glm::dvec3& u) const;
+};
+std::vector<Brick> split_lattice(const Lattice& cells, int count, const WorkBins* work = nullptr);
 
 // A grid: `dims` voxels at origin + i * spacing in its own space, placed in the world by `to_world`
 // (null: its space is world space).

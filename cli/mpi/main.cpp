@@ -1,4 +1,4 @@
-// volref-mpi render SCENE -o OUT [--threads T] [--max-memory M] [--set PATH=VALUE ...]
+// volref-mpi render SCENE -o OUT [--threads T] [--max-memory M] [--set PATH=VALUE ...] [--balance cells|work]
 //
 // Space split into bricks over the MPI ranks (cli/mpi/Bricks.h: a k-d split of the first volume's
 // lattice, extended over every volume); each rank holds its brick of every volume plus a ghost layer
@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
@@ -32,6 +33,7 @@
 #include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
 #include "core/scene/SceneLoader.h"
+#include "cli/mpi/Balance.h"
 #include "cli/mpi/Chain.h"
 #include "cli/mpi/Compositing.h"
 #include "cli/mpi/Frame.h"
@@ -87,6 +89,7 @@ struct Args {
     bool timing = false;
     std::string compositing = "swap";
     bool compositing_given = false;
+    std::string balance = "cells";
 };
 
 double now() { return MPI_Wtime(); }
@@ -106,7 +109,7 @@ std::string guarded(F&& f) {
 
 // Set-up, first half: the scene, every volume's grid, the lattice and its bricks, and this rank's
 // brick of every volume (read as a sub-box of its file, or generated).
-void read_bricks(const Args& args, Frame& f) {
+void read_bricks(const Args& args, Frame& f, const std::vector<Brick>* bricks) {
     if (!args.max_memory.empty()) set_memory_limit(parse_memory_size(args.max_memory, "--max-memory"));
     if (f.rank == 0 && !dump_output(args.output)) check_output_path(args.output);
     f.scene = load_scene(args.scene, args.overrides);
@@ -139,7 +142,7 @@ void read_bricks(const Args& args, Frame& f) {
         grids.push_back(m.grid);
     }
     f.lattice = union_lattice(grids);
-    f.bricks = split_lattice(f.lattice, f.size);
+    f.bricks = bricks ? *bricks : split_lattice(f.lattice, f.size);
     std::size_t held = 0;  // the bricks read before this one (--max-memory counts them all)
     for (std::size_t k = 0; k < f.members.size(); ++k) {
         const VolumeSpec& vs = f.scene.volumes[k];
@@ -303,18 +306,18 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
     });
 }
 
-void print_timing(const Frame& f, bool chain, bool swap, const double (&mine)[2], double gather_s, double write_s,
-                  const Traffic& traffic) {
+void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, const double (&mine)[2], double gather_s,
+                  double write_s, const Traffic& traffic) {
     double slowest[2] = {0.0, 0.0};
     MPI_Reduce(mine, slowest, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
     unsigned long long sent = traffic.sent, most = 0;
     MPI_Reduce(&sent, &most, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
     if (f.rank == 0)
         std::fprintf(stderr,
-                     "volref: timing {\"ranks\": %d, \"compositing\": \"%s\", \"setup_s\": %.4f, \"render_s\": %.4f, "
+                     "volref: timing {\"ranks\": %d, \"compositing\": \"%s\", \"bricks\": \"%s\", \"setup_s\": %.4f, \"render_s\": %.4f, "
                      "\"gather_s\": %.4f, \"combine_write_s\": %.4f, \"bytes_sent_per_rank\": %llu, "
                      "\"bytes_received_rank0\": %llu, \"image_bytes\": %zu}\n",
-                     f.size, chain ? "chain" : swap ? "swap" : "direct", slowest[0], slowest[1], gather_s, write_s, most,
+                     f.size, chain ? "chain" : swap ? "swap" : "direct", bricks, slowest[0], slowest[1], gather_s, write_s, most,
                      (unsigned long long)traffic.received, f.pixels() * std::size_t(f.channels()) * sizeof(double));
 }
 
@@ -324,12 +327,31 @@ int run(const Args& args, int rank, int size) {
     const bool power_of_two = (size & (size - 1)) == 0;
     const bool swap = args.compositing == "swap" && power_of_two && size > 1;
     const double t_start = now();
-    Frame f;
-    f.rank = rank;
-    f.size = size;
-    f.threads = args.threads;
-    if (any_error(guarded([&] { read_bricks(args, f); }), rank, size)) return 1;
-    if (any_error(guarded([&] { prepare(args, f, swap); }), rank, size)) return 1;
+    auto fresh = [&] {
+        auto f = std::make_unique<Frame>();
+        f->rank = rank;
+        f->size = size;
+        f->threads = args.threads;
+        return f;
+    };
+    std::unique_ptr<Frame> frame = fresh();
+    if (any_error(guarded([&] { read_bricks(args, *frame, nullptr); }), rank, size)) return 1;
+    if (any_error(guarded([&] { prepare(args, *frame, swap); }), rank, size)) return 1;
+    const char* bricks = "cells";  // how the bricks were cut (--timing): cells, work (cut again), work-same-cut
+    if (args.balance == "work" && size > 1) {  // the bricks again, cut where the work balances
+        WorkBins work;
+        if (any_error(guarded([&] { work = count_work(*frame); }), rank, size)) return 1;
+        const std::vector<Brick> balanced = balanced_bricks(*frame, std::move(work));
+        bricks = "work-same-cut";
+        if (balanced != frame->bricks) {
+            bricks = "work";
+            frame.reset();  // (its bricks' memory first)
+            frame = fresh();
+            if (any_error(guarded([&] { read_bricks(args, *frame, &balanced); }), rank, size)) return 1;
+            if (any_error(guarded([&] { prepare(args, *frame, swap); }), rank, size)) return 1;
+        }
+    }
+    Frame& f = *frame;
 
     const double t_setup = now();
     const bool chain = chained(f);
@@ -366,7 +388,8 @@ int run(const Args& args, int rank, int size) {
         });
     const double t_write = now();
     if (any_error(err, rank, size)) return 1;
-    if (args.timing) print_timing(f, chain, swap, {t_setup - t_start, t_render - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
+    if (args.timing)
+        print_timing(f, chain, swap, bricks, {t_setup - t_start, t_render - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
     if (args.compositing == "swap" && !power_of_two && args.compositing_given && rank == 0)
         std::fprintf(stderr, "volref-mpi: note: binary swap needs a power-of-two rank count; %d ranks used direct send\n",
                      size);
@@ -397,8 +420,13 @@ int main(int argc, char** argv) {
                    "to direct) or direct (MPI_Gather to rank 0)")
         ->check(CLI::IsMember({"direct", "swap"}))
         ->capture_default_str();
+    rc->add_option("--balance", args.balance,
+                   "Where the bricks are cut: cells (equal cell counts, the default) or work (the samples "
+                   "counted on every 4th pixel's rays balance; the bricks are read twice)")
+        ->check(CLI::IsMember({"work", "cells"}))
+        ->capture_default_str();
     rc->add_flag("--timing", args.timing,
-                 "Print one line on stderr (rank 0): volref: timing {ranks, compositing, setup_s, render_s (the slowest "
+                 "Print one line on stderr (rank 0): volref: timing {ranks, compositing, bricks (cells, work, work-same-cut), setup_s, render_s (the slowest "
                  "rank's), gather_s, combine_write_s, bytes_sent_per_rank (the most any rank sent), bytes_received_rank0, "
                  "image_bytes}");
     int status = 0;

@@ -176,6 +176,14 @@ if a.mode == "equal":
     cases.append(("xray-normalized-persp", s))
     for name, scene in cases:
         check_equal(name, write_scene(name, scene), a.np)
+    # --balance work (cli/mpi/Balance.h): the bricks cut where the probe's sample counts balance, read
+    # again; the image is the single process's as with any cut. The two composite scenes get other cuts
+    # than the cells' rule at 2 and 3 ranks (--timing says "bricks": "work"), the mip one the same cut
+    # ("work-same-cut": its samples balance there).
+    for name in ("composite-ftb-persp", "shaded-btf-tricubic-persp", "mip-ortho"):
+        path = os.path.join(a.work, name + ".json")
+        if os.path.exists(path):
+            check_equal(name + "-balanced", path, a.np, extra=["--balance", "work"])
     # The fast profile (conventions §9b, §14): float positions relative to each brick's origin, so a
     # rank's samples round differently from the single process's; the termination (Tr <= 2^-10) may then
     # fall one sample apart. Within the profile's own bound against the reference, 2^-10 times the
@@ -593,6 +601,10 @@ if a.mode == "adaptive":
         path = write_scene(name, scene)
         for np_ in (2, 3, 4):
             check_equal(name, path, np_)
+    # The chain over bricks cut by work (--balance work).
+    for name in ("adaptive-persp", "adaptive-vols-composite-persp-shaded"):
+        for np_ in (2, 3):
+            check_equal(name + "-balanced", os.path.join(a.work, name + ".json"), np_, extra=["--balance", "work"])
 
 if a.mode == "refusals":
     cases = {

@@ -32,6 +32,40 @@ TEST(MpiBricks, KdSplitByHand) {
     EXPECT_THROW(split_lattice(cells, 11), Error);  // more ranks than the longest axis' cells
 }
 
+// --balance work (WorkBins, Bricks.h), by hand. 16 x 4 x 4 cells in 8 bins per axis: 8 x 4 x 4 bins
+// (y and z have only 4 cells) of 2 x 1 x 1 cells. Work 3 in every bin with x < 4 (x bins 0, 1), 1
+// elsewhere: per x bin 16 bins in y, z, so 24 a cell below x = 4 and 8 above, 96 + 96 = 192 in all;
+// two ranks cut where 96 is reached: x = 4 (the cell rule: 8). Three ranks: the first third (64) is
+// passed within cell 2 (48 before it, 72 after), the nearer boundary x = 3; then [3, 16) holds
+// 24 + 96 = 120, half 60 reached within cell 8 (56 before it, 64 after: as near, the first, x = 8).
+// No work: the cell rule.
+TEST(MpiBricks, KdSplitByWorkByHand) {
+    Lattice cells;
+    cells.hi = {16, 4, 4};
+    WorkBins w(cells, 8);
+    ASSERT_EQ(w.bins, (std::array<std::int64_t, 3>{8, 4, 4}));
+    ASSERT_EQ(w.width, (std::array<std::int64_t, 3>{2, 1, 1}));
+    for (std::int64_t k = 0; k < 4; ++k)
+        for (std::int64_t j = 0; j < 4; ++j)
+            for (std::int64_t i = 0; i < 8; ++i) w.work[std::size_t(i + 8 * (j + 4 * k))] = i < 2 ? 3.0 : 1.0;
+    std::vector<Brick> b = split_lattice(cells, 2, &w);
+    ASSERT_EQ(b.size(), 2u);
+    EXPECT_EQ(b[0].hi[0], 4);
+    EXPECT_EQ(b[1].lo[0], 4);
+    EXPECT_EQ(split_lattice(cells, 2)[0].hi[0], 8);
+    b = split_lattice(cells, 3, &w);
+    ASSERT_EQ(b.size(), 3u);
+    EXPECT_EQ(b[0].hi[0], 3);
+    EXPECT_EQ(b[1].lo[0], 3);
+    EXPECT_EQ(b[1].hi[0], 8);
+    EXPECT_EQ(b[2].lo[0], 8);
+    // bin_of: a continuous index in cell 5 of x, 3 of y, 0 of z is bin (2, 3, 0); outside clamps.
+    EXPECT_EQ(w.bin_of(cells, glm::dvec3(5.5, 3.2, 0.1)), std::size_t(2 + 8 * 3));
+    EXPECT_EQ(w.bin_of(cells, glm::dvec3(-3.0, 99.0, 4.0)), std::size_t(0 + 8 * (3 + 4 * 3)));
+    std::fill(w.work.begin(), w.work.end(), 0.0);
+    EXPECT_EQ(split_lattice(cells, 2, &w)[0].hi[0], 8);
+}
+
 TEST(MpiBricks, EveryPointBelongsToExactlyOneBrick) {
     Lattice cells;
     cells.lo = {-3, 0, 2};

@@ -13,7 +13,6 @@
 
 #include <glm/geometric.hpp>
 
-#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/grid/Volume.h"
 #include "core/integrate/march/March.h"

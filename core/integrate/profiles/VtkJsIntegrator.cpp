@@ -12,7 +12,6 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"

@@ -133,16 +133,19 @@ template <class Fn>
 void march(const std::vector<Interval>& intervals, const MarchOptions& o, Fn&& on_sample) {
     const double h = o.step;
     using Kind = MarchPlacement::Kind;
-    if (o.placement.kind == Kind::ShaderEnds || o.placement.kind == Kind::FromExitFloat32) {
-        if (intervals.empty()) return;
-        const double t0 = intervals.front().t0, t1 = intervals.back().t1;
-        if (o.placement.kind == Kind::FromExitFloat32) {
-            const float in = float(t0), step = float(h);
-            std::int64_t k = 0;
-            for (float s = float(t1); s >= in; s -= step, ++k)
-                if (cancel_polled(k) || !on_sample(MarchSample{double(s), h, {double(s), double(s)}, 0, k, 0})) return;
-            return;
-        }
+    // The shaders' placements cast one segment through the hull [first t0, last t1] of the intervals.
+    const bool over_hull = o.placement.kind == Kind::FromExit || o.placement.kind == Kind::FromExitFloat32 ||
+                           o.placement.kind == Kind::ShaderEnds;
+    if (over_hull && intervals.empty()) return;
+    const Interval hull = over_hull ? Interval{intervals.front().t0, intervals.back().t1} : Interval{};
+    if (o.placement.kind == Kind::FromExitFloat32) {  // seed 001's kernel: float32 s = t1, s - h, ... >= t0
+        const float in = float(hull.t0), step = float(h);
+        std::int64_t k = 0;
+        for (float s = float(hull.t1); s >= in; s -= step, ++k)
+            if (cancel_polled(k) || !on_sample(MarchSample{double(s), h, {double(s), double(s)}, 0, k, 0})) return;
+        return;
+    }
+    if (o.placement.kind == Kind::ShaderEnds) {  // vtk.js's shader loop
         using End = MarchSample::End;
         auto at = [&](double t, std::int64_t k, End end, double steps) {
             MarchSample m{t, h, {t, t}, 0, k, 0};
@@ -150,27 +153,24 @@ void march(const std::vector<Interval>& intervals, const MarchOptions& o, Fn&& o
             m.steps = steps;
             return m;
         };
-        const double R = (t1 - t0) / h;  // raySteps
+        const double R = (hull.t1 - hull.t0) / h;  // raySteps
         if (R <= 1.0) {  // "handle very thin volumes"
-            on_sample(at(t0, 0, End::Only, R));
+            on_sample(at(hull.t0, 0, End::Only, R));
             return;
         }
-        if (!on_sample(at(t0, 0, End::Entry, o.placement.first))) return;
+        if (!on_sample(at(hull.t0, 0, End::Entry, o.placement.first))) return;
         double travelled = o.placement.first;
         std::int64_t k = 1;
         while (travelled + 1.0 < R) {
             if (cancel_polled(std::int64_t(travelled))) return;
-            const double t = t0 + travelled * h;
+            const double t = hull.t0 + travelled * h;
             travelled += 1.0;
             if (!on_sample(at(t, k++, End::None, 1.0))) return;
         }
-        if (R - travelled > 0.0) on_sample(at(t1, k, End::Exit, R - travelled));
+        if (R - travelled > 0.0) on_sample(at(hull.t1, k, End::Exit, R - travelled));
         return;
     }
-    if (o.placement.kind == Kind::FromExit) {  // seed 001: s = outAbs, outAbs - h, ... >= inAbs, over the whole hull
-        if (intervals.empty()) return;
-        Interval hull = intervals.front();
-        hull.t1 = intervals.back().t1;
+    if (o.placement.kind == Kind::FromExit) {  // seed 001 in double: s = outAbs, outAbs - h, ... >= inAbs
         using R = march_detail::StepCountRule;
         const double n = sample_count(hull, h, 0.0, o.placement.through_exit ? R::ThroughExit : R::BeforeExit);
         for (double k = 0.0; k < n; k += 1.0) {

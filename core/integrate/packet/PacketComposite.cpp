@@ -34,9 +34,14 @@ using VT = hn::Vec<DT<T>>;
 template <typename T>
 using MT = hn::Mask<DT<T>>;
 
+// TableLookupLanes' index vector for lanes of T.
+template <typename T>
+using LaneIndex = decltype(hn::IndicesFromVec(DT<T>(), hn::Zero(hn::RebindToSigned<DT<T>>())));
+
 template <typename T>
 struct TableLookup {
     VT<T> lo_row, hi_row, lo_x, hi_x;  // row indices as T (exact)
+    LaneIndex<T> lo_lane, hi_lane;     // register tables: the rows' lanes (RegisterTable::lane_of), shared by the columns
     VT<T> w;  // (v - x_lo) / (x_hi - x_lo), shared by the channels
     MT<T> below, above;
 };
@@ -68,34 +73,64 @@ struct RegisterTable {
             }
         }
     }
-    // Row `row` (exact integers as T, 0 <= row < rows) of the column `v` (x or y[c]): part row / n,
-    // lane row mod n.
-    HWY_INLINE VT<T> pick(DT<T> d, const VT<T> (&v)[kParts], VT<T> row) const {
+    // The lane of row `row` (exact integers as T, 0 <= row < rows) within its part: row mod n.
+    static HWY_INLINE LaneIndex<T> lane_of(DT<T> d, VT<T> row) {
         const hn::RebindToSigned<DT<T>> di;
         using TI = hn::TFromD<decltype(di)>;
-        const TI n = TI(hn::Lanes(d));
-        const auto lane = hn::IndicesFromVec(d, hn::And(hn::ConvertTo(di, row), hn::Set(di, TI(n - 1))));
+        return hn::IndicesFromVec(d, hn::And(hn::ConvertTo(di, row), hn::Set(di, TI(hn::Lanes(d) - 1))));
+    }
+    // Row `row` of the column `v` (x or y[c]), at its lane (lane_of(row)): part row / n, lane row mod n.
+    HWY_INLINE VT<T> pick(DT<T> d, const VT<T> (&v)[kParts], VT<T> row, LaneIndex<T> lane) const {
         VT<T> out = hn::TableLookupLanes(v[0], lane);
         for (int p = 1; p < parts; ++p)
-            out = hn::IfThenElse(hn::Ge(row, hn::Set(d, T(p * n))), hn::TableLookupLanes(v[p], lane), out);
+            out = hn::IfThenElse(hn::Ge(row, hn::Set(d, T(p * hn::Lanes(d)))), hn::TableLookupLanes(v[p], lane), out);
         return out;
     }
 };
 
+// k = the number of rows with x <= v: R compares, unrolled for tables of up to 8 rows (one switch per
+// search instead of a loop's counter and branch per row; the same k).
+template <int R, typename T>
+HWY_INLINE VT<T> rows_at_or_below(DT<T> d, const T* xs, VT<T> v) {
+    const VT<T> one = hn::Set(d, T(1));
+    VT<T> k = hn::Zero(d);
+    for (int r = 0; r < R; ++r) k = hn::Add(k, hn::IfThenElseZero(hn::Le(hn::Set(d, xs[r]), v), one));
+    return k;
+}
+template <typename T>
+HWY_INLINE VT<T> rows_at_or_below(DT<T> d, const T* xs, int rows, VT<T> v) {
+    switch (rows) {
+        case 1: return rows_at_or_below<1, T>(d, xs, v);
+        case 2: return rows_at_or_below<2, T>(d, xs, v);
+        case 3: return rows_at_or_below<3, T>(d, xs, v);
+        case 4: return rows_at_or_below<4, T>(d, xs, v);
+        case 5: return rows_at_or_below<5, T>(d, xs, v);
+        case 6: return rows_at_or_below<6, T>(d, xs, v);
+        case 7: return rows_at_or_below<7, T>(d, xs, v);
+        case 8: return rows_at_or_below<8, T>(d, xs, v);
+        default: break;
+    }
+    const VT<T> one = hn::Set(d, T(1));
+    VT<T> k = hn::Zero(d);
+    for (int r = 0; r < rows; ++r) k = hn::Add(k, hn::IfThenElseZero(hn::Le(hn::Set(d, xs[r]), v), one));
+    return k;
+}
+
 template <typename T>
 HWY_INLINE TableLookup<T> locate_rows(DT<T> d, const T* xs, int rows, VT<T> v, const RegisterTable<T>& reg) {
     const hn::RebindToSigned<DT<T>> di;
-    VT<T> k = hn::Zero(d);
+    const VT<T> k = rows_at_or_below<T>(d, xs, rows, v);
     const VT<T> one = hn::Set(d, T(1));
-    for (int r = 0; r < rows; ++r) k = hn::Add(k, hn::IfThenElseZero(hn::Le(hn::Set(d, xs[r]), v), one));
     TableLookup<T> t;
     t.below = hn::Eq(k, hn::Zero(d));
     t.above = hn::Eq(k, hn::Set(d, T(rows)));
     t.lo_row = hn::Max(hn::Sub(k, one), hn::Zero(d));
     t.hi_row = hn::Min(k, hn::Set(d, T(rows - 1)));
     if (reg.in_register) {
-        t.lo_x = reg.pick(d, reg.x, t.lo_row);
-        t.hi_x = reg.pick(d, reg.x, t.hi_row);
+        t.lo_lane = RegisterTable<T>::lane_of(d, t.lo_row);
+        t.hi_lane = RegisterTable<T>::lane_of(d, t.hi_row);
+        t.lo_x = reg.pick(d, reg.x, t.lo_row, t.lo_lane);
+        t.hi_x = reg.pick(d, reg.x, t.hi_row, t.hi_lane);
     } else {
         t.lo_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.lo_row));
         t.hi_x = hn::GatherIndex(d, xs, hn::ConvertTo(di, t.hi_row));
@@ -110,8 +145,8 @@ HWY_INLINE VT<T> table_channel(DT<T> d, const TableLookup<T>& t, const T* ys, in
     const hn::RebindToSigned<DT<T>> di;
     VT<T> y0, y1;
     if (reg.in_register) {
-        y0 = reg.pick(d, reg.y[channel], t.lo_row);
-        y1 = reg.pick(d, reg.y[channel], t.hi_row);
+        y0 = reg.pick(d, reg.y[channel], t.lo_row, t.lo_lane);
+        y1 = reg.pick(d, reg.y[channel], t.hi_row, t.hi_lane);
     } else {
         const VT<T> s = hn::Set(d, T(stride)), c = hn::Set(d, T(channel));
         y0 = hn::GatherIndex(d, ys, hn::ConvertTo(di, hn::Add(hn::Mul(t.lo_row, s), c)));

@@ -124,6 +124,8 @@ struct VectorSkip {
 template <typename T>
 struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
+    static constexpr bool kFloatLanes = std::is_same_v<T, float>;
+    using V_ = hn::Vec<hn::ScalableTag<T>>;
     HWY_ALIGN T ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
     HWY_ALIGN T tm[kLanes], len[kLanes], live[kLanes];
     // Local coordinates (float lanes, the fast profile): each lane's ray starts at its first entry
@@ -133,10 +135,12 @@ struct RayPacketT {
     HWY_ALIGN double t_ref[kLanes] = {};
     HWY_ALIGN T t_ref_lane[kLanes] = {};
     ForwardSegmentWalk walk[kLanes];
-    // Each lane's current run (ForwardSegmentWalk::next_run) as doubles (integers exact below 2^53):
-    // its next segment k, the end of the run, n - 1 of its interval, and the interval's t0 and t1.
-    HWY_ALIGN double run_k[kLanes] = {}, run_end[kLanes] = {}, run_last[kLanes] = {}, run_t0[kLanes] = {},
-                     run_t1[kLanes] = {}, run_live[kLanes] = {};
+    // Each lane's current run (ForwardSegmentWalk::next_run) in T (next(): double lanes count from the
+    // interval's start, float lanes from the run's): its next segment k, the end of the run, the
+    // interval's last segment, the base t0 (double: the interval's start; float: the run's first
+    // segment's start, local) and the interval's end t1.
+    HWY_ALIGN T run_k[kLanes] = {}, run_end[kLanes] = {}, run_last[kLanes] = {}, run_t0[kLanes] = {},
+                run_t1[kLanes] = {}, run_live[kLanes] = {};
     double step = 1.0;
     bool active[kLanes];
     std::size_t lanes = 0;
@@ -194,19 +198,25 @@ struct RayPacketT {
     }
     // Moves every active lane to its next segment and fills tm (midpoints), len (lengths) and live
     // (1/0); false when no lane is active any more. A lane whose run is used up takes the next one from
-    // its walk (ForwardSegmentWalk::next_run); then every lane's segment k is placed at once, on double
-    // vectors, with segment()'s arithmetic (SamplePlacement.h): a = t0 + k h, b = t1 for the last
-    // segment (k = n - 1), else t0 + (k + 1) h; midpoint (a + b) / 2, length b - a; then rounded to T.
+    // its walk (ForwardSegmentWalk::next_run); then every lane's segment is placed at once, on vectors
+    // of T, with segment()'s arithmetic (SamplePlacement.h) from the run's base: a = t0 + k h, b = t1
+    // for the interval's last segment, else t0 + (k + 1) h; midpoint (a + b) / 2, length b - a.
+    // Double lanes: t0 is the interval's start and k the segment's index in it, so every value is the
+    // scalar path's. Float lanes (the fast profile, conventions section 9b): t0 is the run's first
+    // segment's start a_0 = t0 + k_0 h, computed in double and rounded to float in the lane's local t
+    // (t - t_ref), and k counts from 0 within the run (at most ForwardSegmentWalk::kMaxRun, exact in
+    // float); so a float lane's placement is rounded once per run and then a few float ulp per step.
     bool next() {
-        const hn::ScalableTag<double> dd;
-        const std::size_t nd = hn::Lanes(dd);
+        const hn::ScalableTag<T> d;
+        const std::size_t nv = hn::Lanes(d);
+        const auto zero = hn::Zero(d);
         // Lanes whose run is used up (k >= end) go back to their walk; the check is on vectors, the
         // refill lane by lane (one lane in a run's length of steps).
         bool refill = !started_;
         started_ = true;
-        for (std::size_t i = 0; i < lanes && !refill; i += nd)
-            refill = !hn::AllFalse(dd, hn::And(hn::Gt(hn::Load(dd, run_live + i), hn::Zero(dd)),
-                                               hn::Ge(hn::Load(dd, run_k + i), hn::Load(dd, run_end + i))));
+        for (std::size_t i = 0; i < lanes && !refill; i += nv)
+            refill = !hn::AllFalse(d, hn::And(hn::Gt(hn::Load(d, run_live + i), zero),
+                                              hn::Ge(hn::Load(d, run_k + i), hn::Load(d, run_end + i))));
         if (refill) {
             live_count_ = 0;
             for (std::size_t l = 0; l < lanes; ++l) {
@@ -214,40 +224,40 @@ struct RayPacketT {
                     ForwardSegmentWalk::Run r;
                     if (walk[l].next_run(r)) {
                         recheck_[l] = -std::numeric_limits<T>::infinity();
-                        run_k[l] = double(r.k);
-                        run_end[l] = double(r.end);
-                        run_last[l] = double(r.n - 1);
-                        run_t0[l] = r.iv->t0;
-                        run_t1[l] = r.iv->t1;
+                        if constexpr (kFloatLanes) {
+                            static_assert(ForwardSegmentWalk::kMaxRun < (std::int64_t(1) << 24), "run indices exact in float");
+                            run_k[l] = T(0);
+                            run_end[l] = T(r.end - r.k);
+                            // Only equality with k < end matters: a last segment beyond the run is never reached.
+                            run_last[l] = T(std::min<std::int64_t>(r.n - 1 - r.k, r.end - r.k));
+                            run_t0[l] = T(r.iv->t0 + double(r.k) * step - t_ref[l]);
+                            run_t1[l] = T(r.iv->t1 - t_ref[l]);
+                        } else {
+                            run_k[l] = double(r.k);
+                            run_end[l] = double(r.end);
+                            run_last[l] = double(r.n - 1);
+                            run_t0[l] = r.iv->t0;
+                            run_t1[l] = r.iv->t1;
+                        }
                     } else {
                         active[l] = false;
                     }
                 }
-                run_live[l] = active[l] ? 1.0 : 0.0;
+                run_live[l] = active[l] ? T(1) : T(0);
                 live_count_ += active[l] ? 1 : 0;
             }
         }
         if (live_count_ == 0) return false;
-        const auto h = hn::Set(dd, step), half = hn::Set(dd, 0.5), one = hn::Set(dd, 1.0), zero = hn::Zero(dd);
-        for (std::size_t i = 0; i < lanes; i += nd) {
-            const auto k = hn::Load(dd, run_k + i), t0 = hn::Load(dd, run_t0 + i);
-            const auto on = hn::Gt(hn::Load(dd, run_live + i), zero);
-            const auto a = hn::Add(t0, hn::Mul(k, h));
-            const auto b = hn::IfThenElse(hn::Eq(k, hn::Load(dd, run_last + i)), hn::Load(dd, run_t1 + i),
-                                          hn::Add(t0, hn::Mul(hn::Add(k, one), h)));
-            const auto mid = hn::IfThenElseZero(on, hn::Sub(hn::Mul(half, hn::Add(a, b)), hn::Load(dd, t_ref + i)));
-            const auto length = hn::IfThenElseZero(on, hn::Sub(b, a));
-            hn::Store(hn::IfThenElse(on, hn::Add(k, one), k), dd, run_k + i);
-            if constexpr (std::is_same_v<T, double>) {
-                hn::Store(mid, dd, tm + i);
-                hn::Store(length, dd, len + i);
-                hn::Store(hn::IfThenElseZero(on, one), dd, live + i);
-            } else {
-                const hn::Rebind<T, decltype(dd)> dt;
-                hn::Store(hn::DemoteTo(dt, mid), dt, tm + i);
-                hn::Store(hn::DemoteTo(dt, length), dt, len + i);
-                hn::Store(hn::DemoteTo(dt, hn::IfThenElseZero(on, one)), dt, live + i);
-            }
+        const auto one = hn::Set(d, T(1));
+        for (std::size_t i = 0; i < lanes; i += nv) {
+            const auto k = hn::Load(d, run_k + i);
+            const auto on = hn::Gt(hn::Load(d, run_live + i), zero);
+            V_ mid, length;
+            place(i, k, mid, length);
+            hn::Store(hn::IfThenElse(on, hn::Add(k, one), k), d, run_k + i);
+            hn::Store(hn::IfThenElseZero(on, mid), d, tm + i);
+            hn::Store(hn::IfThenElseZero(on, length), d, len + i);
+            hn::Store(hn::IfThenElseZero(on, one), d, live + i);
         }
         // A lane moved on takes its new segment in this same step (checked again: it may land in
         // another empty box), so that no step is spent on a sample known to be empty.
@@ -260,15 +270,14 @@ struct RayPacketT {
     void retire(std::size_t l) {
         if (!active[l]) return;
         active[l] = false;
-        run_live[l] = 0.0;
+        run_live[l] = T(0);
         --live_count_;
     }
 
 private:
     // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
-    // past the samples that stay in its empty box, placing its new segment (segment()'s arithmetic, as
-    // next() does on vectors; a lane at the end of its run takes no sample this step). True when a
-    // lane was moved.
+    // past the samples that stay in its empty box, placing its new segment on the vectors (place(), as
+    // next() does; a lane at the end of its run takes no sample this step). True when a lane was moved.
     bool skip_empty() {
         const hn::ScalableTag<T> d;
         const hn::Rebind<std::int32_t, decltype(d)> di;  // int32 lanes, as many as d's
@@ -278,7 +287,7 @@ private:
         constexpr int kM = conventions::kMacrocellSize;
         static_assert(std::has_single_bit(unsigned(kM)), "the shift below is the division by kMacrocellSize");
         constexpr int kShift = std::countr_zero(unsigned(kM));
-        HWY_ALIGN T dt_buf[kLanes] = {};
+        const auto h = hn::Set(d, T(step)), half = hn::Set(d, T(0.5)), one = hn::Set(d, T(1));
         bool any = false;
         for (std::size_t i = 0; i < lanes; i += nf) {
             const auto t = hn::Load(d, tm + i);
@@ -333,37 +342,44 @@ private:
             dt = hn::Sub(dt, hn::Load(d, margin_ + i));
             const auto jump = hn::And(empty, hn::Gt(dt, zero));
             if (hn::AllFalse(d, jump)) continue;
-            hn::Store(hn::IfThenElseZero(jump, dt), d, dt_buf + i);
-            any = true;
-        }
-        if (!any) return false;
-        // The first segment whose midpoint is at or after t + dt (double: SamplePlacement's lattice).
-        bool moved = false;
-        for (std::size_t l = 0; l < lanes; ++l) {
-            if (!(dt_buf[l] > T(0)) || run_live[l] == 0.0) continue;
-            const double target = t_ref[l] + double(tm[l]) + double(dt_buf[l]);
-            const double k = std::ceil((target - run_t0[l]) / step - 0.5);
-            if (!(k > run_k[l] - 1.0)) continue;  // not past the segment just placed
+            // The first segment of the run whose midpoint is at or after t + dt: k = ceil((t + dt - t0) / h
+            // - 1/2) (in T: on float lanes the 0.01-cell margin covers its rounding); a lane moves only past
+            // the segment just placed (k > its next k - 1).
+            const auto kk = hn::Load(d, run_k + i);
+            const auto k = hn::Ceil(hn::Sub(hn::Div(hn::Sub(hn::Add(t, dt), hn::Load(d, run_t0 + i)), h), half));
+            const auto go = hn::And(jump, hn::Gt(k, hn::Sub(kk, one)));
+            if (hn::AllFalse(d, go)) continue;
+            const auto end = hn::Load(d, run_end + i);
             if (s.end_margin > 0.0) {
                 // Pre-integrated segments: the segment just placed stays (its ends may lie outside the
                 // box although its midpoint is inside); the lane moves on after it.
-                run_k[l] = std::min(k, run_end[l]);
+                hn::Store(hn::IfThenElse(go, hn::Min(k, end), kk), d, run_k + i);
                 continue;
             }
-            moved = true;
-            if (k >= run_end[l]) {  // the run is used up: no sample this step, the walk refills next step
-                run_k[l] = run_end[l];
-                tm[l] = len[l] = live[l] = T(0);
-                continue;
-            }
-            const double a = run_t0[l] + k * step;
-            const double b = k == run_last[l] ? run_t1[l] : run_t0[l] + (k + 1.0) * step;
-            tm[l] = T(0.5 * (a + b) - t_ref[l]);
-            len[l] = T(b - a);
-            run_k[l] = k + 1.0;
-            recheck_[l] = -std::numeric_limits<T>::infinity();
+            any = true;
+            // At the end of its run a lane takes no sample this step (the walk refills it next step);
+            // otherwise it takes segment k now (and is checked again).
+            const auto used_up = hn::And(go, hn::Ge(k, end));
+            const auto placed = hn::AndNot(used_up, go);
+            V_ mid, length;
+            place(i, k, mid, length);
+            hn::Store(hn::IfThenElse(placed, mid, hn::IfThenElseZero(hn::Not(used_up), t)), d, tm + i);
+            hn::Store(hn::IfThenElse(placed, length, hn::IfThenElseZero(hn::Not(used_up), hn::Load(d, len + i))), d, len + i);
+            hn::Store(hn::IfThenElseZero(hn::Not(used_up), hn::Load(d, live + i)), d, live + i);
+            hn::Store(hn::IfThenElse(used_up, end, hn::IfThenElse(placed, hn::Add(k, one), kk)), d, run_k + i);
         }
-        return moved;
+        return any;
+    }
+    // The segment k of the run of the lanes [i, i + lanes of T) (next()'s arithmetic): its midpoint and length.
+    HWY_INLINE void place(std::size_t i, V_ k, V_& mid, V_& length) const {
+        const hn::ScalableTag<T> d;
+        const auto h = hn::Set(d, T(step)), half = hn::Set(d, T(0.5)), one = hn::Set(d, T(1));
+        const auto t0 = hn::Load(d, run_t0 + i);
+        const auto a = hn::Add(t0, hn::Mul(k, h));
+        const auto b = hn::IfThenElse(hn::Eq(k, hn::Load(d, run_last + i)), hn::Load(d, run_t1 + i),
+                                      hn::Add(t0, hn::Mul(hn::Add(k, one), h)));
+        mid = hn::Mul(half, hn::Add(a, b));
+        length = hn::Sub(b, a);
     }
 
     const VectorSkip* vskip_ = nullptr;

@@ -216,7 +216,7 @@ TEST_F(Cli, WritesPngAndTiff) {
 TEST_F(Cli, ProgressOnlyOnATerminal) {
     const std::string render = std::string(VOLREF_CLI) + " render " + std::string(VOLREF_SOURCE_DIR) +
                                "/reference_scenes/default.json -o " + (dir_ / "p.exr").string() +
-                               " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.1";
+                               " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.04";
     const fs::path log = dir_ / "tty.txt";
     const std::string cmd = "script -qec '" + render + "' " + log.string() + " > /dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
@@ -226,7 +226,7 @@ TEST_F(Cli, ProgressOnlyOnATerminal) {
     EXPECT_NE(ss.str().find("volref: rendering"), std::string::npos) << ss.str();
     const Result r = run("render " + std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/default.json -o " +
                          (dir_ / "q.exr").string() +
-                         " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.1");
+                         " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.04");
     EXPECT_EQ(r.status, 0);
     EXPECT_EQ(r.err.find("volref: rendering"), std::string::npos) << r.err;
 }

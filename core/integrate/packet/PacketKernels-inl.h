@@ -125,6 +125,8 @@ template <typename T>
 struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
     static constexpr bool kFloatLanes = std::is_same_v<T, float>;
+    // Float lanes place segment k of an interval from the start of its block of 2^23 segments (next()).
+    static constexpr std::int64_t kFloatRunBlock = std::int64_t(1) << 23;
     using V_ = hn::Vec<hn::ScalableTag<T>>;
     HWY_ALIGN T ox[kLanes], oy[kLanes], oz[kLanes], dx[kLanes], dy[kLanes], dz[kLanes];
     HWY_ALIGN T tm[kLanes], len[kLanes], live[kLanes];
@@ -136,9 +138,9 @@ struct RayPacketT {
     HWY_ALIGN T t_ref_lane[kLanes] = {};
     ForwardSegmentWalk walk[kLanes];
     // Each lane's current run (ForwardSegmentWalk::next_run) in T (next(): double lanes count from the
-    // interval's start, float lanes from the run's): its next segment k, the end of the run, the
-    // interval's last segment, the base t0 (double: the interval's start; float: the run's first
-    // segment's start, local) and the interval's end t1.
+    // interval's start, float lanes from their block's): its next segment k, the end of the run, the
+    // interval's last segment, the base t0 (double: the interval's start; float: the block's start,
+    // local) and the interval's end t1.
     HWY_ALIGN T run_k[kLanes] = {}, run_end[kLanes] = {}, run_last[kLanes] = {}, run_t0[kLanes] = {},
                 run_t1[kLanes] = {}, run_live[kLanes] = {};
     double step = 1.0;
@@ -202,10 +204,10 @@ struct RayPacketT {
     // of T, with segment()'s arithmetic (SamplePlacement.h) from the run's base: a = t0 + k h, b = t1
     // for the interval's last segment, else t0 + (k + 1) h; midpoint (a + b) / 2, length b - a.
     // Double lanes: t0 is the interval's start and k the segment's index in it, so every value is the
-    // scalar path's. Float lanes (the fast profile, conventions section 9b): t0 is the run's first
-    // segment's start a_0 = t0 + k_0 h, computed in double and rounded to float in the lane's local t
-    // (t - t_ref), and k counts from 0 within the run (at most ForwardSegmentWalk::kMaxRun, exact in
-    // float); so a float lane's placement is rounded once per run and then a few float ulp per step.
+    // scalar path's. Float lanes (the fast profile, conventions section 9b): t0 is the start of the
+    // segment's block, t0 + k_b h with k_b = the largest multiple of 2^23 <= its index (0 below 2^23
+    // segments), computed in double and rounded to float in the lane's local t (t - t_ref), and k
+    // counts from k_b (exact in float); so a float lane's a = float(t0 + k_b h - t_ref) + k h in float.
     bool next() {
         const hn::ScalableTag<T> d;
         const std::size_t nv = hn::Lanes(d);
@@ -225,12 +227,17 @@ struct RayPacketT {
                     if (walk[l].next_run(r)) {
                         recheck_[l] = -std::numeric_limits<T>::infinity();
                         if constexpr (kFloatLanes) {
-                            static_assert(ForwardSegmentWalk::kMaxRun < (std::int64_t(1) << 24), "run indices exact in float");
-                            run_k[l] = T(0);
-                            run_end[l] = T(r.end - r.k);
+                            // The base is the start of the block of kFloatRunBlock segments holding the
+                            // run's first one: the same for every run in the block, so a span resumed
+                            // mid-ray (march/RaySpan.h) places its samples as the whole ray does.
+                            static_assert(kFloatRunBlock + ForwardSegmentWalk::kMaxRun <= (std::int64_t(1) << 24),
+                                          "indices within a block exact in float");
+                            const std::int64_t kb = r.k / kFloatRunBlock * kFloatRunBlock;
+                            run_k[l] = T(r.k - kb);
+                            run_end[l] = T(r.end - kb);
                             // Only equality with k < end matters: a last segment beyond the run is never reached.
-                            run_last[l] = T(std::min<std::int64_t>(r.n - 1 - r.k, r.end - r.k));
-                            run_t0[l] = T(r.iv->t0 + double(r.k) * step - t_ref[l]);
+                            run_last[l] = T(std::min<std::int64_t>(r.n - 1, r.end) - kb);
+                            run_t0[l] = T(r.iv->t0 + double(kb) * step - t_ref[l]);
                             run_t1[l] = T(r.iv->t1 - t_ref[l]);
                         } else {
                             run_k[l] = double(r.k);

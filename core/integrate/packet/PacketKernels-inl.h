@@ -183,6 +183,14 @@ struct RayPacketT {
         }
         for (std::size_t l = 0; l < kLanes; ++l) recheck_[l] = -std::numeric_limits<T>::infinity();
         if (vskip_) {
+            // The grid's constants in T (and the macrocell counts in int32), converted once per packet.
+            for (int a = 0; a < 3; ++a) {
+                skip_origin_[a] = T(vskip_->origin[a]);
+                skip_inv_[a] = T(vskip_->inv_spacing[a]);
+                skip_hi_[a] = T(vskip_->dims[a] - 1);
+                skip_top_[a] = T(vskip_->dims[a] - 2);
+                skip_counts_[a] = std::int32_t(vskip_->counts[a]);
+            }
             // Per lane: index units per unit of t along each axis.
             for (std::size_t l = 0; l < lanes; ++l) {
                 const double dl[3] = {double(dx[l]), double(dy[l]), double(dz[l])};
@@ -308,11 +316,10 @@ private:
             hn::Vec<decltype(di)> mc[3];
             hn::Vec<decltype(d)> u[3];
             for (int a = 0; a < 3; ++a) {
-                const T hi = T(s.dims[a] - 1);
-                u[a] = hn::Mul(hn::Sub(P[a], hn::Set(d, T(s.origin[a]))), hn::Set(d, T(s.inv_spacing[a])));
-                inside = hn::And(inside, hn::And(hn::Ge(u[a], zero), hn::Le(u[a], hn::Set(d, hi))));
-                const auto cell = s.dims[a] == 1 ? zero : hn::Min(hn::Floor(hn::Min(hn::Max(u[a], zero), hn::Set(d, hi))),
-                                                                  hn::Set(d, T(s.dims[a] - 2)));
+                const auto hi = hn::Set(d, skip_hi_[a]);
+                u[a] = hn::Mul(hn::Sub(P[a], hn::Set(d, skip_origin_[a])), hn::Set(d, skip_inv_[a]));
+                inside = hn::And(inside, hn::And(hn::Ge(u[a], zero), hn::Le(u[a], hi)));
+                const auto cell = s.dims[a] == 1 ? zero : hn::Min(hn::Floor(hn::Min(hn::Max(u[a], zero), hi)), hn::Set(d, skip_top_[a]));
                 // the cell (an integer below 2^31) as int32 lanes
                 if constexpr (std::is_same_v<T, float>) mc[a] = hn::ShiftRight<kShift>(hn::ConvertTo(di, cell));
                 else mc[a] = hn::ShiftRight<kShift>(hn::DemoteTo(di, cell));
@@ -321,8 +328,7 @@ private:
                 hn::Store(hn::Set(d, -std::numeric_limits<T>::infinity()), d, recheck_ + i);
                 continue;
             }
-            const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, std::int32_t(s.counts[0])),
-                                                    hn::Add(mc[1], hn::Mul(hn::Set(di, std::int32_t(s.counts[1])), mc[2]))));
+            const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, skip_counts_[0]), hn::Add(mc[1], hn::Mul(hn::Set(di, skip_counts_[1]), mc[2]))));
             hn::Mask<decltype(di)> inside32;  // `inside` on the int32 lanes
             if constexpr (std::is_same_v<T, float>) inside32 = hn::RebindMask(di, inside);
             else inside32 = hn::Ne(hn::DemoteTo(di, hn::IfThenElseZero(inside, hn::Set(d, T(1)))), hn::Zero(di));
@@ -390,6 +396,8 @@ private:
     }
 
     const VectorSkip* vskip_ = nullptr;
+    T skip_origin_[3] = {}, skip_inv_[3] = {}, skip_hi_[3] = {}, skip_top_[3] = {};
+    std::int32_t skip_counts_[3] = {};
     HWY_ALIGN T rate_[3][kLanes] = {};
     HWY_ALIGN T inv_speed_[3][kLanes] = {};  // 1 / |rate| (+inf where the ray is parallel to the axis' planes)
     HWY_ALIGN T margin_[kLanes] = {};
@@ -581,8 +589,9 @@ struct PacketTrilinearT {
     }
 
     // Float lanes: the floats p[i] and p[i + 1] for each lane's index i (in floats), each pair read as
-    // one 64-bit load (little-endian: the lower half is p[i]) into a buffer, then split into even and
-    // odd floats. Plain loads, not gather instructions: gathers are microcoded on AMD's CPUs (the
+    // one 64-bit load (little-endian: the lower half is p[i]) straight into a vector's 64-bit part
+    // (load_pairs: the halves joined by Combine, no round trip through memory), then split into even
+    // and odd floats. Plain loads, not gather instructions: gathers are microcoded on AMD's CPUs (the
     // speed-limit note; here 5% faster on the fast profile's benchmark frame than 64-bit gathers).
     HWY_INLINE void x_pair(const float* p, hn::Vec<DI32> idx, V& first, V& second) const {
         const D d;
@@ -590,18 +599,36 @@ struct PacketTrilinearT {
         (void)p, (void)idx, (void)d;  // pairs is false on the scalar target
         first = second = V();
 #else
-        constexpr std::size_t kMax = RayPacketT<T>::kLanes;
-        HWY_ALIGN std::int32_t ix[kMax];
-        HWY_ALIGN std::uint64_t w[kMax];
-        hn::Store(idx, DI32(), ix);
-        const std::size_t n = hn::Lanes(d);
-        for (std::size_t l = 0; l < n; ++l) std::memcpy(&w[l], p + ix[l], sizeof(std::uint64_t));
-        const V lo = hn::Load(d, reinterpret_cast<const T*>(w));  // p[i0] p[i0 + 1] p[i1] ...
-        const V hi = hn::Load(d, reinterpret_cast<const T*>(w + n / 2));
-        first = hn::ConcatEven(d, hi, lo);
-        second = hn::ConcatOdd(d, hi, lo);
+        if constexpr (kFloat) {
+            constexpr std::size_t kMax = RayPacketT<T>::kLanes;
+            // The indices as unsigned (they are >= 0): a 32-bit move zero-extends them, no sign extension.
+            HWY_ALIGN std::uint32_t ix[kMax];
+            hn::Store(hn::BitCast(DU32(), idx), DU32(), ix);
+            const std::size_t n = hn::Lanes(d);
+            const V lo = load_pairs(d, p, ix);  // p[i0] p[i0 + 1] p[i1] ...
+            const V hi = load_pairs(d, p, ix + n / 2);
+            first = hn::ConcatEven(d, hi, lo);
+            second = hn::ConcatOdd(d, hi, lo);
+        } else {
+            (void)p, (void)idx;
+            first = second = hn::Zero(d);  // pairs is false on double lanes
+        }
 #endif
     }
+#if HWY_TARGET != HWY_SCALAR
+    // The pairs p[ix[j]], p[ix[j] + 1] for j < (lanes of DP) / 2, in order: a 64-bit load per pair,
+    // the halves of a wider vector built the same way and joined.
+    template <class DP>
+    static HWY_INLINE hn::Vec<DP> load_pairs(DP dp, const float* p, const std::uint32_t* ix) {
+        if constexpr (hn::MaxLanes(DP()) <= 2) {
+            return hn::LoadU(dp, p + ix[0]);
+        } else {
+            const hn::Half<DP> dh;
+            constexpr std::size_t kHalfPairs = hn::MaxLanes(DP()) / 4;
+            return hn::Combine(dp, load_pairs(dh, p, ix + kHalfPairs), load_pairs(dh, p, ix));
+        }
+    }
+#endif
 
     // Lane by lane (64-bit indices), any storage type (double lanes).
     HWY_INLINE V lanes(hn::Vec<DI> idx) const {

@@ -73,11 +73,15 @@ struct RegisterTable {
             }
         }
     }
-    // The lane of row `row` (exact integers as T, 0 <= row < rows) within its part: row mod n.
+    // The lane of row `row` (exact integers as T, 0 <= row < rows) within its part: row mod n. The
+    // integer is read from the mantissa of row + 2^m (m = 52 for double, 23 for float: the sum is
+    // exact and its low bits are row), not by a conversion, which AVX2 lacks for double -> int64.
     static HWY_INLINE LaneIndex<T> lane_of(DT<T> d, VT<T> row) {
         const hn::RebindToSigned<DT<T>> di;
         using TI = hn::TFromD<decltype(di)>;
-        return hn::IndicesFromVec(d, hn::And(hn::ConvertTo(di, row), hn::Set(di, TI(hn::Lanes(d) - 1))));
+        constexpr T kMantissaUnit = sizeof(T) == 8 ? T(4503599627370496.0) : T(8388608.0);  // 2^52, 2^23
+        const auto bits = hn::BitCast(di, hn::Add(row, hn::Set(d, kMantissaUnit)));
+        return hn::IndicesFromVec(d, hn::And(bits, hn::Set(di, TI(hn::Lanes(d) - 1))));
     }
     // Row `row` of the column `v` (x or y[c]), at its lane (lane_of(row)): part row / n, lane row mod n.
     HWY_INLINE VT<T> pick(DT<T> d, const VT<T> (&v)[kParts], VT<T> row, LaneIndex<T> lane) const {

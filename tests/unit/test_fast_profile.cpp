@@ -175,6 +175,29 @@ TEST(FastProfile, TerminatesAtTheCutoffClosedForm) {
         }
 }
 
+// The float lanes place the reference's segments (conventions 9b): on f = z seen from above (the ray
+// enters at z = 4 and leaves at z = 0, 4 world units), MIP reads the first midpoint, z = 4 - h / 2, and
+// MinIP the last, z = r / 2 with r = 4 - (n - 1) h the interval's short last segment (its end is the
+// exit, not t0 + n h); alpha = v / 4. Steps 0.75 (r = h / 3), 0.9 (r = 0.44 h) and 4 / 70000.5 (70,001
+// segments, r = h / 2: two of the walk's runs of at most 65,536, placed from the same block start).
+// Placing the last segment a whole step long would move MinIP's alpha by (h - r) / 8 (3.6e-6 at the
+// finest step); the float bound: a few ulp of t <= 4 (4.8e-7 each) in z, a quarter of that in alpha.
+TEST(FastProfile, PlacesTheReferenceSegmentsInFloat) {
+    for (const double h : {0.75, 0.9, 4.0 / 70000.5}) {
+        const std::int64_t n = std::int64_t(std::ceil(4.0 / h - 1e-9));
+        const double r = 4.0 - double(n - 1) * h;
+        for (const Projection p : {Projection::Mip, Projection::Minip}) {
+            Scene s = ramp_scene(ProfileId::Fast, p, h);
+            const glm::dvec4 fast = rgba(render_scene(s, {1, false}), 0, 0);
+            s.render.profile = ProfileId::Reference;
+            const glm::dvec4 ref = rgba(render_scene(s, {1, false}), 0, 0);
+            const double z = p == Projection::Mip ? 4.0 - h / 2.0 : r / 2.0;
+            EXPECT_NEAR(ref.a, z / 4.0, 1e-12) << "h " << h;
+            EXPECT_NEAR(fast.a, z / 4.0, 1e-6) << "h " << h << " n " << n << " r " << r;
+        }
+    }
+}
+
 // Every pixel goes through the packets: the image does not depend on RenderOptions::simd, the thread
 // count or empty-space skipping.
 TEST(FastProfile, SameImageForAnySimdOptionThreadsAndSkipping) {

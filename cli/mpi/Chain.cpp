@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <optional>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -61,28 +62,50 @@ struct PixelRays {
     }
 };
 
-// f(px, scratch) for the pixels `list` (all of them when null), in parallel; the error message of an
-// exception (empty: none).
-template <class F>
-std::string each_pixel(const Frame& frame, const std::vector<std::size_t>* list, F&& f) {
-    try {
-        tbb::task_arena arena(frame.threads > 0 ? frame.threads : tbb::task_arena::automatic);
-        const std::size_t n = list ? list->size() : frame.pixels();
-        arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-                PixelRays scratch(frame.volumes());
-                for (std::size_t i = r.begin(); i != r.end(); ++i) f(list ? (*list)[i] : i, scratch);
-            });
-        });
-    } catch (const std::bad_alloc&) {
-        return "out of memory";
-    } catch (const std::exception& e) {
-        return e.what();
+// f(px, scratch) for the pixels `list` (all of them when null), on the frame's threads; run() returns the
+// error message of an exception (empty: none). The arena is made once (per loop, not per call), and
+// with one thread the loop runs inline: an arena made per chunk of the chain below cost a rank 0.2 s
+// of its 0.8 s (2 ranks, one thread each, the adaptive scene of docs/performance.md).
+class PixelLoop {
+public:
+    explicit PixelLoop(const Frame& frame) : frame_(frame) {
+        if (frame.threads != 1) arena_.emplace(frame.threads > 0 ? frame.threads : tbb::task_arena::automatic);
     }
-    return {};
-}
+    template <class F>
+    std::string run(const std::vector<std::size_t>* list, F&& f) {
+        const std::size_t n = list ? list->size() : frame_.pixels();
+        auto range = [&](std::size_t i0, std::size_t i1) {
+            PixelRays scratch(frame_.volumes());
+            for (std::size_t i = i0; i != i1; ++i) f(list ? (*list)[i] : i, scratch);
+        };
+        try {
+            if (!arena_) {
+                range(0, n);
+            } else {
+                arena_->execute([&] {
+                    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n),
+                                      [&](const tbb::blocked_range<std::size_t>& r) { range(r.begin(), r.end()); });
+                });
+            }
+        } catch (const std::bad_alloc&) {
+            return "out of memory";
+        } catch (const std::exception& e) {
+            return e.what();
+        }
+        return {};
+    }
 
-// Pixels per block of the pipeline below.
+private:
+    const Frame& frame_;
+    std::optional<tbb::task_arena> arena_;
+};
+
+// Pixels per block of the pipeline below. A block's states (up to 256 x 15 doubles, 30 KiB) go on as
+// one message; a message above OpenMPI's eager limit (4 KiB on shared memory) moves only while its
+// sender is inside MPI, so the sender progresses its sends between chunks of 32 pixels a thread
+// instead of once a block (measured at 2 ranks on the adaptive scene: the rank behind waited 0.52 s
+// of a 1.5 s chain for states its front rank had finished; with the progress, only for states not yet
+// computed, and the chain took 1.18 s).
 constexpr std::size_t kChainBlock = 256;
 
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
@@ -104,8 +127,14 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
     std::vector<std::vector<double>> outbox;
     std::vector<MPI_Request> requests;
     std::string err;
-    std::vector<std::size_t> mine;
+    std::vector<std::size_t> mine, part;
     std::vector<double> buffer;
+    PixelLoop loop(frame);
+    const std::size_t chunk = 32 * std::size_t(frame.threads > 0 ? frame.threads : int(tbb::this_task_arena::max_concurrency()));
+    auto progress = [&] {
+        int done = 0;
+        if (!requests.empty()) MPI_Testall(int(requests.size()), requests.data(), &done, MPI_STATUSES_IGNORE);
+    };
     for (int j = 0; j < frame.size && err.empty(); ++j) {
         for (std::size_t b0 = 0; b0 < P && err.empty(); b0 += kChainBlock) {
             const std::size_t b1 = std::min(P, b0 + kChainBlock);
@@ -124,7 +153,12 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
                 for (std::size_t px : mine)
                     if (from[px] == r) std::copy(&buffer[i * S], &buffer[i * S] + S, &state[px * S]), ++i;
             }
-            err = each_pixel(frame, &mine, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
+            // In chunks of 32 pixels a thread, progressing the sends between them (see kChainBlock).
+            for (std::size_t c0 = 0; c0 < mine.size() && err.empty(); c0 += chunk) {
+                part.assign(mine.begin() + std::ptrdiff_t(c0), mine.begin() + std::ptrdiff_t(std::min(mine.size(), c0 + chunk)));
+                err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
+                progress();
+            }
             // Out: to each rank behind, in pixel order.
             for (int r = 0; r < frame.size && err.empty(); ++r) {
                 std::vector<double> out;
@@ -136,9 +170,7 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
                 requests.emplace_back();
                 MPI_Isend(outbox.back().data(), int(outbox.back().size()), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, &requests.back());
             }
-            // (Progress: a large send moves only while its sender is inside MPI.)
-            int flag = 0;
-            if (!requests.empty()) MPI_Testall(int(requests.size()), requests.data(), &flag, MPI_STATUSES_IGNORE);
+            progress();
         }
     }
     // (An error stops this rank's pipeline; the ranks behind it may then wait for its states: abort.)
@@ -168,7 +200,7 @@ std::vector<double> collect(const Frame& frame, const RankOrder& order, std::siz
 template <class Has>
 bool span_keys(const Frame& frame, std::vector<double>& key, Has&& has) {
     key.assign(frame.pixels(), kNone);
-    const std::string err = each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
+    const std::string err = PixelLoop(frame).run(nullptr, [&](std::size_t px, PixelRays& scratch) {
         scratch.of(frame, px);
         const RaySpan span = frame.span(scratch.rays[0]);
         if (span.t0 < span.t1 && has(px, span, scratch)) key[px] = span.t0;
@@ -248,7 +280,7 @@ bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vec
         return !pieces[px].empty();
     });
     if (!ok) return false;
-    const std::string err = each_pixel(frame, nullptr, [&](std::size_t px, PixelRays& scratch) {
+    const std::string err = PixelLoop(frame).run(nullptr, [&](std::size_t px, PixelRays& scratch) {
         if (frame.rank != 0 || total[px] > 0.0) return;
         scratch.of(frame, px);
         total[px] = length(scratch);

@@ -32,6 +32,7 @@
 #include "core/MemoryLimit.h"
 #include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
+#include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 #include "cli/mpi/Balance.h"
 #include "cli/mpi/Chain.h"
@@ -258,13 +259,17 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
             store(px, k, span.t0, st);
         }
     };
-    // Blocks of kBlock x kBlock pixels (one packet for one volume: `volref render`'s blocks), rows of
-    // blocks in parallel.
+    // `volref render`'s order (core/render/Renderer.cpp): tiles of tile_side() pixels, one task each, and
+    // in a tile blocks of kBlock x kBlock pixels (one packet for one volume). The tiles keep neighbouring
+    // rays' voxels in cache: rows of blocks across the whole image made one rank's frame 1.37x
+    // `volref render`'s on a 256^3 volume (64 MiB).
     constexpr int kBlock = 4;
     static_assert(kBlock * kBlock == kMaxPacketRays);
     tbb::task_arena arena(f.threads > 0 ? f.threads : tbb::task_arena::automatic);
+    const int T = tile_side(f.width(), f.height(), arena.max_concurrency());
+    const int tiles_x = (f.width() + T - 1) / T, tiles_y = (f.height() + T - 1) / T;
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, (f.height() + kBlock - 1) / kBlock), [&](const tbb::blocked_range<int>& rows) {
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
             Ray world[kMaxPacketRays], rays[kMaxPacketRays];
             std::vector<Interval> intervals[kMaxPacketRays];
             RaySpan spans[kMaxPacketRays];
@@ -272,11 +277,14 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
             std::size_t at[kMaxPacketRays];
             std::vector<Ray> vrays(V);
             std::vector<std::vector<Interval>> vintervals(V);
-            for (int by = rows.begin() * kBlock; by < std::min(rows.end() * kBlock, f.height()); by += kBlock)
-                for (int bx = 0; bx < f.width(); bx += kBlock) {
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+                const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
+                const int x_end = std::min(x0 + T, f.width()), y_end = std::min(y0 + T, f.height());
+                for (int by = y0; by < y_end; by += kBlock)
+                for (int bx = x0; bx < x_end; bx += kBlock) {
                     int n = 0;
-                    for (int y = by; y < std::min(by + kBlock, f.height()); ++y)
-                        for (int x = bx; x < std::min(bx + kBlock, f.width()); ++x) {
+                    for (int y = by; y < std::min(by + kBlock, y_end); ++y)
+                        for (int x = bx; x < std::min(bx + kBlock, x_end); ++x) {
                             if (V > 1) {
                                 one_pixel(x, y, vrays, vintervals);
                                 continue;
@@ -302,7 +310,8 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
                         for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);
                     for (int i = 0; i < count; ++i) store(at[i], 0, spans[i].t0, states[i]);
                 }
-        });
+            }
+        }, tbb::simple_partitioner());
     });
 }
 

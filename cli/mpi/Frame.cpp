@@ -56,6 +56,15 @@ RaySpan Frame::span(const Ray& lattice_ray) const {
     return owned_span(bricks[std::size_t(rank)], lattice, members[0].grid, lattice_ray);
 }
 
+bool Frame::meets_brick(const Ray* world, int count) const {
+    for (int i = 0; i < count; ++i) {
+        const Ray lattice_ray = members[0].transform ? members[0].transform->local_ray(world[i]) : world[i];
+        Interval range;
+        if (intersect_box(lattice_ray, brick_lo, brick_hi, range)) return true;
+    }
+    return false;
+}
+
 // A slot is the volume's own integrator (one volume; several volumes other than composite), or the
 // several-volume mix, whose state is composite_state's (march/SpanStates.h).
 void Frame::merge(std::size_t slot, RayState& front, const RayState& back) const {

@@ -76,6 +76,9 @@ struct Frame {
     // The span of the ray this rank owns (`rays[0]`, the first volume's ray: the lattice's space);
     // empty ([+inf, +inf)) when the ray misses the brick's box (padded: every sample a rank owns lies in it).
     RaySpan span(const Ray& lattice_ray) const;
+    // Whether any of `count` world rays meets this rank's brick (span()'s first test, on the first
+    // volume's rays): a block of rays that all miss it has no span, and is skipped before its intervals.
+    bool meets_brick(const Ray* world, int count) const;
     glm::dvec3 brick_lo{0.0}, brick_hi{0.0};  // this rank's brick's box in the first volume's space, padded
     // Slot `slot`'s rule: `back` (a part behind) merged into `front`, and the pixel of a finished state.
     void merge(std::size_t slot, RayState& front, const RayState& back) const;

@@ -292,7 +292,7 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
                             world[n] = f.camera->pixel_ray(x, y);
                             at[n++] = std::size_t(y) * W + std::size_t(x);
                         }
-                    if (n == 0) continue;
+                    if (n == 0 || !f.meets_brick(world, n)) continue;
                     f.volume_intervals(0, world, n, rays, intervals);
                     int count = 0;  // the rays with a span, moved to the front
                     for (int i = 0; i < n; ++i) {

@@ -61,7 +61,6 @@ struct Collector final : SampleRecorder {
 };
 
 bool composite(const PixelTrace& t) { return is_composite(t.projection); }
-bool extremum(const PixelTrace& t) { return is_extremum(t.projection); }
 bool line_integral(const PixelTrace& t) { return is_line_integral(t.projection); }
 
 }  // namespace

@@ -58,7 +58,7 @@ TEST(CudaSeedIntersection, EyeInsideTheCylinderByHand) {
         }
         return sum;
     }();
-    for (const std::string extra : {std::string(), std::string(R"(, "tessellate": 64)")}) {
+    for (const std::string& extra : {std::string(), std::string(R"(, "tessellate": 64)")}) {
         SCOPED_TRACE(extra);
         const glm::dvec4 p = render_json(inside_scene(extra, "composite"));
         EXPECT_NEAR(p.r, expected.r, 1e-9);

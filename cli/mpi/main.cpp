@@ -259,10 +259,9 @@ void integrate_parts(const Frame& f, std::vector<double>& part) {
             store(px, k, span.t0, st);
         }
     };
-    // `volref render`'s order (core/render/Renderer.cpp): tiles of tile_side() pixels, one task each, and
-    // in a tile blocks of kBlock x kBlock pixels (one packet for one volume). The tiles keep neighbouring
-    // rays' voxels in cache: rows of blocks across the whole image made one rank's frame 1.37x
-    // `volref render`'s on a 256^3 volume (64 MiB).
+    // `volref render`'s order (Renderer.cpp): tiles of tile_side() pixels, one task each, of kBlock x kBlock
+    // blocks (one packet for one volume). The tiles keep neighbouring rays' voxels in cache: rows of blocks
+    // across the image made one rank's frame 1.37x `volref render`'s on a 256^3 volume (64 MiB).
     constexpr int kBlock = 4;
     static_assert(kBlock * kBlock == kMaxPacketRays);
     tbb::task_arena arena(f.threads > 0 ? f.threads : tbb::task_arena::automatic);

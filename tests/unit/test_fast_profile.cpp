@@ -198,6 +198,22 @@ TEST(FastProfile, PlacesTheReferenceSegmentsInFloat) {
     }
 }
 
+// The same closed form past the float lanes' first blocks (conventions 9b: a lane's segments are placed
+// from the start of their block of 2^23, b_0 = float(t0 + k_b h - t_ref), then b_0 + (k - k_b) h): at
+// h = 4 / 17000000.5 the interval has n = 17,000,001 segments, so its last (r = h / 2) lies in the third
+// block, past 2^24, where a float k would no longer be exact. MinIP reads that last midpoint, z = r / 2;
+// a block start misplaced by a block (2^23 h = 1.97) would move alpha by 0.49, a whole step by h / 8.
+TEST(FastProfile, PlacesSegmentsPastTheFirstFloatBlocks) {
+    const double h = 4.0 / 17000000.5;
+    const std::int64_t n = std::int64_t(std::ceil(4.0 / h - 1e-9));
+    ASSERT_GT(n, std::int64_t(1) << 24);
+    const double z = (4.0 - double(n - 1) * h) / 2.0;
+    for (const ProfileId profile : {ProfileId::Fast, ProfileId::Reference}) {
+        const glm::dvec4 c = rgba(render_scene(ramp_scene(profile, Projection::Minip, h), {1, false}), 0, 0);
+        EXPECT_NEAR(c.a, z / 4.0, profile == ProfileId::Fast ? 1e-6 : 1e-12) << "n " << n;
+    }
+}
+
 // Every pixel goes through the packets: the image does not depend on RenderOptions::simd, the thread
 // count or empty-space skipping.
 TEST(FastProfile, SameImageForAnySimdOptionThreadsAndSkipping) {

@@ -69,7 +69,9 @@ struct PixelRays {
 class PixelLoop {
 public:
     explicit PixelLoop(const Frame& frame) : frame_(frame) {
-        if (frame.threads != 1) arena_.emplace(frame.threads > 0 ? frame.threads : tbb::task_arena::automatic);
+        // (The count as a value first: emplace's forwarding reference would odr-use TBB's constant.)
+        const int threads = frame.threads > 0 ? frame.threads : int(tbb::task_arena::automatic);
+        if (threads != 1) arena_.emplace(threads);
     }
     template <class F>
     std::string run(const std::vector<std::size_t>* list, F&& f) {

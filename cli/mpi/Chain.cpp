@@ -103,18 +103,18 @@ private:
 };
 
 // Pixels per block of the pipeline below. A block's states (up to 256 x 15 doubles, 30 KiB) go on as
-// one message; a message above OpenMPI's eager limit (4 KiB on shared memory) moves only while its
-// sender is inside MPI, so the sender progresses its sends between chunks of 32 pixels a thread
-// instead of once a block (measured at 2 ranks on the adaptive scene: the rank behind waited 0.52 s
-// of a 1.5 s chain for states its front rank had finished; with the progress, only for states not yet
-// computed, and the chain took 1.18 s).
+// one message; a message above OpenMPI's eager limit (4 KiB on shared memory) moves only while both
+// its sender and its receiver are inside MPI (a handshake, then the data), so every rank drives MPI's
+// progress between chunks of 32 pixels a thread, and posts its receives before it starts (measured at
+// 2 ranks on the adaptive scene: the rank behind waited 0.52 s of a 1.5 s chain for states its front
+// rank had finished; with the sender's progress 0.11 s, a handshake per block; see performance.md).
 constexpr std::size_t kChainBlock = 256;
 
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
 // kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
-// takes its round-j pixels' states from the ranks in front of it (blocking receives, in the order they
-// were sent), runs step(px, scratch, state) on them, and sends them on to the ranks behind
-// (non-blocking). Every rank goes through the units (j, b) in the same order and a unit only waits for
+// takes its round-j pixels' states from the ranks in front of it (receives posted at the start, in the
+// order they are sent, waited for here), runs step(px, scratch, state) on them, and sends them on to
+// the ranks behind (non-blocking). Every rank goes through the units (j, b) in the same order and a unit only waits for
 // (j - 1, b), which its sender did earlier in that order: no deadlock, and a rank waits only where it
 // overtakes the rank in front of it on the same block (no barrier per round, no image-wide reduction).
 // On return each pixel's state is final on its last rank. An error aborts every rank (MPI_Abort: the
@@ -126,61 +126,96 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
     auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
     const std::vector<int>& from = reverse ? order.behind : order.front;
     const std::vector<int>& to = reverse ? order.front : order.behind;
+    // This rank's units (round j, block b) in the order every rank takes them, each with its pixels.
+    struct Unit {
+        int j;
+        std::vector<std::size_t> pixels;
+    };
+    std::vector<Unit> units;
+    for (int j = 0; j < frame.size; ++j)
+        for (std::size_t b0 = 0; b0 < P; b0 += kChainBlock) {
+            Unit u{j, {}};
+            for (std::size_t px = b0; px < std::min(P, b0 + kChainBlock); ++px)
+                if (order.position[px] >= 0 && round_of(px) == j) u.pixels.push_back(px);
+            if (!u.pixels.empty()) units.push_back(std::move(u));
+        }
+    // In: every receive posted at once, unit by unit, from each rank in front (its pixels in pixel
+    // order, as it sends them; a sender's messages to one rank match the receives in the order posted),
+    // so that a state's handshake goes on while this rank computes and its data is there when needed.
+    struct Inbox {
+        std::size_t unit;
+        int from;
+        std::vector<double> states;
+    };
+    std::vector<Inbox> inbox;
+    std::vector<MPI_Request> receives;
+    for (std::size_t u = 0; u < units.size(); ++u)
+        for (int r = 0; r < frame.size && units[u].j > 0; ++r) {
+            std::size_t n = 0;
+            for (std::size_t px : units[u].pixels) n += from[px] == r ? 1 : 0;
+            if (n > 0) inbox.push_back({u, r, std::vector<double>(n * S)});
+        }
+    receives.resize(inbox.size());
+    for (std::size_t i = 0; i < inbox.size(); ++i)
+        MPI_Irecv(inbox[i].states.data(), int(inbox[i].states.size()), MPI_DOUBLE, inbox[i].from, 0, MPI_COMM_WORLD,
+                  &receives[i]);
     std::vector<std::vector<double>> outbox;
-    std::vector<MPI_Request> requests;
+    std::vector<MPI_Request> sends;
     std::string err;
-    std::vector<std::size_t> mine, part;
-    std::vector<double> buffer;
+    std::vector<std::size_t> part;
     PixelLoop loop(frame);
     const std::size_t chunk = 32 * std::size_t(frame.threads > 0 ? frame.threads : int(tbb::this_task_arena::max_concurrency()));
+    std::size_t next_in = 0;     // inbox[next_in...]: the receives of the units not yet taken
+    std::size_t first_send = 0;  // sends[.. first_send): completed
+    std::vector<int> completed;
+    // MPI's progress (any test call drives every pending transfer): the open sends, freed as they
+    // complete, and the next few receives; a window, so that a frame of many blocks tests few requests.
     auto progress = [&] {
+        while (first_send < sends.size() && sends[first_send] == MPI_REQUEST_NULL) ++first_send;
+        if (first_send < sends.size()) {
+            completed.resize(sends.size() - first_send);
+            int n = 0;
+            MPI_Testsome(int(sends.size() - first_send), sends.data() + first_send, &n, completed.data(), MPI_STATUSES_IGNORE);
+        }
+        const std::size_t window = std::min<std::size_t>(receives.size() - next_in, 8);
         int done = 0;
-        if (!requests.empty()) MPI_Testall(int(requests.size()), requests.data(), &done, MPI_STATUSES_IGNORE);
+        if (window > 0) MPI_Testall(int(window), receives.data() + next_in, &done, MPI_STATUSES_IGNORE);
     };
-    for (int j = 0; j < frame.size && err.empty(); ++j) {
-        for (std::size_t b0 = 0; b0 < P && err.empty(); b0 += kChainBlock) {
-            const std::size_t b1 = std::min(P, b0 + kChainBlock);
-            mine.clear();
-            for (std::size_t px = b0; px < b1; ++px)
-                if (order.position[px] >= 0 && round_of(px) == j) mine.push_back(px);
-            if (mine.empty()) continue;
-            // In: from each rank in front, its pixels in pixel order (as it sent them).
-            for (int r = 0; r < frame.size && j > 0; ++r) {
-                std::size_t n = 0;
-                for (std::size_t px : mine) n += from[px] == r ? 1 : 0;
-                if (n == 0) continue;
-                buffer.resize(n * S);
-                MPI_Recv(buffer.data(), int(n * S), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                std::size_t i = 0;
-                for (std::size_t px : mine)
-                    if (from[px] == r) std::copy(&buffer[i * S], &buffer[i * S] + S, &state[px * S]), ++i;
-            }
-            // In chunks of 32 pixels a thread, progressing the sends between them (see kChainBlock).
-            for (std::size_t c0 = 0; c0 < mine.size() && err.empty(); c0 += chunk) {
-                part.assign(mine.begin() + std::ptrdiff_t(c0), mine.begin() + std::ptrdiff_t(std::min(mine.size(), c0 + chunk)));
-                err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
-                progress();
-            }
-            // Out: to each rank behind, in pixel order.
-            for (int r = 0; r < frame.size && err.empty(); ++r) {
-                std::vector<double> out;
-                for (std::size_t px : mine)
-                    if (to[px] == r) out.insert(out.end(), &state[px * S], &state[px * S] + S);
-                if (out.empty()) continue;
-                bytes += out.size() * sizeof(double);
-                outbox.push_back(std::move(out));
-                requests.emplace_back();
-                MPI_Isend(outbox.back().data(), int(outbox.back().size()), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, &requests.back());
-            }
+    for (std::size_t u = 0; u < units.size() && err.empty(); ++u) {
+        const std::vector<std::size_t>& mine = units[u].pixels;
+        for (; next_in < inbox.size() && inbox[next_in].unit == u; ++next_in) {
+            Inbox& in = inbox[next_in];
+            MPI_Wait(&receives[next_in], MPI_STATUS_IGNORE);
+            std::size_t i = 0;
+            for (std::size_t px : mine)
+                if (from[px] == in.from) std::copy(&in.states[i * S], &in.states[i * S] + S, &state[px * S]), ++i;
+            std::vector<double>().swap(in.states);
+        }
+        // In chunks of 32 pixels a thread, progressing the sends and receives between them (see kChainBlock).
+        for (std::size_t c0 = 0; c0 < mine.size() && err.empty(); c0 += chunk) {
+            part.assign(mine.begin() + std::ptrdiff_t(c0), mine.begin() + std::ptrdiff_t(std::min(mine.size(), c0 + chunk)));
+            err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
             progress();
         }
+        // Out: to each rank behind, in pixel order.
+        for (int r = 0; r < frame.size && err.empty(); ++r) {
+            std::vector<double> out;
+            for (std::size_t px : mine)
+                if (to[px] == r) out.insert(out.end(), &state[px * S], &state[px * S] + S);
+            if (out.empty()) continue;
+            bytes += out.size() * sizeof(double);
+            outbox.push_back(std::move(out));
+            sends.emplace_back();
+            MPI_Isend(outbox.back().data(), int(outbox.back().size()), MPI_DOUBLE, r, 0, MPI_COMM_WORLD, &sends.back());
+        }
+        progress();
     }
     // (An error stops this rank's pipeline; the ranks behind it may then wait for its states: abort.)
     if (!err.empty()) {
         std::fprintf(stderr, "volref: error: %s\n", err.c_str());
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
-    MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+    MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE);
 }
 
 // The final states (on each pixel's last rank, or first with `first`) summed onto rank 0; zero elsewhere.

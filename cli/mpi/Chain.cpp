@@ -96,6 +96,8 @@ public:
         }
         return {};
     }
+    // The threads the loop runs on.
+    int concurrency() const { return arena_ ? arena_->max_concurrency() : 1; }
 
 private:
     const Frame& frame_;
@@ -109,6 +111,8 @@ private:
 // 2 ranks on the adaptive scene: the rank behind waited 0.52 s of a 1.5 s chain for states its front
 // rank had finished; with the sender's progress 0.11 s, a handshake per block; see performance.md).
 constexpr std::size_t kChainBlock = 256;
+// Pixels a thread between two of MPI's progress calls (about 2 ms of the adaptive scene's work).
+constexpr std::size_t kChainChunkPerThread = 32;
 
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
 // kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
@@ -164,7 +168,7 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
     std::string err;
     std::vector<std::size_t> part;
     PixelLoop loop(frame);
-    const std::size_t chunk = 32 * std::size_t(frame.threads > 0 ? frame.threads : int(tbb::this_task_arena::max_concurrency()));
+    const std::size_t chunk = kChainChunkPerThread * std::size_t(loop.concurrency());
     std::size_t next_in = 0;     // inbox[next_in...]: the receives of the units not yet taken
     std::size_t first_send = 0;  // sends[.. first_send): completed
     std::vector<int> completed;
@@ -191,7 +195,7 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
                 if (from[px] == in.from) std::copy(&in.states[i * S], &in.states[i * S] + S, &state[px * S]), ++i;
             std::vector<double>().swap(in.states);
         }
-        // In chunks of 32 pixels a thread, progressing the sends and receives between them (see kChainBlock).
+        // In chunks of kChainChunkPerThread pixels a thread, progressing the sends and receives between them.
         for (std::size_t c0 = 0; c0 < mine.size() && err.empty(); c0 += chunk) {
             part.assign(mine.begin() + std::ptrdiff_t(c0), mine.begin() + std::ptrdiff_t(std::min(mine.size(), c0 + chunk)));
             err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });

@@ -42,7 +42,7 @@ void Frame::pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* inte
 
 void Frame::volume_intervals(std::size_t k, const Ray* world, int count, Ray* local, std::vector<Interval>* out) const {
     const VolumeSpec& vs = scene.volumes[k];
-    for (int i = 0; i < count; ++i) local[i] = members[k].transform ? members[k].transform->local_ray(world[i]) : world[i];
+    for (int i = 0; i < count; ++i) local[i] = local_ray(k, world[i]);
     geometry.intervals(local, count, members[k].geometry_id, out);
     for (int i = 0; i < count; ++i) {
         if (vs.crop) crop_intervals(local[i], *vs.crop, out[i]);
@@ -50,18 +50,23 @@ void Frame::volume_intervals(std::size_t k, const Ray* world, int count, Ray* lo
     }
 }
 
-RaySpan Frame::span(const Ray& lattice_ray) const {
+Ray Frame::local_ray(std::size_t k, const Ray& world) const {
+    return members[k].transform ? members[k].transform->local_ray(world) : world;
+}
+
+bool Frame::meets_brick_box(const Ray& lattice_ray) const {
     Interval range;
-    if (!intersect_box(lattice_ray, brick_lo, brick_hi, range)) return RaySpan{kNone, kNone};
+    return intersect_box(lattice_ray, brick_lo, brick_hi, range);
+}
+
+RaySpan Frame::span(const Ray& lattice_ray) const {
+    if (!meets_brick_box(lattice_ray)) return RaySpan{kNone, kNone};
     return owned_span(bricks[std::size_t(rank)], lattice, members[0].grid, lattice_ray);
 }
 
 bool Frame::meets_brick(const Ray* world, int count) const {
-    for (int i = 0; i < count; ++i) {
-        const Ray lattice_ray = members[0].transform ? members[0].transform->local_ray(world[i]) : world[i];
-        Interval range;
-        if (intersect_box(lattice_ray, brick_lo, brick_hi, range)) return true;
-    }
+    for (int i = 0; i < count; ++i)
+        if (meets_brick_box(local_ray(0, world[i]))) return true;
     return false;
 }
 

@@ -79,6 +79,10 @@ struct Frame {
     // Whether any of `count` world rays meets this rank's brick (span()'s first test, on the first
     // volume's rays): a block of rays that all miss it has no span, and is skipped before its intervals.
     bool meets_brick(const Ray* world, int count) const;
+    // Volume k's ray in its own space (its transform's, else the world ray), as volume_intervals gives it.
+    Ray local_ray(std::size_t k, const Ray& world) const;
+    // Whether the lattice ray meets this rank's padded brick box (span()'s and meets_brick()'s test).
+    bool meets_brick_box(const Ray& lattice_ray) const;
     glm::dvec3 brick_lo{0.0}, brick_hi{0.0};  // this rank's brick's box in the first volume's space, padded
     // Slot `slot`'s rule: `back` (a part behind) merged into `front`, and the pixel of a finished state.
     void merge(std::size_t slot, RayState& front, const RayState& back) const;

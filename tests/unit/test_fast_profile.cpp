@@ -202,7 +202,8 @@ TEST(FastProfile, PlacesTheReferenceSegmentsInFloat) {
 // from the start of their block of 2^23, b_0 = float(t0 + k_b h - t_ref), then b_0 + (k - k_b) h): at
 // h = 4 / 17000000.5 the interval has n = 17,000,001 segments, so its last (r = h / 2) lies in the third
 // block, past 2^24, where a float k would no longer be exact. MinIP reads that last midpoint, z = r / 2;
-// a block start misplaced by a block (2^23 h = 1.97) would move alpha by 0.49, a whole step by h / 8.
+// a block start misplaced by a block (2^23 h = 1.97) would move alpha by 0.49 (a last segment placed a
+// whole step long only by (h - r) / 8 = h / 16, below the float bound: the other test checks that).
 TEST(FastProfile, PlacesSegmentsPastTheFirstFloatBlocks) {
     const double h = 4.0 / 17000000.5;
     const std::int64_t n = std::int64_t(std::ceil(4.0 / h - 1e-9));

@@ -113,6 +113,9 @@ private:
 constexpr std::size_t kChainBlock = 256;
 // Pixels a thread between two of MPI's progress calls (about 2 ms of the adaptive scene's work).
 constexpr std::size_t kChainChunkPerThread = 32;
+// The posted receives each progress call tests (the next ones a rank will wait for; any test drives
+// every transfer, the window only bounds the call's cost on a frame of many blocks).
+constexpr std::size_t kChainReceiveWindow = 8;
 
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
 // kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
@@ -181,7 +184,7 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
             int n = 0;
             MPI_Testsome(int(sends.size() - first_send), sends.data() + first_send, &n, completed.data(), MPI_STATUSES_IGNORE);
         }
-        const std::size_t window = std::min<std::size_t>(receives.size() - next_in, 8);
+        const std::size_t window = std::min(receives.size() - next_in, kChainReceiveWindow);
         int done = 0;
         if (window > 0) MPI_Testall(int(window), receives.data() + next_in, &done, MPI_STATUSES_IGNORE);
     };

@@ -1,4 +1,4 @@
-// volref-mpi render SCENE -o OUT [--threads T] [--max-memory M] [--set PATH=VALUE ...] [--balance cells|work]
+// volref-mpi render SCENE -o OUT [--threads T] [--max-memory M] [--set PATH=VALUE ...] [--balance auto|cells|work]
 //
 // Space split into bricks over the MPI ranks (cli/mpi/Bricks.h: a k-d split of the first volume's
 // lattice, extended over every volume); each rank holds its brick of every volume plus a ghost layer
@@ -84,13 +84,11 @@ void write_dump(const Image& image, const std::string& path) {
 }
 
 struct Args {
-    std::string scene, output, max_memory;
+    std::string scene, output, max_memory, compositing = "swap";
+    std::string balance = "auto";  // auto: work for the chain, cells otherwise (conventions §14)
     int threads = 0;
     std::vector<std::string> overrides;
-    bool timing = false;
-    std::string compositing = "swap";
-    bool compositing_given = false;
-    std::string balance = "cells";
+    bool timing = false, compositing_given = false;
 };
 
 double now() { return MPI_Wtime(); }
@@ -346,7 +344,8 @@ int run(const Args& args, int rank, int size) {
     if (any_error(guarded([&] { read_bricks(args, *frame, nullptr); }), rank, size)) return 1;
     if (any_error(guarded([&] { prepare(args, *frame, swap); }), rank, size)) return 1;
     const char* bricks = "cells";  // how the bricks were cut (--timing): cells, work (cut again), work-same-cut
-    if (args.balance == "work" && size > 1) {  // the bricks again, cut where the work balances
+    const bool by_work = args.balance == "work" || (args.balance == "auto" && chained(*frame));
+    if (by_work && size > 1) {  // the bricks again, cut where the work balances
         WorkBins work;
         if (any_error(guarded([&] { work = count_work(*frame); }), rank, size)) return 1;
         const std::vector<Brick> balanced = balanced_bricks(*frame, std::move(work));
@@ -429,9 +428,10 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"direct", "swap"}))
         ->capture_default_str();
     rc->add_option("--balance", args.balance,
-                   "Where the bricks are cut: cells (equal cell counts, the default) or work (the samples "
-                   "counted on every 4th pixel's rays balance; the bricks are read twice)")
-        ->check(CLI::IsMember({"work", "cells"}))
+                   "Where the bricks are cut: cells (equal cell counts), work (the samples counted on every 4th "
+                   "pixel's rays balance; the bricks are read twice) or auto (work where the ranks chain "
+                   "each pixel's state, cells otherwise)")
+        ->check(CLI::IsMember({"auto", "work", "cells"}))
         ->capture_default_str();
     rc->add_flag("--timing", args.timing,
                  "Print one line on stderr (rank 0): volref: timing {ranks, compositing, bricks (cells, work, work-same-cut), setup_s, render_s (the slowest "

@@ -18,7 +18,8 @@ volumes      : mesh bounds; several volumes (different grids, overlapping, one c
                2, 3 and 4 ranks in turn, equal `volref render`; a constant medium beside a second one has a closed form.
 adaptive     : render.integrator "adaptive" on every projection, one volume and three (the composite's
                state handed from rank to rank, the others' independent parts), each by two of 2, 3 and 4 ranks:
-               every channel, the error channel included, equals `volref render` within 1e-12.
+               every channel, the error channel included, equals `volref render` within 1e-12; the
+               chain's bricks cut by work by default, by cells when asked (--timing names the cut).
 refusals     : scenes outside the first version's scope are refused in one line naming the key.
 """
 import argparse, json, os, shutil, struct, subprocess, sys, math
@@ -627,10 +628,23 @@ if a.mode == "adaptive":
         path = write_scene(name, scene)
         for np_ in rank_counts(i):
             check_equal(name, path, np_)
-    # The chain over bricks cut by work (--balance work).
+    # The chain's bricks are cut by work unless asked otherwise (--balance auto, conventions §14): the
+    # cell cut too, and --timing names the cut each way (the fixed step's default stays cells).
     for name in ("adaptive-persp", "adaptive-vols-composite-persp-shaded"):
         for np_ in (2, 3):
-            check_equal(name + "-balanced", os.path.join(a.work, name + ".json"), np_, extra=["--balance", "work"])
+            check_equal(name + "-cells", os.path.join(a.work, name + ".json"), np_, extra=["--balance", "cells"])
+    fixed = write_scene("fixed-persp", base_scene("composite", "persp"))
+    for scene_path, extra, expect in ((os.path.join(a.work, "adaptive-persp.json"), [], "work"),
+                                      (os.path.join(a.work, "adaptive-persp.json"), ["--balance", "cells"], "cells"),
+                                      (fixed, [], "cells")):
+        r = mpirun(2, ["render", scene_path, "-o", os.path.join(a.work, "timing.img"), "--threads", "1", "--timing"] + extra)
+        said = [l for l in r.stderr.splitlines() if l.startswith("volref: timing ")]
+        cut = json.loads(said[0][len("volref: timing "):])["bricks"] if said else None
+        if r.returncode != 0 or cut not in (expect, expect + "-same-cut"):
+            failures.append("%s %s: expected bricks %r in --timing, got %r (%d) %r" % (
+                os.path.basename(scene_path), extra, expect, cut, r.returncode, r.stderr[-300:]))
+        else:
+            print("ok %s %s: bricks %s" % (os.path.basename(scene_path), " ".join(extra) or "(default)", cut))
 
 if a.mode == "refusals":
     cases = {

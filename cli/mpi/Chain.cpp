@@ -127,7 +127,7 @@ constexpr std::size_t kChainReceiveWindow = 8;
 // On return each pixel's state is final on its last rank. An error aborts every rank (MPI_Abort: the
 // ranks behind would wait for its states).
 template <class Step>
-void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vector<double>& state, bool reverse,
+void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuffer& state, bool reverse,
              std::size_t& bytes, Step&& step) {
     const std::size_t P = frame.pixels();
     auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
@@ -226,10 +226,10 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, std::vec
 }
 
 // The final states (on each pixel's last rank, or first with `first`) summed onto rank 0; zero elsewhere.
-std::vector<double> collect(const Frame& frame, const RankOrder& order, std::size_t S, const std::vector<double>& state,
+PartBuffer collect(const Frame& frame, const RankOrder& order, std::size_t S, const PartBuffer& state,
                             bool first, std::size_t& bytes) {
     const std::size_t P = frame.pixels();
-    std::vector<double> mine(P * S, 0.0), all(frame.rank == 0 ? P * S : 0);
+    PartBuffer mine(P * S, 0.0), all(frame.rank == 0 ? P * S : 0);
     for (std::size_t px = 0; px < P; ++px) {
         const bool holds = order.position[px] >= 0 && order.position[px] == (first ? 0 : order.count[px] - 1);
         if (holds) std::copy(&state[px * S], &state[px * S] + S, &mine[px * S]);
@@ -254,7 +254,7 @@ bool span_keys(const Frame& frame, std::vector<double>& key, Has&& has) {
 
 // The fixed step with early termination: RayState resumed span after span (the volume's integrator,
 // or the several-volume mix); pixels R G B A on rank 0.
-bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes) {
+bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
     const std::size_t P = frame.pixels(), S = RayState::kDoubles;
     std::vector<double> key;
     const bool ok = span_keys(frame, key, [&](std::size_t, const RaySpan&, const PixelRays& scratch) {
@@ -265,7 +265,7 @@ bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& b
     if (!ok) return false;
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
-    std::vector<double> state(P * S, 0.0);  // fresh states (all zero)
+    PartBuffer state(P * S, 0.0);  // fresh states (all zero)
     hand_on(frame, order, S, state, false, bytes, [&](std::size_t px, PixelRays& scratch, double* s) {
         scratch.of(frame, px);
         RayState st = RayState::read(s);
@@ -274,7 +274,7 @@ bool fixed_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& b
         else frame.members[0].prepared->integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
         st.write(s);
     });
-    const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
+    const PartBuffer final_state = collect(frame, order, S, state, false, bytes);
     if (frame.rank != 0) return true;
     pixels.assign(P * 4, 0.0);
     // The slot's own finish (the reference's composite_state, the fast profile's product_state); a
@@ -336,7 +336,7 @@ bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vec
 // composite, MultiVolumeIntegrator::adaptive_composite), a piece belonging to the rank whose span
 // holds its midpoint; AdaptiveComposite's state front to back, then the error's sums back to front;
 // pixels R G B A error on rank 0.
-bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes) {
+bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
     using Composite = AdaptiveIntegrator::Composite;
     using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
     const std::size_t P = frame.pixels(), V = frame.volumes(), S = std::size_t(Composite::kStateSize);
@@ -352,7 +352,7 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     const double tolerance = frame.scene.render.tolerance;
     const double safety = V == 1 ? one->safety() : frame.multi->adaptive_safety();
     const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
-    std::vector<double> state(P * S, 0.0);
+    PartBuffer state(P * S, 0.0);
     const Composite fresh(none, tolerance, safety, 1.0);
     for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
     std::vector<std::vector<adaptive_detail::Leaf>> leaves(P);
@@ -388,7 +388,7 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
     // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c
     // (the last rank's final state).
     constexpr std::size_t E = 5;
-    std::vector<double> sums(P * E, 0.0);
+    PartBuffer sums(P * E, 0.0);
     for (std::size_t px = 0; px < P; ++px)
         if (order.position[px] >= 0 && order.position[px] == order.count[px] - 1)
             for (std::size_t i = 0; i < 3; ++i) sums[px * E + i] = state[px * S + Composite::kStateOpaqueColour + i];
@@ -398,8 +398,8 @@ bool adaptive_chain(const Frame& frame, std::vector<double>& pixels, std::size_t
         Composite::error_sums(leaves[px], behind, colour_err, tau_err);
         q[0] = behind.r, q[1] = behind.g, q[2] = behind.b, q[3] = colour_err, q[4] = tau_err;
     });
-    const std::vector<double> final_state = collect(frame, order, S, state, false, bytes);
-    const std::vector<double> final_sums = collect(frame, order, E, sums, true, bytes);
+    const PartBuffer final_state = collect(frame, order, S, state, false, bytes);
+    const PartBuffer final_sums = collect(frame, order, E, sums, true, bytes);
     if (frame.rank != 0) return true;
     pixels.assign(P * 5, 0.0);
     for (std::size_t px = 0; px < P; ++px) {
@@ -421,7 +421,7 @@ bool chained(const Frame& frame) {
     return frame.mixed() ? frame.multi->composite_spans_in_order() : frame.members[0].prepared->integrator->spans_in_order();
 }
 
-bool chained_pixels(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes) {
+bool chained_pixels(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
     return frame.adaptive() ? adaptive_chain(frame, pixels, bytes) : fixed_chain(frame, pixels, bytes);
 }
 

@@ -16,7 +16,7 @@ namespace volref::mpi {
 
 // The finished pixels (Frame::channels() doubles each) on rank 0, and the bytes this rank sent; false
 // after an error (reported by rank 0 through any_error; every rank returns false).
-bool chained_pixels(const Frame& frame, std::vector<double>& pixels, std::size_t& bytes_handed);
+bool chained_pixels(const Frame& frame, PartBuffer& pixels, std::size_t& bytes_handed);
 
 // Whether the scene's composite is chained (rather than merged from independent parts).
 bool chained(const Frame& frame);

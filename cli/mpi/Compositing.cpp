@@ -25,9 +25,9 @@ void finish_pixel(const Frame& frame, std::size_t px, SlotPart&& slot_part, std:
 
 }  // namespace
 
-void direct_send(const Frame& frame, const std::vector<double>& part, double* image, Traffic& traffic) {
+void direct_send(const Frame& frame, const PartBuffer& part, double* image, Traffic& traffic) {
     const int size = frame.size;
-    std::vector<double> all;
+    PartBuffer all;
     if (frame.rank == 0) all.resize(part.size() * std::size_t(size));
     MPI_Gather(part.data(), int(part.size()), MPI_DOUBLE, all.data(), int(part.size()), MPI_DOUBLE, 0, MPI_COMM_WORLD);
     if (frame.rank != 0) {
@@ -59,7 +59,7 @@ void direct_send(const Frame& frame, const std::vector<double>& part, double* im
 // r ^ 1 sibling bricks, and after round i the 2^(i+1) ranks merged are one subtree's box, convex: the
 // ray crosses it in one span, so two merged parts are in ray order by their keys. Then rank 0 gathers
 // the finished pixels of every rank's range (MPI_Gatherv).
-void binary_swap(const Frame& frame, std::vector<double>& part, double* image, Traffic& traffic) {
+void binary_swap(const Frame& frame, PartBuffer& part, double* image, Traffic& traffic) {
     const int rank = frame.rank, size = frame.size;
     const std::size_t pixels = frame.pixels(), slots = frame.slots(), nc = std::size_t(frame.channels());
     auto merge = [&](std::size_t sl, double* a, const double* b, bool b_first_on_tie) {
@@ -79,7 +79,7 @@ void binary_swap(const Frame& frame, std::vector<double>& part, double* image, T
         }
         return std::array<std::size_t, 2>{lo, hi};
     };
-    std::vector<double> incoming;
+    PartBuffer incoming;
     std::size_t lo = 0, hi = pixels;
     const std::size_t stride = slots * kPart;  // one pixel's slots
     for (int bit = 1; bit < size; bit <<= 1) {
@@ -99,7 +99,7 @@ void binary_swap(const Frame& frame, std::vector<double>& part, double* image, T
         lo = keep_lo;
         hi = keep_hi;
     }
-    std::vector<double> finished((hi - lo) * nc);
+    PartBuffer finished((hi - lo) * nc);
     std::vector<PixelValue> values(slots);
     std::vector<std::vector<Interval>> intervals(frame.volumes());
     std::vector<Ray> rays(frame.volumes());

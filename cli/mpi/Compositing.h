@@ -16,7 +16,7 @@ struct Traffic {
 
 // `part` holds this rank's parts (pixels x slots x kPart doubles; binary swap merges into it). On rank 0,
 // `image` receives every pixel (Frame::channels() doubles each); elsewhere it is not touched.
-void direct_send(const Frame& frame, const std::vector<double>& part, double* image, Traffic& traffic);
-void binary_swap(const Frame& frame, std::vector<double>& part, double* image, Traffic& traffic);
+void direct_send(const Frame& frame, const PartBuffer& part, double* image, Traffic& traffic);
+void binary_swap(const Frame& frame, PartBuffer& part, double* image, Traffic& traffic);
 
 }  // namespace volref::mpi

@@ -20,6 +20,7 @@
 #include "geometry/VolumeTransform.h"
 #include "cli/mpi/BrickReader.h"
 #include "cli/mpi/Bricks.h"
+#include "cli/mpi/PartBuffer.h"
 
 namespace volref::mpi {
 

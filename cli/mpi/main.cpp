@@ -229,7 +229,7 @@ void prepare(const Args& args, Frame& f, bool swap) {
 // This rank's part of every pixel (Frame::slots() parts of kPart doubles): the key of its span and the
 // state its span gives from a fresh one (the slot's integrator, in SIMD packets where the volume allows;
 // several volumes: the mix, or each volume's own integrator).
-void integrate_parts(const Frame& f, std::vector<double>& part) {
+void integrate_parts(const Frame& f, PartBuffer& part) {
     const std::size_t V = f.volumes(), slots = f.slots(), W = std::size_t(f.width());
     part.assign(f.pixels() * slots * kPart, 0.0);
     for (std::size_t i = 0; i < f.pixels() * slots; ++i) part[i * kPart] = kNone;
@@ -362,7 +362,7 @@ int run(const Args& args, int rank, int size) {
 
     const double t_setup = now();
     const bool chain = chained(f);
-    std::vector<double> part, chained_image;
+    PartBuffer part, chained_image;
     Traffic traffic;
     if (chain) {
         if (!chained_pixels(f, chained_image, traffic.sent)) return 1;

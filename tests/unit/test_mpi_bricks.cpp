@@ -9,6 +9,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "cli/mpi/Bricks.h"
+#include "cli/mpi/PartBuffer.h"
 #include "core/Error.h"
 
 namespace {
@@ -139,3 +140,19 @@ TEST(MpiBricks, VoxelsForByHand) {
 }
 
 }  // namespace
+
+// PartBuffer (cli/mpi/PartBuffer.h): a large buffer starts on a 2 MiB boundary (so that madvise's huge
+// pages cover all of it), a small one is std::allocator's; both hold what is written, and copy like
+// any vector (the values never depend on where the storage lies).
+TEST(MpiPartBuffer, LargeBuffersStartOnHugePageBoundaries) {
+    constexpr std::size_t kHuge = std::size_t(1) << 21;
+    for (std::size_t n : {std::size_t(3), kHuge / sizeof(double) - 1, kHuge / sizeof(double), 3 * kHuge / sizeof(double) + 5}) {
+        PartBuffer b(n, 0.0);
+        if (n * sizeof(double) >= kHuge) EXPECT_EQ(reinterpret_cast<std::uintptr_t>(b.data()) % kHuge, 0u) << n;
+        for (std::size_t i = 0; i < n; ++i) b[i] = double(i) * 0.5;
+        const PartBuffer c = b;
+        double sum = 0.0;
+        for (double v : c) sum += v;
+        EXPECT_EQ(sum, 0.25 * double(n) * double(n - 1)) << n;  // 0.5 * n (n - 1) / 2, exact in doubles here
+    }
+}

@@ -30,7 +30,6 @@
 
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
-#include "core/film/ImageWriter.h"
 #include "core/grid/ProceduralField.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
@@ -38,6 +37,7 @@
 #include "cli/mpi/Chain.h"
 #include "cli/mpi/Compositing.h"
 #include "cli/mpi/Frame.h"
+#include "cli/mpi/ImageOutput.h"
 
 namespace {
 
@@ -60,26 +60,6 @@ void check_supported(const Scene& scene) {
         // "auto" decides from the whole volume's voxels (resolve_gradient_cache), which no rank holds.
         if (vs.gradient.cache_auto)
             throw Error(key + ".gradient.cache: \"auto\" is not supported by volref-mpi yet (say true or false)");
-    }
-}
-
-// OUT ending in ".img": the pixels as doubles in tests/identity/image_dump.cpp's format (a text line
-// "W H R G B A", then W H 4 IEEE-754 doubles in the host's byte order), so that tests compare doubles
-// (EXR stores floats). Written to a temporary name and renamed into place.
-bool dump_output(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".img") == 0; }
-
-void write_dump(const Image& image, const std::string& path) {
-    const std::string temp = path + ".part";
-    std::FILE* f = std::fopen(temp.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot write");
-    std::string header = std::to_string(image.width) + " " + std::to_string(image.height);
-    for (const std::string& c : image.channels) header += " " + c;
-    header += "\n";
-    const bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
-                    std::fwrite(image.pixels.data(), sizeof(double), image.pixels.size(), f) == image.pixels.size();
-    if (std::fclose(f) != 0 || !ok || std::rename(temp.c_str(), path.c_str()) != 0) {
-        std::remove(temp.c_str());
-        throw Error(path + ": cannot write");
     }
 }
 
@@ -110,7 +90,7 @@ std::string guarded(F&& f) {
 // brick of every volume (read as a sub-box of its file, or generated).
 void read_bricks(const Args& args, Frame& f, const std::vector<Brick>* bricks) {
     if (!args.max_memory.empty()) set_memory_limit(parse_memory_size(args.max_memory, "--max-memory"));
-    if (f.rank == 0 && !dump_output(args.output)) check_output_path(args.output);
+    if (f.rank == 0) check_output(args.output);
     f.scene = load_scene(args.scene, args.overrides);
     check_supported(f.scene);
     f.members.resize(f.scene.volumes.size());
@@ -389,10 +369,7 @@ int run(const Args& args, int rank, int size) {
     const double t_gather = now();
     std::string err;
     if (rank == 0)
-        err = guarded([&] {
-            if (dump_output(args.output)) write_dump(*image, args.output);
-            else write_image(*image, args.output, f.scene.image.background);
-        });
+        err = guarded([&] { write_output(*image, args.output, f.scene.image.background); });
     const double t_write = now();
     if (any_error(err, rank, size)) return 1;
     if (args.timing)

@@ -105,3 +105,32 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
 }
 
 }  // namespace volref
+
+namespace {
+// Runs f; 0, or 1 with the exception's message copied into error[0, size).
+template <class F>
+int with_message(F&& f, char* error, std::size_t size) {
+    try {
+        f();
+        return 0;
+    } catch (const std::exception& e) {
+        if (size > 0) {
+            const std::size_t n = std::min(size - 1, std::char_traits<char>::length(e.what()));
+            std::copy(e.what(), e.what() + n, error);
+            error[n] = '\0';
+        }
+        return 1;
+    }
+}
+}  // namespace
+
+extern "C" int volref_check_output_path(const char* path, char* error, std::size_t size) {
+    return with_message([&] { volref::check_output_path(path); }, error, size);
+}
+
+extern "C" int volref_write_image(const volref::Image* image, const char* path, const double background[4], char* error,
+                                  std::size_t size) {
+    return with_message([&] {
+        volref::write_image(*image, path, glm::dvec4(background[0], background[1], background[2], background[3]));
+    }, error, size);
+}

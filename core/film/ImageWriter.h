@@ -7,6 +7,7 @@
 // The file is written to a temporary name in the same folder and renamed into place, so a failed
 // or interrupted run never leaves a partial file under the requested name.
 #pragma once
+#include <cstddef>
 #include <filesystem>
 
 #include <glm/vec4.hpp>
@@ -22,3 +23,10 @@ void check_output_path(const std::filesystem::path& path);
 void write_image(const Image& image, const std::filesystem::path& path, const glm::dvec4& background);
 
 }  // namespace volref
+
+// The two functions above with C names, for a program that loads libvolref_tools at run time instead of
+// linking it (volref-mpi: cli/mpi/ImageOutput.cpp; its ranks then start without OpenImageIO's 280
+// libraries). Each returns 0, or 1 with the Error's message in `error` (NUL-terminated, cut to `size`).
+extern "C" int volref_check_output_path(const char* path, char* error, std::size_t size);
+extern "C" int volref_write_image(const volref::Image* image, const char* path, const double background[4], char* error,
+                                  std::size_t size);

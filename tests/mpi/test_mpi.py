@@ -14,10 +14,10 @@ failed       : a truncated raw file whose last brick cannot be read: exit status
 formats      : NRRD (attached and detached), MetaImage (.mha, .mhd), NIfTI-1 (.nii, scaled) read as bricks
                by 2, 3 and 4 ranks equal `volref render`; gzip data and a flipped NIfTI are one-line errors.
 volumes      : mesh bounds; several volumes (different grids, overlapping, one cropped and clipped, transformed) on every
-               projection and order, orthographic and perspective, shaded and unshaded, each by two of
-               2, 3 and 4 ranks in turn, equal `volref render`; a constant medium beside a second one has a closed form.
+               projection and order, orthographic and perspective, shaded and unshaded, by 2, 3 and
+               4 ranks equal `volref render`; a constant medium beside a second one has a closed form.
 adaptive     : render.integrator "adaptive" on every projection, one volume and three (the composite's
-               state handed from rank to rank, the others' independent parts), each by two of 2, 3 and 4 ranks:
+               state handed from rank to rank, the others' independent parts), by 2, 3 and 4 ranks:
                every channel, the error channel included, equals `volref render` within 1e-12; the
                chain's bricks cut by work by default, by cells when asked (--timing names the cut).
 refusals     : scenes outside the first version's scope are refused in one line naming the key.
@@ -91,13 +91,6 @@ def reference(name, scene_path):
         ref = None
     references[scene_path] = ref
     return ref
-
-
-def rank_counts(i):
-    """The rank counts case i of a long list runs at: two of 2, 3 and 4 in turn, so that every count
-    meets two thirds of the cases (each mpirun costs 1-2 s of start-up, mostly loading libraries; the
-    cut along the longest axis and the compositing differ between counts, the rest of the path not)."""
-    return ((2, 3), (3, 4), (4, 2))[i % 3]
 
 
 def check_equal(name, scene_path, np, extra=(), tolerance=1e-12):
@@ -541,9 +534,9 @@ if a.mode == "volumes":
                                     "two-volumes-clipped.json")))
     s["image"] = {"width": 40, "height": 32}
     cases.append(("vols-two-volumes-clipped", s))
-    for i, (name, scene) in enumerate(cases):
+    for name, scene in cases:
         path = write_scene(name, scene)
-        for np_ in rank_counts(i):
+        for np_ in (2, 3, 4):
             check_equal(name, path, np_)
     # Closed form: two constant media along z, one above the other (z in [0, 16] and [16, 32]), with
     # opacities 0.5 and 0.25 per unit and colours c0, c1, seen from above along -z: the upper medium
@@ -624,9 +617,9 @@ if a.mode == "adaptive":
     s = base_scene("first-hit", "persp", shaded=True)
     s["render"].update({"integrator": "adaptive"})
     cases.append(("adaptive-shaded-first-hit-persp", s))
-    for i, (name, scene) in enumerate(cases):
+    for name, scene in cases:
         path = write_scene(name, scene)
-        for np_ in rank_counts(i):
+        for np_ in (2, 3, 4):
             check_equal(name, path, np_)
     # The chain's bricks are cut by work unless asked otherwise (--balance auto, conventions §14): the
     # cell cut too, and --timing names the cut each way (the fixed step's default stays cells).

@@ -20,6 +20,9 @@ namespace volref::mpi {
 
 namespace {
 
+// The adaptive chain's error sums handed back to front per pixel: behind R G B, colour_err, tau_err.
+constexpr std::size_t kErrorSums = 5;
+
 // Each pixel's ranks in ray order (by their spans' keys, then rank): this rank's place among them
 // (-1: none), how many there are, and the ranks just in front of and behind this one (-1: none).
 struct RankOrder {
@@ -387,7 +390,7 @@ bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) 
     });
     // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c
     // (the last rank's final state).
-    constexpr std::size_t E = 5;
+    constexpr std::size_t E = kErrorSums;
     PartBuffer sums(P * E, 0.0);
     for (std::size_t px = 0; px < P; ++px)
         if (order.position[px] >= 0 && order.position[px] == order.count[px] - 1)
@@ -414,6 +417,15 @@ bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) 
 }
 
 }  // namespace
+
+std::size_t chain_bytes(const Frame& frame) {
+    const std::size_t P = frame.pixels(), ranks = std::size_t(frame.size), root = frame.rank == 0 ? 1 : 0;
+    const std::size_t handed = frame.adaptive() ? std::size_t(AdaptiveIntegrator::Composite::kStateSize) + kErrorSums
+                                                : std::size_t(RayState::kDoubles);
+    const std::size_t per_pixel = (1 + ranks) * sizeof(double) + 4 * sizeof(int) + handed * sizeof(double) * (4 + root) +
+                                  root * std::size_t(frame.channels()) * sizeof(double);
+    return P * per_pixel;
+}
 
 bool chained(const Frame& frame) {
     if (!is_composite(frame.scene.render.projection)) return false;

@@ -21,4 +21,11 @@ bool chained_pixels(const Frame& frame, PartBuffer& pixels, std::size_t& bytes_h
 // Whether the scene's composite is chained (rather than merged from independent parts).
 bool chained(const Frame& frame);
 
+// The bytes the chain's fixed-size arrays take on this rank (--max-memory, checked before they are
+// made): per pixel its key and every rank's (1 + ranks doubles), its place among the ranks (4 ints), and
+// for each value handed on (the state; the adaptive chain's error sums too) the array, as much again
+// received, as much sent and collect's copy (rank 0: and the sum, and the pixels). The adaptive
+// chain's pieces and leaves, which depend on the field, are not counted.
+std::size_t chain_bytes(const Frame& frame);
+
 }  // namespace volref::mpi

@@ -201,9 +201,11 @@ void prepare(const Args& args, Frame& f, bool swap) {
     // and half of them received; rank 0 also holds the image.
     const std::size_t image_bytes = f.pixels() * std::size_t(f.channels()) * sizeof(double);
     const std::size_t mine = f.rank == 0 ? image_bytes : 0;
-    const std::size_t held_parts = swap ? parts + parts / 2 + mine : parts * (f.rank == 0 ? std::size_t(f.size) + 1 : 1) + mine;
-    check_memory(held + held_parts, "this rank's bricks with the image parts (" + std::to_string(f.size) + " ranks, " +
-                                        (swap ? "binary swap" : "direct send") + ")");
+    const bool chain = chained(f);  // (the chain's arrays instead: Chain.h chain_bytes)
+    const std::size_t held_parts = chain ? chain_bytes(f) : swap ? parts + parts / 2 + mine
+                                                                 : parts * (f.rank == 0 ? std::size_t(f.size) + 1 : 1) + mine;
+    check_memory(held + held_parts, std::string(chain ? "this rank's bricks with the chain's states (" : "this rank's bricks with the image parts (") +
+                                        std::to_string(f.size) + " ranks" + (chain ? "" : swap ? ", binary swap" : ", direct send") + ")");
 }
 
 // This rank's part of every pixel (Frame::slots() parts of kPart doubles): the key of its span and the

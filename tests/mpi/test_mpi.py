@@ -424,6 +424,26 @@ if a.mode == "memory":
     else:
         print("ok refused by 1 rank: " + lines[0])
     check_equal("big", scene, 4, extra=["--max-memory", "1536K"])
+    # The adaptive chain's arrays count too (cli/mpi/Chain.h chain_bytes), by hand for rank 0 of 2 at
+    # 512 x 512: per pixel its key and both ranks' (3 doubles), its place among the ranks (4 ints), the
+    # state (15 doubles) and the error sums (5): 20 doubles x 5 (the array, received, sent, collect's
+    # copy, rank 0's sum), and the pixels (R G B A error: 5 doubles): 24 + 16 + 800 + 40 = 880 bytes,
+    # x 262144 pixels = 220.0 MiB; the bricks (5 x 5 x 9 voxels) add kilobytes. The merged parts' count
+    # (what was checked before) is 58 MiB, under the 120 MiB limit.
+    chain = write_scene("chain-memory", {
+        "volume": {"source": {"field": "constant", "value": 1.0, "dims": [5, 5, 9]},
+                   "transfer": {"color": [[0.0, 1.0, 0.5, 0.25], [2.0, 1.0, 0.5, 0.25]], "opacity": [[0.0, 0.5], [2.0, 0.5]]}},
+        "camera": {"type": "orthographic", "eye": [2, 2, 100], "target": [2, 2, 4], "up": [0, 1, 0], "height": 4},
+        "image": {"width": 512, "height": 512},
+        "render": {"projection": "composite", "integrator": "adaptive", "tolerance": 1e-3}})
+    out2 = os.path.join(a.work, "chain-memory.img")
+    r = mpirun(2, ["--max-memory", "120M", "render", chain, "-o", out2, "--threads", "1"])
+    lines = [l for l in r.stderr.splitlines() if l.startswith("volref: error:")]
+    if r.returncode == 0 or len(lines) != 1 or "chain's states" not in lines[0] or "220 MiB" not in lines[0] or os.path.exists(out2):
+        failures.append("2 ranks, adaptive chain under --max-memory 120M: expected one error line naming the chain's "
+                        "220 MiB and no image, got %d: %r" % (r.returncode, r.stderr))
+    else:
+        print("ok refused by 2 ranks: " + lines[0])
 
 if a.mode == "failed":
     # 16 x 16 x 64 u8, split along z; the file holds 40 of the 64 slices. Every rank checks the file's size

@@ -24,8 +24,8 @@ struct HugePageAllocator {
     template <class U>
     HugePageAllocator(const HugePageAllocator<U>&) {}
     T* allocate(std::size_t n) {
-        const std::size_t bytes = n * sizeof(T);
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+        const std::size_t bytes = n * sizeof(T);
         if (bytes < kHugePage) return std::allocator<T>().allocate(n);
         const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
         void* p = std::aligned_alloc(kHugePage, rounded);

@@ -197,15 +197,18 @@ void prepare(const Args& args, Frame& f, bool swap) {
         throw Error("image: " + std::to_string(f.width()) + " x " + std::to_string(f.height()) +
                     " is too large for volref-mpi (its messages hold at most 2^31 - 1 doubles: " +
                     std::to_string(f.slots() * kPart) + " per pixel)");
-    // Direct send: rank 0 holds every rank's parts and its own; binary swap: a rank holds its parts
-    // and half of them received; rank 0 also holds the image.
+    // Chained: the chain's arrays (Chain.h chain_bytes). Direct send: rank 0 holds every rank's parts
+    // and its own; binary swap: a rank holds its parts and half of them received; rank 0 also holds the image.
     const std::size_t image_bytes = f.pixels() * std::size_t(f.channels()) * sizeof(double);
     const std::size_t mine = f.rank == 0 ? image_bytes : 0;
-    const bool chain = chained(f);  // (the chain's arrays instead: Chain.h chain_bytes)
-    const std::size_t held_parts = chain ? chain_bytes(f) : swap ? parts + parts / 2 + mine
-                                                                 : parts * (f.rank == 0 ? std::size_t(f.size) + 1 : 1) + mine;
-    check_memory(held + held_parts, std::string(chain ? "this rank's bricks with the chain's states (" : "this rank's bricks with the image parts (") +
-                                        std::to_string(f.size) + " ranks" + (chain ? "" : swap ? ", binary swap" : ", direct send") + ")");
+    const std::string ranks = std::to_string(f.size) + " ranks";
+    if (chained(f))
+        check_memory(held + chain_bytes(f), "this rank's bricks with the chain's states (" + ranks + ")");
+    else if (swap)
+        check_memory(held + parts + parts / 2 + mine, "this rank's bricks with the image parts (" + ranks + ", binary swap)");
+    else
+        check_memory(held + parts * (f.rank == 0 ? std::size_t(f.size) + 1 : 1) + mine,
+                     "this rank's bricks with the image parts (" + ranks + ", direct send)");
 }
 
 // This rank's part of every pixel (Frame::slots() parts of kPart doubles): the key of its span and the

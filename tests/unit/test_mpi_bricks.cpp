@@ -148,7 +148,9 @@ TEST(MpiPartBuffer, LargeBuffersStartOnHugePageBoundaries) {
     constexpr std::size_t kHuge = std::size_t(1) << 21;
     for (std::size_t n : {std::size_t(3), kHuge / sizeof(double) - 1, kHuge / sizeof(double), 3 * kHuge / sizeof(double) + 5}) {
         PartBuffer b(n, 0.0);
-        if (n * sizeof(double) >= kHuge) EXPECT_EQ(reinterpret_cast<std::uintptr_t>(b.data()) % kHuge, 0u) << n;
+        if (n * sizeof(double) >= kHuge) {
+            EXPECT_EQ(reinterpret_cast<std::uintptr_t>(b.data()) % kHuge, 0u) << n;
+        }
         for (std::size_t i = 0; i < n; ++i) b[i] = double(i) * 0.5;
         const PartBuffer c = b;
         double sum = 0.0;

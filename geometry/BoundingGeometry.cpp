@@ -21,6 +21,7 @@ struct BoxShape {
     glm::dvec3 lo, hi;
     glm::dvec3 domain_lo, domain_hi;
     int volume_id;
+    bool is_domain = false;  // lo, hi = domain_lo, domain_hi
 };
 
 struct MeshShape {
@@ -92,10 +93,12 @@ void box_bounds(const RTCBoundsFunctionArguments* args) {
 }
 
 // The ray's interval in the box AND its domain, in front of the origin (t >= 0), if not empty.
+// A box that is its domain (the usual case) takes one slab test: the second would repeat the first.
 bool box_interval(const BoxShape& box, const Ray& ray, Interval& out) {
     Interval shape, domain;
     if (!intersect_box(ray, box.lo, box.hi, shape)) return false;
-    if (!intersect_box(ray, box.domain_lo, box.domain_hi, domain)) return false;
+    if (box.is_domain) domain = shape;
+    else if (!intersect_box(ray, box.domain_lo, box.domain_hi, domain)) return false;
     out = Interval{std::max({shape.t0, domain.t0, 0.0}), std::min(shape.t1, domain.t1)};
     return out.t1 > out.t0;
 }
@@ -233,7 +236,7 @@ BoundingGeometry::~BoundingGeometry() {
 int BoundingGeometry::add_box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& domain_lo,
                               const glm::dvec3& domain_hi) {
     const int id = impl_->next_id();
-    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id}));
+    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id, lo == domain_lo && hi == domain_hi}));
     impl_->attach(1, impl_->boxes.back().get(), box_bounds, box_intersect, "adding a box");
     impl_->volume_mesh.push_back(nullptr);
     impl_->volume_box.push_back(impl_->boxes.back().get());

@@ -318,16 +318,14 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
     const V t_ref = hn::Load(d, packet.t_ref_lane);  // 0 on double lanes
     const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, origin, in.grid.inv_spacing);
-    // The cached gradient components share the volume's grid.
+    // The cached gradient components share the volume's grid (built only where the gradient is cached).
     const bool cached = in.gradient == PacketCompositeInputs::Gradient::Cached;
-    const ScalarType cached_type = kFast ? ScalarType::F32 : ScalarType::F64;
-    const PacketTrilinearT<T> gx(cached ? tab.cached_gradient[0] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, origin, in.grid.inv_spacing);
-    const PacketTrilinearT<T> gy(cached ? tab.cached_gradient[1] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, origin, in.grid.inv_spacing);
-    const PacketTrilinearT<T> gz(cached ? tab.cached_gradient[2] : in.grid.voxels, cached ? cached_type : in.grid.voxel_type,
-                                 in.grid.dims, origin, in.grid.inv_spacing);
-    const PacketGradient<T> gradient{in, trilinear, {&gx, &gy, &gz}, local};
+    PacketTrilinearT<T> component[3];  // unset unless cached
+    if (cached)
+        for (int a = 0; a < 3; ++a)
+            component[a] = PacketTrilinearT<T>(tab.cached_gradient[a], kFast ? ScalarType::F32 : ScalarType::F64, in.grid.dims,
+                                               origin, in.grid.inv_spacing);
+    const PacketGradient<T> gradient{in, trilinear, {&component[0], &component[1], &component[2]}, local};
     const V view[3] = {hn::Neg(Dx), hn::Neg(Dy), hn::Neg(Dz)};
     const ShadingConstants shading = shading_constants(in);
 

@@ -191,18 +191,24 @@ struct RayPacketT {
                 skip_top_[a] = T(vskip_->dims[a] - 2);
                 skip_counts_[a] = std::int32_t(vskip_->counts[a]);
             }
-            // Per lane: index units per unit of t along each axis.
+            // Per lane: index units per unit of t along each axis (rounded from double), then on the
+            // vectors (the same correctly rounded divisions) 1 / |rate| and the margin.
             for (std::size_t l = 0; l < lanes; ++l) {
-                const double dl[3] = {double(dx[l]), double(dy[l]), double(dz[l])};
-                T fastest = T(0);
+                rate_[0][l] = T(double(dx[l]) * vskip_->inv_spacing[0]);
+                rate_[1][l] = T(double(dy[l]) * vskip_->inv_spacing[1]);
+                rate_[2][l] = T(double(dz[l]) * vskip_->inv_spacing[2]);
+            }
+            const hn::ScalableTag<T> d;
+            const auto zero = hn::Zero(d), one = hn::Set(d, T(1)), inf = hn::Set(d, std::numeric_limits<T>::infinity());
+            for (std::size_t i = 0; i < kLanes; i += hn::Lanes(d)) {
+                auto fastest = zero;
                 for (int a = 0; a < 3; ++a) {
-                    rate_[a][l] = T(dl[a] * vskip_->inv_spacing[a]);
-                    const T speed = std::abs(rate_[a][l]);
-                    inv_speed_[a][l] = speed > T(0) ? T(1) / speed : std::numeric_limits<T>::infinity();
-                    fastest = std::max(fastest, speed);
+                    const auto speed = hn::Abs(hn::Load(d, rate_[a] + i));
+                    hn::Store(hn::IfThenElse(hn::Gt(speed, zero), hn::Div(one, speed), inf), d, inv_speed_[a] + i);
+                    fastest = hn::Max(fastest, speed);
                 }
                 // dt's margin: 0.01 cell at the fastest axis' rate, and the pre-integrated segments' h / 2.
-                margin_[l] = T(0.01) / fastest + T(vskip_->end_margin);
+                hn::Store(hn::Add(hn::Div(hn::Set(d, T(0.01)), fastest), hn::Set(d, T(vskip_->end_margin))), d, margin_ + i);
             }
         }
     }
@@ -445,6 +451,7 @@ struct PacketTrilinearT {
     hn::Vec<DI> offx, offy, offz;
     hn::Vec<DI32> offx32, offy32, offz32, nx32, nxy32;
 
+    PacketTrilinearT() = default;  // unset: assigned before use
     PacketTrilinearT(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
                      const double inv_spacing[3]) {
         const D d;

@@ -216,8 +216,48 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
                                 want = std::min(want, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
                 non_empty += want == 0;
                 EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
+                // solid_radii: the smallest Chebyshev distance to an empty macrocell.
+                std::int64_t solid = MacrocellGrid::kMaxEmptyRadius;
+                for (std::int64_t c = 0; c < 7; ++c)
+                    for (std::int64_t b = 0; b < 7; ++b)
+                        for (std::int64_t a = 0; a < 7; ++a)
+                            if (g.empty({a, b, c}))
+                                solid = std::min(solid, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
+                EXPECT_EQ(g.solid_radii()[std::size_t(i + 7 * (j + 7 * k))], solid) << i << "," << j << "," << k;
             }
     EXPECT_GE(non_empty, 5);
+}
+
+// solid_radii by hand, the complement of the test above: a 41^3 volume of ones whose voxels 16..24 per
+// axis (exactly those macrocell (2, 2, 2) reads) are 0, so (2, 2, 2) is the one empty macrocell (its
+// neighbours also read ones); every other macrocell's solid radius is its Chebyshev distance to it, and
+// without the hole every solid radius is the cap.
+TEST(MacrocellGrid, SolidRadiusIsTheChebyshevDistanceToTheNearestEmptyMacrocell) {
+    for (const bool hole : {true, false}) {
+        FieldSpec f;
+        f.kind = FieldSpec::Kind::Cells;
+        f.dims = {41, 41, 41};
+        f.values.assign(41 * 41 * 41, 1.0);
+        if (hole)
+            for (int k = 16; k <= 24; ++k)
+                for (int j = 16; j <= 24; ++j)
+                    for (int i = 16; i <= 24; ++i) f.values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
+        const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
+        TransferSpec ts;
+        ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
+        const TransferFunction tf(ts, v);
+        const VolumeSampler sampler(v, Interpolation::Trilinear);
+        const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
+        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{5, 5, 5}));
+        for (std::int64_t k = 0; k < 5; ++k)
+            for (std::int64_t j = 0; j < 5; ++j)
+                for (std::int64_t i = 0; i < 5; ++i) {
+                    const std::int64_t d = std::max({std::abs(i - 2), std::abs(j - 2), std::abs(k - 2)});
+                    const std::int64_t want = hole ? d : MacrocellGrid::kMaxEmptyRadius;
+                    EXPECT_EQ(g.solid_radii()[std::size_t(i + 5 * (j + 5 * k))], want) << i << "," << j << "," << k;
+                    EXPECT_EQ(g.empty({i, j, k}), hole && d == 0);
+                }
+    }
 }
 
 // One non-zero voxel in a 20^3 volume of zeros (19 cells per axis: macrocells of 8, 8 and 3 cells):

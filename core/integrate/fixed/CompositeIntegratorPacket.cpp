@@ -103,8 +103,11 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     in.termination = early_termination(ctx.render);
     in.macrocells = ctx.macrocells;
     if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
-        const auto& radii = in.macrocells->empty_radii();
-        skip_radius_.assign(radii.begin(), radii.end());
+        // Per macrocell: empty_radius where it is empty, minus solid_radius where it is not.
+        const auto& empty = in.macrocells->empty_radii();
+        const auto& solid = in.macrocells->solid_radii();
+        skip_radius_.resize(empty.size());
+        for (std::size_t i = 0; i < empty.size(); ++i) skip_radius_[i] = empty[i] > 0 ? std::int32_t(empty[i]) : -std::int32_t(solid[i]);
         in.skip_radius = skip_radius_.data();
     }
     if (fast) {

@@ -110,7 +110,8 @@ struct PacketCompositeInputs {
     int pre_n = 0;
     double pre_x0 = 0.0, pre_inv_dx = 1.0;
     // Skipping decided on the lanes (PacketKernels-inl.h, VectorSkip): each macrocell's empty_radius
-    // as int32 (CompositeIntegrator's copy); null: no skipping.
+    // where it is empty, else minus its solid_radius (MacrocellGrid.h), as int32 (CompositeIntegrator's
+    // copy); null: no skipping.
     const std::int32_t* skip_radius = nullptr;
 };
 

@@ -95,7 +95,7 @@ struct SimdLanes {
 // Empty-space skipping of the composite packets, decided for all lanes at once (issue 31, part 1):
 // what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
-    const std::int32_t* radius = nullptr;  // empty_radius of each macrocell, int32 (CompositeIntegrator's copy)
+    const std::int32_t* radius = nullptr;  // per macrocell: empty_radius if empty, else -solid_radius (CompositeIntegrator's copy)
     std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
     std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
     double origin[3] = {0, 0, 0};          // the lanes' positions' origin of the grid (0: float lanes' local coordinates)
@@ -119,7 +119,9 @@ struct VectorSkip {
 // empty macrocells only and its opacity is 0 exactly; the image is the image without skipping. The
 // lane's new segment is placed in the same step (and checked again), replacing the empty sample; with
 // pre-integrated segments the segment at p is kept (its ends may lie outside B) and the lane moves on
-// after it. Lanes whose p lies outside the grid's index range (clamped) are not moved.
+// after it. Lanes whose p lies outside the grid's index range (clamped) are not moved. A lane in a
+// non-empty m with solid_radius(m) = r (every macrocell within r - 1 of m non-empty) is not checked
+// again before it leaves that box (the same exit, with r), since no empty macrocell lies in it.
 template <typename T>
 struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
@@ -342,9 +344,9 @@ private:
             const auto r = hn::IfThenElseZero(inside32, hn::GatherIndex(di, s.radius, safe));
             const auto radius = to_lanes(d, r);  // exact
             const auto empty = hn::Gt(radius, zero);
-            // The exit of the box of macrocells within r - 1 of m (m itself where r = 0): per axis the
-            // face ahead, in index units.
-            const auto rf = hn::Max(radius, hn::Set(d, T(1)));
+            // The exit of the box of macrocells within r - 1 of m, all empty (r = empty_radius) or all
+            // non-empty (r = solid_radius; m itself where r = 0): per axis the face ahead, in index units.
+            const auto rf = hn::Max(hn::Abs(radius), hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
             for (int a = 0; a < 3; ++a) {
                 const auto rate = hn::Load(d, rate_[a] + i);
@@ -354,7 +356,8 @@ private:
                 const auto face = hn::IfThenElse(hn::Lt(rate, zero), lo, hi);
                 dt = hn::Min(dt, hn::Mul(hn::Abs(hn::Sub(face, u[a])), hn::Load(d, inv_speed_[a] + i)));
             }
-            // Non-empty lanes inside the grid: the next check where they leave m; the others every step.
+            // Non-empty lanes inside the grid: the next check where they leave the box of non-empty
+            // macrocells around m (no empty space before it); the others every step.
             const auto solid = hn::AndNot(empty, inside);
             hn::Store(hn::IfThenElse(solid, hn::Add(t, dt), hn::Set(d, -std::numeric_limits<T>::infinity())), d, recheck_ + i);
             if (hn::AllFalse(d, empty)) continue;

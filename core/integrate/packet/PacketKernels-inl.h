@@ -284,7 +284,7 @@ struct RayPacketT {
         }
         // A lane moved on takes its new segment in this same step (checked again: it may land in
         // another empty box), so that no step is spent on a sample known to be empty.
-        if (vskip_)
+        if (vskip_ && any_due())
             for (int pass = 0; pass < 8 && skip_empty(); ++pass) {
             }
         return true;
@@ -301,6 +301,16 @@ private:
     // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
     // past the samples that stay in its empty box, placing its new segment on the vectors (place(), as
     // next() does; a lane at the end of its run takes no sample this step). True when a lane was moved.
+    // Whether a live lane is due for skip_empty's check (its t at or past recheck_): inline, so that a
+    // step where none is costs no call.
+    HWY_INLINE bool any_due() const {
+        const hn::ScalableTag<T> d;
+        const auto zero = hn::Zero(d);
+        for (std::size_t i = 0; i < lanes; i += hn::Lanes(d))
+            if (!hn::AllFalse(d, hn::And(hn::Gt(hn::Load(d, live + i), zero), hn::Ge(hn::Load(d, tm + i), hn::Load(d, recheck_ + i)))))
+                return true;
+        return false;
+    }
     bool skip_empty() {
         const hn::ScalableTag<T> d;
         const hn::Rebind<std::int32_t, decltype(d)> di;  // int32 lanes, as many as d's

@@ -2,9 +2,12 @@
 // tests, and images that are bitwise the same with skipping on and off.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "TestScenes.h"
 #include "core/grid/ProceduralField.h"
@@ -154,32 +157,47 @@ TEST(MacrocellGrid, RangesByHand) {
     }
 }
 
+// The macrocell grid of an n^3 volume of `values` (spacing 1, trilinear) classified by the ramp
+// opacity 0 up to 0.5, rising to 1 at 1: a voxel of 0 is transparent, one of 1 is not.
+template <typename Check>
+void with_ramp_grid(std::int64_t n, std::vector<double> values, Check&& check) {
+    FieldSpec f;
+    f.kind = FieldSpec::Kind::Cells;
+    f.dims = {n, n, n};
+    f.values = std::move(values);
+    const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
+    TransferSpec ts;
+    ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
+    const TransferFunction tf(ts, v);
+    const VolumeSampler sampler(v, Interpolation::Trilinear);
+    const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
+    check(g);
+}
+
+// Calls f(m, d) for every macrocell m of g, a 5^3 grid, d the Chebyshev distance from m to (2, 2, 2).
+template <typename F>
+void each_around_the_centre(const MacrocellGrid& g, F&& f) {
+    ASSERT_EQ(g.counts(), (MacrocellGrid::Index{5, 5, 5}));
+    for (std::int64_t k = 0; k < 5; ++k)
+        for (std::int64_t j = 0; j < 5; ++j)
+            for (std::int64_t i = 0; i < 5; ++i)
+                f(MacrocellGrid::Index{i, j, k}, std::max({std::abs(i - 2), std::abs(j - 2), std::abs(k - 2)}));
+}
+
 // empty_radius by hand: one non-zero voxel at (20, 20, 20) of a 41^3 volume of zeros (40 cells per axis,
 // 5 macrocells of 8): only macrocell (2, 2, 2) reads it (cells 16..23 read voxels 16..24), so every
 // other macrocell's radius is its Chebyshev distance max_a |m_a - 2| to it; with no non-zero voxel,
 // every radius is the cap.
 TEST(MacrocellGrid, EmptyRadiusIsTheChebyshevDistanceToTheNearestNonEmptyMacrocell) {
     for (const bool spike : {true, false}) {
-        FieldSpec f;
-        f.kind = FieldSpec::Kind::Cells;
-        f.dims = {41, 41, 41};
-        f.values.assign(41 * 41 * 41, 0.0);
-        if (spike) f.values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
-        const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
-        TransferSpec ts;
-        ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
-        const TransferFunction tf(ts, v);
-        const VolumeSampler sampler(v, Interpolation::Trilinear);
-        const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
-        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{5, 5, 5}));
-        for (std::int64_t k = 0; k < 5; ++k)
-            for (std::int64_t j = 0; j < 5; ++j)
-                for (std::int64_t i = 0; i < 5; ++i) {
-                    const std::int64_t d = std::max({std::abs(i - 2), std::abs(j - 2), std::abs(k - 2)});
-                    const std::int64_t want = spike ? d : MacrocellGrid::kMaxEmptyRadius;
-                    EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
-                    EXPECT_EQ(g.empty({i, j, k}), !spike || d > 0);
-                }
+        std::vector<double> values(41 * 41 * 41, 0.0);
+        if (spike) values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
+        with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
+            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) {
+                EXPECT_EQ(g.empty_radius(m), spike ? d : MacrocellGrid::kMaxEmptyRadius) << m[0] << "," << m[1] << "," << m[2];
+                EXPECT_EQ(g.empty(m), !spike || d > 0);
+            });
+        });
     }
 }
 
@@ -187,45 +205,36 @@ TEST(MacrocellGrid, EmptyRadiusIsTheChebyshevDistanceToTheNearestNonEmptyMacroce
 // macrocells per axis), spikes at fixed pseudo-random voxels, the radius of each empty macrocell the
 // smallest Chebyshev distance to a macrocell the grid says is not empty.
 TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
-    FieldSpec f;
-    f.kind = FieldSpec::Kind::Cells;
-    f.dims = {57, 57, 57};
-    f.values.assign(57 * 57 * 57, 0.0);
+    std::vector<double> values(57 * 57 * 57, 0.0);
     std::uint32_t x = 12345;
     for (int k = 0; k < 5; ++k) {
         x = x * 1664525u + 1013904223u;
-        f.values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
+        values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
     }
-    const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
-    TransferSpec ts;
-    ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
-    const TransferFunction tf(ts, v);
-    const VolumeSampler sampler(v, Interpolation::Trilinear);
-    const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
-    const auto n = g.counts();
-    ASSERT_EQ(n, (MacrocellGrid::Index{7, 7, 7}));
-    int non_empty = 0;
-    for (std::int64_t k = 0; k < 7; ++k)
-        for (std::int64_t j = 0; j < 7; ++j)
-            for (std::int64_t i = 0; i < 7; ++i) {
-                std::int64_t want = MacrocellGrid::kMaxEmptyRadius;
-                for (std::int64_t c = 0; c < 7; ++c)
-                    for (std::int64_t b = 0; b < 7; ++b)
-                        for (std::int64_t a = 0; a < 7; ++a)
-                            if (!g.empty({a, b, c}))
-                                want = std::min(want, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
-                non_empty += want == 0;
-                EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
-                // solid_radii: the smallest Chebyshev distance to an empty macrocell.
-                std::int64_t solid = MacrocellGrid::kMaxEmptyRadius;
-                for (std::int64_t c = 0; c < 7; ++c)
-                    for (std::int64_t b = 0; b < 7; ++b)
-                        for (std::int64_t a = 0; a < 7; ++a)
-                            if (g.empty({a, b, c}))
-                                solid = std::min(solid, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
-                EXPECT_EQ(g.solid_radii()[std::size_t(i + 7 * (j + 7 * k))], solid) << i << "," << j << "," << k;
-            }
-    EXPECT_GE(non_empty, 5);
+    with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
+        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
+        // The smallest Chebyshev distance from (i, j, k) to a macrocell whose emptiness is `empty`.
+        auto nearest = [&](std::int64_t i, std::int64_t j, std::int64_t k, bool empty) {
+            std::int64_t d = MacrocellGrid::kMaxEmptyRadius;
+            for (std::int64_t c = 0; c < 7; ++c)
+                for (std::int64_t b = 0; b < 7; ++b)
+                    for (std::int64_t a = 0; a < 7; ++a)
+                        if (g.empty({a, b, c}) == empty)
+                            d = std::min(d, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
+            return d;
+        };
+        int non_empty = 0;
+        for (std::int64_t k = 0; k < 7; ++k)
+            for (std::int64_t j = 0; j < 7; ++j)
+                for (std::int64_t i = 0; i < 7; ++i) {
+                    const std::int64_t want = nearest(i, j, k, false);
+                    non_empty += want == 0;
+                    EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
+                    // solid_radii: the smallest Chebyshev distance to an empty macrocell.
+                    EXPECT_EQ(g.solid_radii()[std::size_t(i + 7 * (j + 7 * k))], nearest(i, j, k, true)) << i << "," << j << "," << k;
+                }
+        EXPECT_GE(non_empty, 5);
+    });
 }
 
 // solid_radii by hand, the complement of the test above: a 41^3 volume of ones whose voxels 16..24 per
@@ -234,29 +243,18 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
 // without the hole every solid radius is the cap.
 TEST(MacrocellGrid, SolidRadiusIsTheChebyshevDistanceToTheNearestEmptyMacrocell) {
     for (const bool hole : {true, false}) {
-        FieldSpec f;
-        f.kind = FieldSpec::Kind::Cells;
-        f.dims = {41, 41, 41};
-        f.values.assign(41 * 41 * 41, 1.0);
+        std::vector<double> values(41 * 41 * 41, 1.0);
         if (hole)
             for (int k = 16; k <= 24; ++k)
                 for (int j = 16; j <= 24; ++j)
-                    for (int i = 16; i <= 24; ++i) f.values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
-        const Volume v = make_procedural_volume(f, glm::dvec3(0.0), glm::dvec3(1.0));
-        TransferSpec ts;
-        ts.opacity = {{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}};
-        const TransferFunction tf(ts, v);
-        const VolumeSampler sampler(v, Interpolation::Trilinear);
-        const MacrocellGrid g(sampler, tf, MacrocellGrid::Classification::Post);
-        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{5, 5, 5}));
-        for (std::int64_t k = 0; k < 5; ++k)
-            for (std::int64_t j = 0; j < 5; ++j)
-                for (std::int64_t i = 0; i < 5; ++i) {
-                    const std::int64_t d = std::max({std::abs(i - 2), std::abs(j - 2), std::abs(k - 2)});
-                    const std::int64_t want = hole ? d : MacrocellGrid::kMaxEmptyRadius;
-                    EXPECT_EQ(g.solid_radii()[std::size_t(i + 5 * (j + 5 * k))], want) << i << "," << j << "," << k;
-                    EXPECT_EQ(g.empty({i, j, k}), hole && d == 0);
-                }
+                    for (int i = 16; i <= 24; ++i) values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
+        with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
+            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) {
+                EXPECT_EQ(g.solid_radii()[std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], hole ? d : MacrocellGrid::kMaxEmptyRadius)
+                    << m[0] << "," << m[1] << "," << m[2];
+                EXPECT_EQ(g.empty(m), hole && d == 0);
+            });
+        });
     }
 }
 
@@ -877,8 +875,9 @@ TEST(EmptySpace, WalkVisitsEveryNonEmptySegmentAndRunsMatchSegments) {
             for (std::int64_t k = r.k; k < r.end; ++k) by_run.push_back(segment(*r.iv, step, k, r.n));
         }
         ASSERT_EQ(by_run.size(), by_segment.size()) << "ray " << n;
-        if (!by_run.empty())  // (memcmp of empty vectors would pass null pointers)
+        if (!by_run.empty()) {  // (memcmp of empty vectors would pass null pointers)
             EXPECT_EQ(std::memcmp(by_run.data(), by_segment.data(), by_run.size() * sizeof(Segment)), 0) << "ray " << n;
+        }
     }
     EXPECT_GT(all, 10000);
     EXPECT_LT(visited, all);  // something was passed over
@@ -935,7 +934,9 @@ TEST(ExtremumSkipping, WalkFindsTheSameExtremumWithFewerSamples) {
         EXPECT_LT(visited, all) << (maximum ? "max" : "min");
         std::printf("%s: visited %lld of %lld segments\n", maximum ? "mip" : "minip", (long long)visited, (long long)all);
         EXPECT_LT(visited, all) << "some segments skipped";
-        if (!maximum) EXPECT_LT(10 * visited, 6 * all) << "minip: most of each chord skipped";
+        if (!maximum) {
+            EXPECT_LT(10 * visited, 6 * all) << "minip: most of each chord skipped";
+        }
     }
 }
 

@@ -298,9 +298,6 @@ struct RayPacketT {
     }
 
 private:
-    // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
-    // past the samples that stay in its empty box, placing its new segment on the vectors (place(), as
-    // next() does; a lane at the end of its run takes no sample this step). True when a lane was moved.
     // Whether a live lane is due for skip_empty's check (its t at or past recheck_): inline, so that a
     // step where none is costs no call.
     HWY_INLINE bool any_due() const {
@@ -311,6 +308,9 @@ private:
                 return true;
         return false;
     }
+    // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
+    // past the samples that stay in its empty box, placing its new segment on the vectors (place(), as
+    // next() does; a lane at the end of its run takes no sample this step). True when a lane was moved.
     bool skip_empty() {
         const hn::ScalableTag<T> d;
         const hn::Rebind<std::int32_t, decltype(d)> di;  // int32 lanes, as many as d's

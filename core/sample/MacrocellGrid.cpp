@@ -94,43 +94,39 @@ MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& cla
             return count;
         },
         [](std::int64_t a, std::int64_t b) { return a + b; });
-    compute_empty_radius();
+    empty_radius_ = chebyshev_radii(false);
 }
 
-void MacrocellGrid::compute_empty_radius() {
-    // Chebyshev distance to the nearest macrocell that is not empty (empty_radius) and to the nearest
-    // that is (solid_radius), by the two-pass chamfer transform with unit weights on all 26 neighbours
-    // (exact for this metric): a raster pass taking min(d, d(neighbour) + 1) over the 13 neighbours
-    // already visited, then the reverse pass over the other 13. Linear in the number of macrocells.
+std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii(bool to_empty) const {
+    // Chebyshev distance to the nearest macrocell whose emptiness is `to_empty`, by the two-pass
+    // chamfer transform with unit weights on all 26 neighbours (exact for this metric): a raster pass
+    // taking min(d, d(neighbour) + 1) over the 13 neighbours already visited, then the reverse pass over
+    // the other 13. Linear in the number of macrocells.
     const std::size_t total = empty_.size();
     constexpr std::int64_t far = kMaxEmptyRadius;
-    auto distance_to = [&](bool to_empty) {
-        std::vector<std::int64_t> d(total);
-        for (std::size_t i = 0; i < total; ++i) d[i] = (empty_[i] != 0) == to_empty ? 0 : far;
-        auto pass = [&](int sign) {
-            for (std::size_t n = 0; n < total; ++n) {
-                const std::int64_t s = std::int64_t(sign > 0 ? n : total - 1 - n);
-                const Index m{s % counts_[0], (s / counts_[0]) % counts_[1], s / (counts_[0] * counts_[1])};
-                std::int64_t& here = d[std::size_t(s)];
-                for (int dz = -1; dz <= 1; ++dz)
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dx = -1; dx <= 1; ++dx) {
-                            // the neighbours before m in this pass's order (linear index smaller, or larger)
-                            const std::int64_t offset = dx + counts_[0] * (dy + counts_[1] * dz);
-                            if (sign * offset >= 0 || (dx == 0 && dy == 0 && dz == 0)) continue;
-                            const Index q{m[0] + dx, m[1] + dy, m[2] + dz};
-                            if (inside(q)) here = std::min(here, d[linear(q)] + 1);
-                        }
-            }
-        };
-        pass(+1);
-        pass(-1);
-        std::vector<std::uint8_t> out(total);
-        for (std::size_t i = 0; i < total; ++i) out[i] = std::uint8_t(std::min(d[i], far));
-        return out;
+    std::vector<std::int64_t> d(total);
+    for (std::size_t i = 0; i < total; ++i) d[i] = (empty_[i] != 0) == to_empty ? 0 : far;
+    auto pass = [&](int sign) {
+        for (std::size_t n = 0; n < total; ++n) {
+            const std::int64_t s = std::int64_t(sign > 0 ? n : total - 1 - n);
+            const Index m{s % counts_[0], (s / counts_[0]) % counts_[1], s / (counts_[0] * counts_[1])};
+            std::int64_t& here = d[std::size_t(s)];
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        // the neighbours before m in this pass's order (linear index smaller, or larger)
+                        const std::int64_t offset = dx + counts_[0] * (dy + counts_[1] * dz);
+                        if (sign * offset >= 0 || (dx == 0 && dy == 0 && dz == 0)) continue;
+                        const Index q{m[0] + dx, m[1] + dy, m[2] + dz};
+                        if (inside(q)) here = std::min(here, d[linear(q)] + 1);
+                    }
+        }
     };
-    empty_radius_ = distance_to(false);
-    solid_radius_ = distance_to(true);
+    pass(+1);
+    pass(-1);
+    std::vector<std::uint8_t> out(total);
+    for (std::size_t i = 0; i < total; ++i) out[i] = std::uint8_t(std::min(d[i], far));
+    return out;
 }
 
 void MacrocellGrid::voxel_box(const Index& m, Index& first, Index& last) const {

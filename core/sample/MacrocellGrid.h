@@ -74,10 +74,11 @@ public:
     static constexpr std::int64_t kMaxEmptyRadius = 255;
     // Every macrocell's empty_radius, at m0 + counts0 (m1 + counts1 m2) (the fast profile's packets).
     const std::vector<std::uint8_t>& empty_radii() const { return empty_radius_; }
-    // The same for the other kind: 0 for an empty macrocell; r >= 1 for a non-empty one when every
-    // macrocell within r - 1 of it (per axis) is non-empty, capped at kMaxEmptyRadius (also when none is
-    // empty). A packet's lane in such a box needs no check for empty space before it leaves the box.
-    const std::vector<std::uint8_t>& solid_radii() const { return solid_radius_; }
+    // The same for the other kind, computed on each call (only the composite packets read it, once): 0
+    // for an empty macrocell; r >= 1 for a non-empty one when every macrocell within r - 1 of it (per
+    // axis) is non-empty, capped at kMaxEmptyRadius (also when none is empty). A packet's lane in such
+    // a box needs no check for empty space before it leaves the box.
+    std::vector<std::uint8_t> solid_radii() const { return chebyshev_radii(true); }
     // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
     // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
     // integrator checks it against macrocell_at. exit_distance with r > 1: where the ray leaves the box
@@ -112,10 +113,10 @@ private:
     Index cells_{1, 1, 1};
     std::int64_t apron_ = 0;
     std::vector<std::array<double, 2>> ranges_;
-    void compute_empty_radius();
+    // Per macrocell, the Chebyshev distance to the nearest macrocell that is empty (to_empty) or not.
+    std::vector<std::uint8_t> chebyshev_radii(bool to_empty) const;
     std::vector<unsigned char> empty_;
     std::vector<std::uint8_t> empty_radius_;  // empty_radius(m)
-    std::vector<std::uint8_t> solid_radius_;  // solid_radii()
     std::int64_t empty_count_ = 0;
 };
 

@@ -223,6 +223,7 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
                             d = std::min(d, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
             return d;
         };
+        const std::vector<std::uint8_t> solid = g.solid_radii();
         int non_empty = 0;
         for (std::int64_t k = 0; k < 7; ++k)
             for (std::int64_t j = 0; j < 7; ++j)
@@ -231,7 +232,7 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
                     non_empty += want == 0;
                     EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
                     // solid_radii: the smallest Chebyshev distance to an empty macrocell.
-                    EXPECT_EQ(g.solid_radii()[std::size_t(i + 7 * (j + 7 * k))], nearest(i, j, k, true)) << i << "," << j << "," << k;
+                    EXPECT_EQ(solid[std::size_t(i + 7 * (j + 7 * k))], nearest(i, j, k, true)) << i << "," << j << "," << k;
                 }
         EXPECT_GE(non_empty, 5);
     });
@@ -249,8 +250,9 @@ TEST(MacrocellGrid, SolidRadiusIsTheChebyshevDistanceToTheNearestEmptyMacrocell)
                 for (int j = 16; j <= 24; ++j)
                     for (int i = 16; i <= 24; ++i) values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
         with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
+            const std::vector<std::uint8_t> solid = g.solid_radii();
             each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) {
-                EXPECT_EQ(g.solid_radii()[std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], hole ? d : MacrocellGrid::kMaxEmptyRadius)
+                EXPECT_EQ(solid[std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], hole ? d : MacrocellGrid::kMaxEmptyRadius)
                     << m[0] << "," << m[1] << "," << m[2];
                 EXPECT_EQ(g.empty(m), hole && d == 0);
             });

@@ -105,7 +105,7 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
         // Per macrocell: empty_radius where it is empty, minus solid_radius where it is not.
         const auto& empty = in.macrocells->empty_radii();
-        const auto& solid = in.macrocells->solid_radii();
+        const std::vector<std::uint8_t> solid = in.macrocells->solid_radii();
         skip_radius_.resize(empty.size());
         for (std::size_t i = 0; i < empty.size(); ++i) skip_radius_[i] = empty[i] > 0 ? std::int32_t(empty[i]) : -std::int32_t(solid[i]);
         in.skip_radius = skip_radius_.data();

@@ -298,14 +298,16 @@ struct RayPacketT {
     }
 
 private:
-    // Whether a live lane is due for skip_empty's check (its t at or past recheck_): inline, so that a
-    // step where none is costs no call.
+    // The live lanes of [i, i + lanes of T) due for skip_empty's check: their t at or past recheck_.
+    HWY_INLINE hn::Mask<hn::ScalableTag<T>> due(std::size_t i) const {
+        const hn::ScalableTag<T> d;
+        return hn::And(hn::Gt(hn::Load(d, live + i), hn::Zero(d)), hn::Ge(hn::Load(d, tm + i), hn::Load(d, recheck_ + i)));
+    }
+    // Whether any lane is due: inline, so that a step where none is costs no call.
     HWY_INLINE bool any_due() const {
         const hn::ScalableTag<T> d;
-        const auto zero = hn::Zero(d);
         for (std::size_t i = 0; i < lanes; i += hn::Lanes(d))
-            if (!hn::AllFalse(d, hn::And(hn::Gt(hn::Load(d, live + i), zero), hn::Ge(hn::Load(d, tm + i), hn::Load(d, recheck_ + i)))))
-                return true;
+            if (!hn::AllFalse(d, due(i))) return true;
         return false;
     }
     // VectorSkip (the comment above RayPacketT): moves each lane whose sample lies in an empty macrocell
@@ -325,7 +327,7 @@ private:
         for (std::size_t i = 0; i < lanes; i += nf) {
             const auto t = hn::Load(d, tm + i);
             // A lane found in a non-empty macrocell is not checked again before it can have left it.
-            if (hn::AllFalse(d, hn::And(hn::Gt(hn::Load(d, live + i), zero), hn::Ge(t, hn::Load(d, recheck_ + i))))) continue;
+            if (hn::AllFalse(d, due(i))) continue;
             const auto P0 = hn::Add(hn::Load(d, ox + i), hn::Mul(t, hn::Load(d, dx + i)));
             const auto P1 = hn::Add(hn::Load(d, oy + i), hn::Mul(t, hn::Load(d, dy + i)));
             const auto P2 = hn::Add(hn::Load(d, oz + i), hn::Mul(t, hn::Load(d, dz + i)));

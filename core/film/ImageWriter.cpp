@@ -9,9 +9,8 @@
 #include <cstdint>
 #include <system_error>
 
-#include <OpenImageIO/imageio.h>
-
 #include "core/Error.h"
+#include "core/film/ImageFileModule.h"
 #include "core/io/OutputFile.h"
 
 namespace volref {
@@ -54,6 +53,7 @@ std::vector<T> quantised_over_background(const Image& image, const glm::dvec4& b
 void check_output_path(const fs::path& path) {
     format_of(path);
     check_output_folder(path);
+    image_files::require(path.string());  // before a render, not after it
 }
 
 void write_image(const Image& image, const fs::path& path, const glm::dvec4& background) {
@@ -61,45 +61,48 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
     const Format format = format_of(path);
     const fs::path tmp = temporary_output_path(path);
 
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) throw Error(path.string() + ": cannot create an image writer: " + OIIO::geterror());
-    OIIO::ImageSpec spec;
+    image_files::WriteRequest rq;
+    const std::string tmp_name = tmp.string();
+    rq.path = tmp_name.c_str();
+    rq.width = image.width;
+    rq.height = image.height;
+    rq.alpha_channel = 3;
+    std::vector<const char*> names;
     std::vector<float> floats;
     std::vector<std::uint8_t> bytes;
     std::vector<std::uint16_t> words;
-    const void* data = nullptr;
     if (format == Format::Exr) {
-        spec = OIIO::ImageSpec(image.width, image.height, int(image.channel_count()), OIIO::TypeDesc::FLOAT);
-        spec.channelnames = image.channels;
-        spec.alpha_channel = 3;
-        for (std::size_t c = 0; c < image.channels.size(); ++c)
-            if (image.channels[c] == "Z") spec.z_channel = int(c);
-        spec.attribute("compression", "zip");
+        rq.channels = int(image.channel_count());
+        for (std::size_t c = 0; c < image.channels.size(); ++c) {
+            names.push_back(image.channels[c].c_str());
+            if (image.channels[c] == "Z") rq.z_channel = int(c);
+        }
+        rq.kind = image_files::SampleKind::Float32;
+        rq.compression = "zip";
         floats.assign(image.pixels.begin(), image.pixels.end());
-        data = floats.data();
+        rq.pixels = floats.data();
     } else {
         const bool png = format == Format::Png;
-        spec = OIIO::ImageSpec(image.width, image.height, 4, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
-        spec.channelnames = {"R", "G", "B", "A"};
-        spec.alpha_channel = 3;
-        spec.attribute("oiio:UnassociatedAlpha", 1);
+        rq.channels = 4;
+        names = {"R", "G", "B", "A"};
+        rq.unassociated_alpha = 1;
+        rq.kind = png ? image_files::SampleKind::UInt8 : image_files::SampleKind::UInt16;
         if (png) {
             bytes = quantised_over_background<std::uint8_t>(image, background);
-            data = bytes.data();
+            rq.pixels = bytes.data();
         } else {
             words = quantised_over_background<std::uint16_t>(image, background);
-            data = words.data();
+            rq.pixels = words.data();
         }
     }
-    // No clock in the file: OpenImageIO writes the current time (EXR capDate, TIFF DateTime) unless
-    // DateTime is set, so two renders of one scene would differ in their bytes (issue 18). The same
-    // render gives the same file on every run and at any thread count.
-    spec.attribute("DateTime", "");
-    std::error_code ec;
-    if (!out->open(tmp.string(), spec) || !out->write_image(spec.format, data) || !out->close()) {
-        const std::string why = out->geterror();
+    rq.channel_names = names.data();
+    // (The module writes no clock into the file: the same render gives the same bytes, issue 18.)
+    try {
+        image_files::write(rq, path.string());
+    } catch (...) {
+        std::error_code ec;
         fs::remove(tmp, ec);
-        throw Error(path.string() + ": cannot write the image: " + why);
+        throw;
     }
     commit_output(tmp, path);
 }

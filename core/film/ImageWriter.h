@@ -1,4 +1,4 @@
-// Writing images through OpenImageIO (conventions section 10), by the output's extension:
+// Writing images through OpenImageIO (conventions section 10; the plugin of ImageFiles.h), by the output's extension:
 //   .exr          linear float, premultiplied RGBA plus the extra channels (Z, ...)
 //   .png          8-bit RGBA, .tif/.tiff 16-bit RGBA: the image composited over the background
 //                 (premultiplied: C' = C + (1 - A) bg_a bg_rgb, A' = A + (1 - A) bg_a), stored as
@@ -16,7 +16,8 @@
 
 namespace volref {
 
-// Throws Error unless `path` has a supported extension and its folder exists and is writable.
+// Throws Error unless `path` has a supported extension, its folder exists and is writable, and the
+// image-file plugin loads (ImageFileModule.h).
 // Called before rendering so that a bad output path fails fast.
 void check_output_path(const std::filesystem::path& path);
 

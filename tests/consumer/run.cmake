@@ -1,5 +1,7 @@
 # ctest: install the built volref into a scratch prefix, then configure, build and run the consumer,
-# which links volref::volref_core alone: it must load none of the tools' libraries.
+# which links volref::volref_core alone: it must load none of the tools' libraries. Then the installed
+# `volref` writes an image: it starts without OpenImageIO's libraries (ldd) and loads the installed
+# image-file plugin (libvolref_image_files.so, beside libvolref_tools) to write a PNG.
 #   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -P run.cmake
 file(REMOVE_RECURSE ${WORK_DIR})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix
@@ -33,4 +35,18 @@ if(LDD)
   if(NOT libs MATCHES "libvolref_core\\.so")
     message(FATAL_ERROR "the consumer does not load libvolref_core.so:\n${libs}")
   endif()
+endif()
+
+set(cli ${WORK_DIR}/prefix/bin/volref)
+if(LDD)
+  execute_process(COMMAND ${LDD} ${cli} OUTPUT_VARIABLE libs RESULT_VARIABLE rc)
+  string(REGEX MATCHALL "[^\n]*(OpenImageIO|OpenEXR)[^\n]*" bad "${libs}")
+  if(rc OR bad OR NOT libs MATCHES "libvolref_tools\\.so")
+    message(FATAL_ERROR "the installed volref should link libvolref_tools and load OpenImageIO only when it writes an image: ${libs}")
+  endif()
+endif()
+execute_process(COMMAND ${cli} render ${SOURCE_DIR}/reference_scenes/default.json --set image.width=8 --set image.height=8
+  -o ${WORK_DIR}/out.png RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc OR NOT EXISTS ${WORK_DIR}/out.png)
+  message(FATAL_ERROR "the installed volref did not write a PNG (${rc}): ${err}")
 endif()

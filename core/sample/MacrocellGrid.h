@@ -79,6 +79,14 @@ public:
     // axis) is non-empty, capped at kMaxEmptyRadius (also when none is empty). A packet's lane in such
     // a box needs no check for empty space before it leaves the box.
     std::vector<std::uint8_t> solid_radii() const { return chebyshev_radii(true); }
+    // The empty distance ahead, per octant of ray directions (only the composite packets read it,
+    // once): for octant o = (s0 < 0) + 2 (s1 < 0) + 4 (s2 < 0) (s: the direction's sign per axis, + for
+    // 0), entry o * count + linear(m) is the largest r such that every macrocell m + (i s0, j s1, k s2),
+    // 0 <= i, j, k < r, is empty (a cube with its corner at m, ahead of a ray in that octant): 0 for a
+    // non-empty m, capped at kMaxEmptyRadius; a cube may reach beyond the grid (as empty_radius' box).
+    // By the recurrence r(m) = 1 + min of r over m's 7 neighbours ahead (m + (a s0, b s1, c s2), a, b, c
+    // in {0, 1}, not all 0; kMaxEmptyRadius outside the grid). Always >= empty_radius(m).
+    std::vector<std::uint8_t> octant_empty_radii() const;
     // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
     // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
     // integrator checks it against macrocell_at. exit_distance with r > 1: where the ray leaves the box

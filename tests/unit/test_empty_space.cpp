@@ -238,6 +238,74 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
     });
 }
 
+// octant_empty_radii by hand, on the spike of EmptyRadiusIs...: for octant o (signs s per axis) the cube
+// ahead of m, m + (i s0, j s1, k s2) for 0 <= i, j, k < r, reaches the one non-empty macrocell (2, 2, 2)
+// only if every e_a = s_a (2 - m_a) >= 0, and then first at r = max_a e_a + 1: so the distance ahead is
+// max_a e_a (0 at the spike itself), and the cap where some e_a < 0 (the spike lies behind on that axis).
+TEST(MacrocellGrid, OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell) {
+    std::vector<double> values(41 * 41 * 41, 0.0);
+    values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
+    with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
+        const std::vector<std::uint8_t> ahead = g.octant_empty_radii();
+        ASSERT_EQ(ahead.size(), 8u * 125u);
+        for (int o = 0; o < 8; ++o) {
+            const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
+            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t) {
+                std::int64_t want = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const std::int64_t e = s[a] * (2 - m[a]);
+                    want = e < 0 || want == MacrocellGrid::kMaxEmptyRadius ? MacrocellGrid::kMaxEmptyRadius : std::max(want, e);
+                }
+                EXPECT_EQ(ahead[std::size_t(o) * 125 + std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], want)
+                    << "octant " << o << " at " << m[0] << "," << m[1] << "," << m[2];
+            });
+        }
+    });
+}
+
+// The same against brute force on the scattered spikes of EmptyRadiusMatchesBruteForce: the largest r
+// (up to the grid's 7, then the cap) whose cube ahead holds no macrocell of the grid that is not empty;
+// and never below empty_radius (the symmetric box holds the cube ahead of that size).
+TEST(MacrocellGrid, OctantEmptyRadiusMatchesBruteForce) {
+    std::vector<double> values(57 * 57 * 57, 0.0);
+    std::uint32_t x = 777;
+    for (int k = 0; k < 9; ++k) {
+        x = x * 1664525u + 1013904223u;
+        values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
+    }
+    with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
+        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
+        const std::vector<std::uint8_t> ahead = g.octant_empty_radii();
+        int capped = 0, finite = 0;
+        for (int o = 0; o < 8; ++o) {
+            const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
+            for (std::int64_t k = 0; k < 7; ++k)
+                for (std::int64_t j = 0; j < 7; ++j)
+                    for (std::int64_t i = 0; i < 7; ++i) {
+                        auto cube_empty = [&](std::int64_t r) {
+                            for (std::int64_t c = 0; c < r; ++c)
+                                for (std::int64_t b = 0; b < r; ++b)
+                                    for (std::int64_t a = 0; a < r; ++a) {
+                                        const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
+                                        const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
+                                        if (in && !g.empty(q)) return false;
+                                    }
+                            return true;
+                        };
+                        std::int64_t want = 0;
+                        while (want < 7 && cube_empty(want + 1)) ++want;
+                        if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
+                        (want == MacrocellGrid::kMaxEmptyRadius ? capped : finite) += 1;
+                        const std::int64_t got = ahead[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
+                        EXPECT_EQ(got, want) << "octant " << o << " at " << i << "," << j << "," << k;
+                        EXPECT_GE(got, g.empty_radius({i, j, k}));
+                    }
+        }
+        EXPECT_GT(capped, 100);
+        EXPECT_GT(finite, 500);
+    });
+}
+
 // solid_radii by hand, the complement of the test above: a 41^3 volume of ones whose voxels 16..24 per
 // axis (exactly those macrocell (2, 2, 2) reads) are 0, so (2, 2, 2) is the one empty macrocell (its
 // neighbours also read ones); every other macrocell's solid radius is its Chebyshev distance to it, and

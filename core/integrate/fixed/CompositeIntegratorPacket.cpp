@@ -103,11 +103,14 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     in.termination = early_termination(ctx.render);
     in.macrocells = ctx.macrocells;
     if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
-        // Per macrocell: empty_radius where it is empty, minus solid_radius where it is not.
-        const auto& empty = in.macrocells->empty_radii();
+        // Per octant of directions and macrocell: the empty distance ahead where it is empty, minus
+        // solid_radius where it is not (8 copies of the grid, octant o at o * count).
+        const std::vector<std::uint8_t> ahead = in.macrocells->octant_empty_radii();
         const std::vector<std::uint8_t> solid = in.macrocells->solid_radii();
-        skip_radius_.resize(empty.size());
-        for (std::size_t i = 0; i < empty.size(); ++i) skip_radius_[i] = empty[i] > 0 ? std::int32_t(empty[i]) : -std::int32_t(solid[i]);
+        const std::size_t count = solid.size();
+        skip_radius_.resize(ahead.size());
+        for (std::size_t i = 0; i < ahead.size(); ++i)
+            skip_radius_[i] = ahead[i] > 0 ? std::int32_t(ahead[i]) : -std::int32_t(solid[i % count]);
         in.skip_radius = skip_radius_.data();
     }
     if (fast) {

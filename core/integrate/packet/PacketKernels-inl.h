@@ -95,7 +95,9 @@ struct SimdLanes {
 // Empty-space skipping of the composite packets, decided for all lanes at once (issue 31, part 1):
 // what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
-    const std::int32_t* radius = nullptr;  // per macrocell: empty_radius if empty, else -solid_radius (CompositeIntegrator's copy)
+    // Per octant o of ray directions and macrocell m, at o * (macrocells) + linear(m): the empty distance
+    // ahead (MacrocellGrid::octant_empty_radii) if m is empty, else -solid_radius (CompositeIntegrator's copy).
+    const std::int32_t* radius = nullptr;
     std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
     std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
     double origin[3] = {0, 0, 0};          // the lanes' positions' origin of the grid (0: float lanes' local coordinates)
@@ -111,10 +113,12 @@ struct VectorSkip {
 // lane's segment k is placed, its position p = o + t d in T (the kernel's own arithmetic) gives the
 // cell the kernel's trilinear read uses, cell = min(floor(clamp((p - origin) / s, 0, n - 1)), n - 2),
 // (origin: the grid's on double lanes, 0 on float lanes, whose positions are local), and its macrocell
-// m = cell / M (M = kMacrocellSize, 8); where empty_radius(m) = r >= 1, every macrocell within r - 1 of
-// m is empty, and the ray stays in that box B for dt = the distance to B's exit face along the ray
-// (index space: B spans cells [(m - r + 1) M, (m + r) M) per axis), less 0.01 cell and, for pre-integrated segments,
-// less h / 2. The lane then moves on to the first segment whose midpoint lies at or after t + dt:
+// m = cell / M (M = kMacrocellSize, 8); where the empty distance ahead of m for the lane's octant o of
+// directions is r >= 1 (MacrocellGrid::octant_empty_radii: the macrocells m + (i s0, j s1, k s2),
+// 0 <= i, j, k < r, s the direction's signs, are all empty), the ray stays in that cube B for dt = the
+// distance to B's exit face along the ray (index space, per axis: B spans cells [m M, (m + r) M) where
+// the ray moves up (or not at all), [(m - r + 1) M, (m + 1) M) where it moves down), less 0.01 cell
+// and, for pre-integrated segments, less h / 2. The lane then moves on to the first segment whose midpoint lies at or after t + dt:
 // every segment passed over samples inside B (positions within dt of p), so it reads voxels of
 // empty macrocells only and its opacity is 0 exactly; the image is the image without skipping. The
 // lane's new segment is placed in the same step (and checked again), replacing the empty sample; with
@@ -195,10 +199,14 @@ struct RayPacketT {
             }
             // Per lane: index units per unit of t along each axis (rounded from double), then on the
             // vectors (the same correctly rounded divisions) 1 / |rate| and the margin.
+            const std::int64_t macrocells = vskip_->counts[0] * vskip_->counts[1] * vskip_->counts[2];
             for (std::size_t l = 0; l < lanes; ++l) {
                 rate_[0][l] = T(double(dx[l]) * vskip_->inv_spacing[0]);
                 rate_[1][l] = T(double(dy[l]) * vskip_->inv_spacing[1]);
                 rate_[2][l] = T(double(dz[l]) * vskip_->inv_spacing[2]);
+                // The lane's octant of directions (VectorSkip::radius): its radii's offset.
+                const int octant = (rate_[0][l] < T(0) ? 1 : 0) + (rate_[1][l] < T(0) ? 2 : 0) + (rate_[2][l] < T(0) ? 4 : 0);
+                octant_offset_[l] = std::int32_t(octant * macrocells);
             }
             const hn::ScalableTag<T> d;
             const auto zero = hn::Zero(d), one = hn::Set(d, T(1)), inf = hn::Set(d, std::numeric_limits<T>::infinity());
@@ -348,7 +356,8 @@ private:
                 hn::Store(hn::Set(d, -std::numeric_limits<T>::infinity()), d, recheck_ + i);
                 continue;
             }
-            const auto idx = hn::Add(mc[0], hn::Mul(hn::Set(di, skip_counts_[0]), hn::Add(mc[1], hn::Mul(hn::Set(di, skip_counts_[1]), mc[2]))));
+            const auto idx = hn::Add(hn::Load(di, octant_offset_ + i),
+                                     hn::Add(mc[0], hn::Mul(hn::Set(di, skip_counts_[0]), hn::Add(mc[1], hn::Mul(hn::Set(di, skip_counts_[1]), mc[2])))));
             hn::Mask<decltype(di)> inside32;  // `inside` on the int32 lanes
             if constexpr (std::is_same_v<T, float>) inside32 = hn::RebindMask(di, inside);
             else inside32 = hn::Ne(hn::DemoteTo(di, hn::IfThenElseZero(inside, hn::Set(d, T(1)))), hn::Zero(di));
@@ -356,8 +365,10 @@ private:
             const auto r = hn::IfThenElseZero(inside32, hn::GatherIndex(di, s.radius, safe));
             const auto radius = to_lanes(d, r);  // exact
             const auto empty = hn::Gt(radius, zero);
-            // The exit of the box of macrocells within r - 1 of m, all empty (r = empty_radius) or all
-            // non-empty (r = solid_radius; m itself where r = 0): per axis the face ahead, in index units.
+            // The exit of the cube of empty macrocells ahead of m (r = the empty distance ahead: per axis
+            // [m, m + r) up, (m - r, m] down), or of the box of non-empty macrocells within r - 1 of m
+            // (r = solid_radius; m itself where r = 0): per axis the face ahead, in index units (the
+            // same two faces: m M + r M up, m M - (r - 1) M down).
             const auto rf = hn::Max(hn::Abs(radius), hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
             for (int a = 0; a < 3; ++a) {
@@ -422,6 +433,7 @@ private:
     HWY_ALIGN T rate_[3][kLanes] = {};
     HWY_ALIGN T inv_speed_[3][kLanes] = {};  // 1 / |rate| (+inf where the ray is parallel to the axis' planes)
     HWY_ALIGN T margin_[kLanes] = {};
+    HWY_ALIGN std::int32_t octant_offset_[kLanes] = {};  // o * (macrocells): the lane's radii (VectorSkip::radius)
     // Where each lane's next check is due (local t): the exit of the non-empty macrocell it was last
     // found in, -inf when due now (a new run, a moved lane, outside the grid).
     HWY_ALIGN T recheck_[kLanes];

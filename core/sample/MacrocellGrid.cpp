@@ -94,18 +94,18 @@ MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& cla
             return count;
         },
         [](std::int64_t a, std::int64_t b) { return a + b; });
-    empty_radius_ = chebyshev_radii(false);
+    empty_radius_ = chebyshev_radii();
 }
 
-std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii(bool to_empty) const {
-    // Chebyshev distance to the nearest macrocell whose emptiness is `to_empty`, by the two-pass
+std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii() const {
+    // Chebyshev distance to the nearest macrocell that is not empty, by the two-pass
     // chamfer transform with unit weights on all 26 neighbours (exact for this metric): a raster pass
     // taking min(d, d(neighbour) + 1) over the 13 neighbours already visited, then the reverse pass over
     // the other 13. Linear in the number of macrocells.
     const std::size_t total = empty_.size();
     constexpr std::int64_t far = kMaxEmptyRadius;
     std::vector<std::int64_t> d(total);
-    for (std::size_t i = 0; i < total; ++i) d[i] = (empty_[i] != 0) == to_empty ? 0 : far;
+    for (std::size_t i = 0; i < total; ++i) d[i] = empty_[i] != 0 ? far : 0;
     auto pass = [&](int sign) {
         for (std::size_t n = 0; n < total; ++n) {
             const std::int64_t s = std::int64_t(sign > 0 ? n : total - 1 - n);
@@ -129,7 +129,7 @@ std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii(bool to_empty) const {
     return out;
 }
 
-std::vector<std::uint8_t> MacrocellGrid::octant_empty_radii() const {
+std::vector<std::uint8_t> MacrocellGrid::octant_radii(bool of_empty) const {
     const std::size_t total = empty_.size();
     constexpr std::int64_t far = kMaxEmptyRadius;
     std::vector<std::uint8_t> out(8 * total);
@@ -145,7 +145,7 @@ std::vector<std::uint8_t> MacrocellGrid::octant_empty_radii() const {
                     m[1] = s[1] > 0 ? counts_[1] - 1 - c1 : c1;
                     m[2] = s[2] > 0 ? counts_[2] - 1 - c2 : c2;
                     const std::size_t here = linear(m);
-                    if (empty_[here] == 0) {
+                    if ((empty_[here] != 0) != of_empty) {
                         r[here] = 0;
                         continue;
                     }

@@ -213,26 +213,22 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
     }
     with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
         ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
-        // The smallest Chebyshev distance from (i, j, k) to a macrocell whose emptiness is `empty`.
-        auto nearest = [&](std::int64_t i, std::int64_t j, std::int64_t k, bool empty) {
+        // The smallest Chebyshev distance from (i, j, k) to a macrocell that is not empty.
+        auto nearest = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
             std::int64_t d = MacrocellGrid::kMaxEmptyRadius;
             for (std::int64_t c = 0; c < 7; ++c)
                 for (std::int64_t b = 0; b < 7; ++b)
                     for (std::int64_t a = 0; a < 7; ++a)
-                        if (g.empty({a, b, c}) == empty)
-                            d = std::min(d, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
+                        if (!g.empty({a, b, c})) d = std::min(d, std::max({std::abs(i - a), std::abs(j - b), std::abs(k - c)}));
             return d;
         };
-        const std::vector<std::uint8_t> solid = g.solid_radii();
         int non_empty = 0;
         for (std::int64_t k = 0; k < 7; ++k)
             for (std::int64_t j = 0; j < 7; ++j)
                 for (std::int64_t i = 0; i < 7; ++i) {
-                    const std::int64_t want = nearest(i, j, k, false);
+                    const std::int64_t want = nearest(i, j, k);
                     non_empty += want == 0;
                     EXPECT_EQ(g.empty_radius({i, j, k}), want) << i << "," << j << "," << k;
-                    // solid_radii: the smallest Chebyshev distance to an empty macrocell.
-                    EXPECT_EQ(solid[std::size_t(i + 7 * (j + 7 * k))], nearest(i, j, k, true)) << i << "," << j << "," << k;
                 }
         EXPECT_GE(non_empty, 5);
     });
@@ -242,30 +238,33 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
 // ahead of m, m + (i s0, j s1, k s2) for 0 <= i, j, k < r, reaches the one non-empty macrocell (2, 2, 2)
 // only if every e_a = s_a (2 - m_a) >= 0, and then first at r = max_a e_a + 1: so the distance ahead is
 // max_a e_a (0 at the spike itself), and the cap where some e_a < 0 (the spike lies behind on that axis).
+// Checks radii (8 octants of a 5^3 grid) against that rule, the odd macrocell (2, 2, 2) at distance 0.
+void expect_cubes_ahead_of_the_centre(const MacrocellGrid& g, const std::vector<std::uint8_t>& ahead) {
+    ASSERT_EQ(ahead.size(), 8u * 125u);
+    for (int o = 0; o < 8; ++o) {
+        const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
+        each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t) {
+            std::int64_t want = 0;
+            for (int a = 0; a < 3; ++a) {
+                const std::int64_t e = s[a] * (2 - m[a]);
+                want = e < 0 || want == MacrocellGrid::kMaxEmptyRadius ? MacrocellGrid::kMaxEmptyRadius : std::max(want, e);
+            }
+            EXPECT_EQ(ahead[std::size_t(o) * 125 + std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], want)
+                << "octant " << o << " at " << m[0] << "," << m[1] << "," << m[2];
+        });
+    }
+}
+
 TEST(MacrocellGrid, OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell) {
     std::vector<double> values(41 * 41 * 41, 0.0);
     values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
-    with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
-        const std::vector<std::uint8_t> ahead = g.octant_empty_radii();
-        ASSERT_EQ(ahead.size(), 8u * 125u);
-        for (int o = 0; o < 8; ++o) {
-            const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
-            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t) {
-                std::int64_t want = 0;
-                for (int a = 0; a < 3; ++a) {
-                    const std::int64_t e = s[a] * (2 - m[a]);
-                    want = e < 0 || want == MacrocellGrid::kMaxEmptyRadius ? MacrocellGrid::kMaxEmptyRadius : std::max(want, e);
-                }
-                EXPECT_EQ(ahead[std::size_t(o) * 125 + std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], want)
-                    << "octant " << o << " at " << m[0] << "," << m[1] << "," << m[2];
-            });
-        }
-    });
+    with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) { expect_cubes_ahead_of_the_centre(g, g.octant_empty_radii()); });
 }
 
-// The same against brute force on the scattered spikes of EmptyRadiusMatchesBruteForce: the largest r
-// (up to the grid's 7, then the cap) whose cube ahead holds no macrocell of the grid that is not empty;
-// and never below empty_radius (the symmetric box holds the cube ahead of that size).
+// The same against brute force on scattered spikes (as EmptyRadiusMatchesBruteForce): the largest r (up
+// to the grid's 7, then the cap) whose cube ahead holds only macrocells of m's kind (empty for
+// octant_empty_radii, non-empty for octant_solid_radii); the empty one never below empty_radius (the
+// symmetric box holds the cube ahead of that size).
 TEST(MacrocellGrid, OctantEmptyRadiusMatchesBruteForce) {
     std::vector<double> values(57 * 57 * 57, 0.0);
     std::uint32_t x = 777;
@@ -275,7 +274,8 @@ TEST(MacrocellGrid, OctantEmptyRadiusMatchesBruteForce) {
     }
     with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
         ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
-        const std::vector<std::uint8_t> ahead = g.octant_empty_radii();
+        for (const bool of_empty : {true, false}) {
+        const std::vector<std::uint8_t> ahead = of_empty ? g.octant_empty_radii() : g.octant_solid_radii();
         int capped = 0, finite = 0;
         for (int o = 0; o < 8; ++o) {
             const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
@@ -288,29 +288,31 @@ TEST(MacrocellGrid, OctantEmptyRadiusMatchesBruteForce) {
                                     for (std::int64_t a = 0; a < r; ++a) {
                                         const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
                                         const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
-                                        if (in && !g.empty(q)) return false;
+                                        if (in && g.empty(q) != of_empty) return false;
                                     }
                             return true;
                         };
                         std::int64_t want = 0;
                         while (want < 7 && cube_empty(want + 1)) ++want;
                         if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
-                        (want == MacrocellGrid::kMaxEmptyRadius ? capped : finite) += 1;
+                        if (want == MacrocellGrid::kMaxEmptyRadius) ++capped;
+                        else if (want > 0) ++finite;
                         const std::int64_t got = ahead[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
-                        EXPECT_EQ(got, want) << "octant " << o << " at " << i << "," << j << "," << k;
-                        EXPECT_GE(got, g.empty_radius({i, j, k}));
+                        EXPECT_EQ(got, want) << (of_empty ? "empty" : "solid") << ", octant " << o << " at " << i << "," << j << "," << k;
+                        if (of_empty) EXPECT_GE(got, g.empty_radius({i, j, k}));
                     }
         }
-        EXPECT_GT(capped, 100);
-        EXPECT_GT(finite, 500);
+        if (of_empty) EXPECT_GT(capped, 100);
+        EXPECT_GT(finite, of_empty ? 500 : 50);
+        }
     });
 }
 
-// solid_radii by hand, the complement of the test above: a 41^3 volume of ones whose voxels 16..24 per
-// axis (exactly those macrocell (2, 2, 2) reads) are 0, so (2, 2, 2) is the one empty macrocell (its
-// neighbours also read ones); every other macrocell's solid radius is its Chebyshev distance to it, and
-// without the hole every solid radius is the cap.
-TEST(MacrocellGrid, SolidRadiusIsTheChebyshevDistanceToTheNearestEmptyMacrocell) {
+// octant_solid_radii by hand, the complement of OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell: a 41^3
+// volume of ones whose voxels 16..24 per axis (exactly those macrocell (2, 2, 2) reads) are 0, so (2, 2, 2)
+// is the one empty macrocell (its neighbours also read ones), and the solid distance ahead of every other
+// macrocell follows the same rule; without the hole every solid distance is the cap.
+TEST(MacrocellGrid, OctantSolidRadiusIsTheCubeAheadOfTheMacrocell) {
     for (const bool hole : {true, false}) {
         std::vector<double> values(41 * 41 * 41, 1.0);
         if (hole)
@@ -318,12 +320,13 @@ TEST(MacrocellGrid, SolidRadiusIsTheChebyshevDistanceToTheNearestEmptyMacrocell)
                 for (int j = 16; j <= 24; ++j)
                     for (int i = 16; i <= 24; ++i) values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
         with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
-            const std::vector<std::uint8_t> solid = g.solid_radii();
-            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) {
-                EXPECT_EQ(solid[std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], hole ? d : MacrocellGrid::kMaxEmptyRadius)
-                    << m[0] << "," << m[1] << "," << m[2];
-                EXPECT_EQ(g.empty(m), hole && d == 0);
-            });
+            const std::vector<std::uint8_t> solid = g.octant_solid_radii();
+            if (hole) {
+                expect_cubes_ahead_of_the_centre(g, solid);
+            } else {
+                for (const std::uint8_t r : solid) EXPECT_EQ(r, MacrocellGrid::kMaxEmptyRadius);
+            }
+            each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) { EXPECT_EQ(g.empty(m), hole && d == 0); });
         });
     }
 }

@@ -77,7 +77,7 @@ private:
     Termination termination_;  // early_termination(render)
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
     std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
-    std::vector<std::int32_t> skip_radius_;         // the macrocells' empty_radius, or -solid_radius (the packets' skipping)
+    std::vector<std::int32_t> skip_radius_;         // per octant: the empty distance ahead, or minus the solid one (the packets' skipping)
 };
 
 }  // namespace volref

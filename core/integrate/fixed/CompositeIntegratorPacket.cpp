@@ -104,13 +104,12 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     in.macrocells = ctx.macrocells;
     if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
         // Per octant of directions and macrocell: the empty distance ahead where it is empty, minus
-        // solid_radius where it is not (8 copies of the grid, octant o at o * count).
+        // the solid distance ahead where it is not (8 copies of the grid, octant o at o * count).
         const std::vector<std::uint8_t> ahead = in.macrocells->octant_empty_radii();
-        const std::vector<std::uint8_t> solid = in.macrocells->solid_radii();
-        const std::size_t count = solid.size();
+        const std::vector<std::uint8_t> solid = in.macrocells->octant_solid_radii();
         skip_radius_.resize(ahead.size());
         for (std::size_t i = 0; i < ahead.size(); ++i)
-            skip_radius_[i] = ahead[i] > 0 ? std::int32_t(ahead[i]) : -std::int32_t(solid[i % count]);
+            skip_radius_[i] = ahead[i] > 0 ? std::int32_t(ahead[i]) : -std::int32_t(solid[i]);
         in.skip_radius = skip_radius_.data();
     }
     if (fast) {

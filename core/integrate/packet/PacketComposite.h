@@ -109,9 +109,10 @@ struct PacketCompositeInputs {
     const float* preintegration = nullptr;
     int pre_n = 0;
     double pre_x0 = 0.0, pre_inv_dx = 1.0;
-    // Skipping decided on the lanes (PacketKernels-inl.h, VectorSkip): each macrocell's empty_radius
-    // where it is empty, else minus its solid_radius (MacrocellGrid.h), as int32 (CompositeIntegrator's
-    // copy); null: no skipping.
+    // Skipping decided on the lanes (PacketKernels-inl.h, VectorSkip): per octant of ray directions and
+    // macrocell, the empty distance ahead where it is empty, else minus the solid distance ahead
+    // (MacrocellGrid::octant_empty_radii, octant_solid_radii), as int32 (CompositeIntegrator's copy);
+    // null: no skipping.
     const std::int32_t* skip_radius = nullptr;
 };
 

@@ -96,7 +96,8 @@ struct SimdLanes {
 // what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
     // Per octant o of ray directions and macrocell m, at o * (macrocells) + linear(m): the empty distance
-    // ahead (MacrocellGrid::octant_empty_radii) if m is empty, else -solid_radius (CompositeIntegrator's copy).
+    // ahead (MacrocellGrid::octant_empty_radii) if m is empty, else minus the solid distance ahead
+    // (octant_solid_radii) (CompositeIntegrator's copy).
     const std::int32_t* radius = nullptr;
     std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
     std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
@@ -124,8 +125,9 @@ struct VectorSkip {
 // lane's new segment is placed in the same step (and checked again), replacing the empty sample; with
 // pre-integrated segments the segment at p is kept (its ends may lie outside B) and the lane moves on
 // after it. Lanes whose p lies outside the grid's index range (clamped) are not moved. A lane in a
-// non-empty m with solid_radius(m) = r (every macrocell within r - 1 of m non-empty) is not checked
-// again before it leaves that box (the same exit, with r), since no empty macrocell lies in it.
+// non-empty m whose solid distance ahead is r (octant_solid_radii: the cube of r^3 macrocells ahead of m,
+// as above, all non-empty) is not checked again before it leaves that cube (the same exit, with r),
+// since no empty macrocell lies in it.
 template <typename T>
 struct RayPacketT {
     static constexpr std::size_t kLanes = HWY_LANES(T);
@@ -365,10 +367,10 @@ private:
             const auto r = hn::IfThenElseZero(inside32, hn::GatherIndex(di, s.radius, safe));
             const auto radius = to_lanes(d, r);  // exact
             const auto empty = hn::Gt(radius, zero);
-            // The exit of the cube of empty macrocells ahead of m (r = the empty distance ahead: per axis
-            // [m, m + r) up, (m - r, m] down), or of the box of non-empty macrocells within r - 1 of m
-            // (r = solid_radius; m itself where r = 0): per axis the face ahead, in index units (the
-            // same two faces: m M + r M up, m M - (r - 1) M down).
+            // The exit of the cube ahead of m whose macrocells are all empty (r = the empty distance
+            // ahead) or all non-empty (r = the solid distance ahead; m itself where r = 0): per axis
+            // [m, m + r) up, (m - r, m] down, so the face ahead is m M + r M up, m M - (r - 1) M down, in
+            // index units.
             const auto rf = hn::Max(hn::Abs(radius), hn::Set(d, T(1)));
             auto dt = hn::Set(d, std::numeric_limits<T>::infinity());
             for (int a = 0; a < 3; ++a) {

@@ -16,7 +16,8 @@
 # those runs), VOLREF_BUILD (build) the build folder holding cli/volref.
 #
 # Steps:
-#  1. freeze the volref binary: cli/volref, libvolref_core.so.0 and libvolref_tools.so.0 are copied to
+#  1. freeze the volref binary: cli/volref, libvolref_core.so.0, libvolref_tools.so.0 and the plugin
+#     libvolref_image_files.so (which libvolref_tools loads from its own folder) are copied to
 #     OUT_DIR/bin and run from there (LD_LIBRARY_PATH beats the RUNPATH), so a rebuild during the run
 #     changes nothing;
 #  2. count each scene's samples from the geometry (count_samples.py);
@@ -78,7 +79,7 @@ wait_idle() {
 
 # 1. Freeze the binary.
 cp "$build/cli/volref" "$out/bin/volref"
-for lib in libvolref_core.so.0 libvolref_tools.so.0; do cp -L "$build/$lib" "$out/bin/$lib"; done
+for lib in libvolref_core.so.0 libvolref_tools.so.0 libvolref_image_files.so; do cp -L "$build/$lib" "$out/bin/$lib"; done
 volref() { LD_LIBRARY_PATH="$out/bin${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$out/bin/volref" "$@"; }
 
 # Runs volref once: $1 = JSON file to write, the rest = volref's arguments. Records the render

@@ -82,7 +82,7 @@ def step_text(s):
 
 # 1. The frozen binary and the float32 volume.
 shutil.copy(os.path.join(a.build, "cli", "volref"), os.path.join(out, "bin", "volref"))
-for lib in ("libvolref_core.so.0", "libvolref_tools.so.0"):
+for lib in ("libvolref_core.so.0", "libvolref_tools.so.0", "libvolref_image_files.so"):
     shutil.copy(os.path.realpath(os.path.join(a.build, lib)), os.path.join(out, "bin", lib))
 env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(out, "bin") + ":" + os.environ.get("LD_LIBRARY_PATH", ""))
 volume = os.path.join(out, "ml256.nrrd")

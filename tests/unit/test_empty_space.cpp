@@ -204,14 +204,18 @@ TEST(MacrocellGrid, EmptyRadiusIsTheChebyshevDistanceToTheNearestNonEmptyMacroce
 // The same against brute force (every pair of macrocells) on scattered spikes: 57^3 voxels (7
 // macrocells per axis), spikes at fixed pseudo-random voxels, the radius of each empty macrocell the
 // smallest Chebyshev distance to a macrocell the grid says is not empty.
-TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
+// 57^3 voxels of 0 with `spikes` voxels of 1 at pseudo-random places (a linear congruential sequence from `seed`).
+std::vector<double> scattered_spikes(std::uint32_t seed, int spikes) {
     std::vector<double> values(57 * 57 * 57, 0.0);
-    std::uint32_t x = 12345;
-    for (int k = 0; k < 5; ++k) {
-        x = x * 1664525u + 1013904223u;
-        values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
+    for (int k = 0; k < spikes; ++k) {
+        seed = seed * 1664525u + 1013904223u;
+        values[std::size_t(seed % (57u * 57u * 57u))] = 1.0;
     }
-    with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
+    return values;
+}
+
+TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
+    with_ramp_grid(57, scattered_spikes(12345, 5), [&](const MacrocellGrid& g) {
         ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
         // The smallest Chebyshev distance from (i, j, k) to a macrocell that is not empty.
         auto nearest = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -265,45 +269,39 @@ TEST(MacrocellGrid, OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell) {
 // to the grid's 7, then the cap) whose cube ahead holds only macrocells of m's kind (empty for
 // octant_empty_radii, non-empty for octant_solid_radii); the empty one never below empty_radius (the
 // symmetric box holds the cube ahead of that size).
-TEST(MacrocellGrid, OctantEmptyRadiusMatchesBruteForce) {
-    std::vector<double> values(57 * 57 * 57, 0.0);
-    std::uint32_t x = 777;
-    for (int k = 0; k < 9; ++k) {
-        x = x * 1664525u + 1013904223u;
-        values[std::size_t(x % (57u * 57u * 57u))] = 1.0;
-    }
-    with_ramp_grid(57, std::move(values), [&](const MacrocellGrid& g) {
+TEST(MacrocellGrid, OctantRadiiMatchBruteForce) {
+    with_ramp_grid(57, scattered_spikes(777, 9), [&](const MacrocellGrid& g) {
         ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
         for (const bool of_empty : {true, false}) {
-        const std::vector<std::uint8_t> ahead = of_empty ? g.octant_empty_radii() : g.octant_solid_radii();
-        int capped = 0, finite = 0;
-        for (int o = 0; o < 8; ++o) {
-            const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
-            for (std::int64_t k = 0; k < 7; ++k)
-                for (std::int64_t j = 0; j < 7; ++j)
-                    for (std::int64_t i = 0; i < 7; ++i) {
-                        auto cube_empty = [&](std::int64_t r) {
-                            for (std::int64_t c = 0; c < r; ++c)
-                                for (std::int64_t b = 0; b < r; ++b)
-                                    for (std::int64_t a = 0; a < r; ++a) {
-                                        const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
-                                        const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
-                                        if (in && g.empty(q) != of_empty) return false;
-                                    }
-                            return true;
-                        };
-                        std::int64_t want = 0;
-                        while (want < 7 && cube_empty(want + 1)) ++want;
-                        if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
-                        if (want == MacrocellGrid::kMaxEmptyRadius) ++capped;
-                        else if (want > 0) ++finite;
-                        const std::int64_t got = ahead[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
-                        EXPECT_EQ(got, want) << (of_empty ? "empty" : "solid") << ", octant " << o << " at " << i << "," << j << "," << k;
-                        if (of_empty) EXPECT_GE(got, g.empty_radius({i, j, k}));
-                    }
-        }
-        if (of_empty) EXPECT_GT(capped, 100);
-        EXPECT_GT(finite, of_empty ? 500 : 50);
+            const std::vector<std::uint8_t> ahead = of_empty ? g.octant_empty_radii() : g.octant_solid_radii();
+            int capped = 0, finite = 0;
+            for (int o = 0; o < 8; ++o) {
+                const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
+                for (std::int64_t k = 0; k < 7; ++k)
+                    for (std::int64_t j = 0; j < 7; ++j)
+                        for (std::int64_t i = 0; i < 7; ++i) {
+                            auto cube_of_kind = [&](std::int64_t r) {
+                                for (std::int64_t c = 0; c < r; ++c)
+                                    for (std::int64_t b = 0; b < r; ++b)
+                                        for (std::int64_t a = 0; a < r; ++a) {
+                                            const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
+                                            const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
+                                            if (in && g.empty(q) != of_empty) return false;
+                                        }
+                                return true;
+                            };
+                            std::int64_t want = 0;
+                            while (want < 7 && cube_of_kind(want + 1)) ++want;
+                            if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
+                            if (want == MacrocellGrid::kMaxEmptyRadius) ++capped;
+                            else if (want > 0) ++finite;
+                            const std::int64_t got = ahead[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
+                            EXPECT_EQ(got, want) << (of_empty ? "empty" : "solid") << ", octant " << o << " at " << i << "," << j << "," << k;
+                            if (of_empty) EXPECT_GE(got, g.empty_radius({i, j, k}));
+                        }
+            }
+            if (of_empty) EXPECT_GT(capped, 100);
+            EXPECT_GT(finite, of_empty ? 500 : 50);
         }
     });
 }

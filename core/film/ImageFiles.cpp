@@ -85,7 +85,6 @@ extern "C" int volref_image_files_read(const char* path, ReadResult* result, cha
         const std::size_t count = std::size_t(w) * std::size_t(h) * std::size_t(n);
         result->width = w;
         result->height = h;
-        result->channels = n;
         for (int c = 0; c < n; ++c) result->add_channel_name(result->owner, spec.channel_name(c).c_str());
         double* data = result->pixels(result->owner, count);
         const OIIO::TypeDesc native = spec.format;

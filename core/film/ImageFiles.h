@@ -34,7 +34,7 @@ struct WriteRequest {
 // read as stored and scaled here in double, v / (2^bits - 1) (OpenImageIO's own conversion to double
 // goes through float: errors of 6e-8 on 8-bit values); anything else is converted by OpenImageIO.
 struct ReadResult {
-    int width = 0, height = 0, channels = 0;
+    int width = 0, height = 0;
     // Filled by the module through these callbacks (so that no allocator crosses the boundary).
     void* owner = nullptr;
     void (*add_channel_name)(void* owner, const char* name) = nullptr;

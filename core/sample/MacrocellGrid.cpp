@@ -129,13 +129,13 @@ std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii() const {
     return out;
 }
 
-std::vector<std::uint8_t> MacrocellGrid::octant_radii(bool of_empty) const {
+std::vector<std::int32_t> MacrocellGrid::octant_radii() const {
     const std::size_t total = empty_.size();
     constexpr std::int64_t far = kMaxEmptyRadius;
-    std::vector<std::uint8_t> out(8 * total);
+    std::vector<std::int32_t> out(8 * total);
     for (int o = 0; o < 8; ++o) {
         const Index s{(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
-        std::uint8_t* r = out.data() + std::size_t(o) * total;
+        std::int32_t* r = out.data() + std::size_t(o) * total;  // signed: + empty, - not
         // Visit the neighbours ahead first: each axis from its far end backwards.
         Index m;
         for (std::int64_t c2 = 0; c2 < counts_[2]; ++c2)
@@ -145,16 +145,15 @@ std::vector<std::uint8_t> MacrocellGrid::octant_radii(bool of_empty) const {
                     m[1] = s[1] > 0 ? counts_[1] - 1 - c1 : c1;
                     m[2] = s[2] > 0 ? counts_[2] - 1 - c2 : c2;
                     const std::size_t here = linear(m);
-                    if ((empty_[here] != 0) != of_empty) {
-                        r[here] = 0;
-                        continue;
-                    }
                     std::int64_t ahead = far;
                     for (int n = 1; n < 8; ++n) {
                         const Index q{m[0] + ((n & 1) ? s[0] : 0), m[1] + ((n & 2) ? s[1] : 0), m[2] + ((n & 4) ? s[2] : 0)};
-                        if (inside(q)) ahead = std::min<std::int64_t>(ahead, r[linear(q)]);
+                        if (!inside(q)) continue;
+                        const std::size_t there = linear(q);
+                        ahead = std::min<std::int64_t>(ahead, empty_[there] == empty_[here] ? std::abs(r[there]) : 0);
                     }
-                    r[here] = std::uint8_t(std::min(ahead + 1, far));
+                    const auto size = std::int32_t(std::min(ahead + 1, far));
+                    r[here] = empty_[here] != 0 ? size : -size;
                 }
     }
     return out;

@@ -72,20 +72,17 @@ public:
     // kMaxEmptyRadius (also when no macrocell is non-empty).
     std::int64_t empty_radius(const Index& m) const { return inside(m) ? empty_radius_[linear(m)] : 0; }
     static constexpr std::int64_t kMaxEmptyRadius = 255;
-    // Every macrocell's empty_radius, at m0 + counts0 (m1 + counts1 m2) (the fast profile's packets).
-    const std::vector<std::uint8_t>& empty_radii() const { return empty_radius_; }
-    // The empty distance ahead, per octant of ray directions, computed on each call (only the
-    // composite packets read it, once): for octant o = (s0 < 0) + 2 (s1 < 0) + 4 (s2 < 0) (s: the direction's sign per axis, + for
-    // 0), entry o * count + linear(m) is the largest r such that every macrocell m + (i s0, j s1, k s2),
-    // 0 <= i, j, k < r, is empty (a cube with its corner at m, ahead of a ray in that octant): 0 for a
-    // non-empty m, capped at kMaxEmptyRadius; a cube may reach beyond the grid (as empty_radius' box).
-    // By the recurrence r(m) = 1 + min of r over m's 7 neighbours ahead (m + (a s0, b s1, c s2), a, b, c
-    // in {0, 1}, not all 0; kMaxEmptyRadius outside the grid). Always >= empty_radius(m).
-    std::vector<std::uint8_t> octant_empty_radii() const { return octant_radii(true); }
-    // The same for the other kind: per octant, the largest cube of non-empty macrocells with its
-    // corner at m, ahead of the ray (0 for an empty m). A packet's lane in such a cube needs no check
-    // for empty space before it leaves the cube.
-    std::vector<std::uint8_t> octant_solid_radii() const { return octant_radii(false); }
+    // The distance ahead, per octant of ray directions, computed on each call (only the composite
+    // packets read it, once): for octant o = (s0 < 0) + 2 (s1 < 0) + 4 (s2 < 0) (s: the direction's
+    // sign per axis, + for 0), entry o * count + linear(m) is the largest r such that every macrocell
+    // m + (i s0, j s1, k s2), 0 <= i, j, k < r, is as m is, empty or not (a cube with its corner at m,
+    // ahead of a ray in that octant), capped at kMaxEmptyRadius; a cube may reach beyond the grid (as
+    // empty_radius' box). By the recurrence r(m) = 1 + min over m's 7 neighbours ahead q = m + (a s0,
+    // b s1, c s2) (a, b, c in {0, 1}, not all 0) of r(q) where q is as m is, else 0 (kMaxEmptyRadius
+    // outside the grid). Signed, as the composite packets read it (VectorSkip): +r for an empty m (never
+    // below empty_radius(m): a lane there may move to the cube's exit), -r for a non-empty one (r >= 1: a
+    // lane there needs no check for empty space before that exit).
+    std::vector<std::int32_t> octant_radii() const;
     // Where the ray leaves (enters) the box of macrocell m through a face with a neighbour behind it,
     // in the ray's t: +inf (-inf) when it crosses no such face. Rounded, so only an estimate: the
     // integrator checks it against macrocell_at. exit_distance with r > 1: where the ray leaves the box
@@ -122,8 +119,6 @@ private:
     std::vector<std::array<double, 2>> ranges_;
     // Per macrocell, the Chebyshev distance to the nearest macrocell that is not empty.
     std::vector<std::uint8_t> chebyshev_radii() const;
-    // Per octant and macrocell, the largest cube ahead whose macrocells are all empty (of_empty) or all not.
-    std::vector<std::uint8_t> octant_radii(bool of_empty) const;
     std::vector<unsigned char> empty_;
     std::vector<std::uint8_t> empty_radius_;  // empty_radius(m)
     std::int64_t empty_count_ = 0;

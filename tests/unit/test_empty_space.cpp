@@ -238,79 +238,41 @@ TEST(MacrocellGrid, EmptyRadiusMatchesBruteForce) {
     });
 }
 
-// octant_empty_radii by hand, on the spike of EmptyRadiusIs...: for octant o (signs s per axis) the cube
-// ahead of m, m + (i s0, j s1, k s2) for 0 <= i, j, k < r, reaches the one non-empty macrocell (2, 2, 2)
-// only if every e_a = s_a (2 - m_a) >= 0, and then first at r = max_a e_a + 1: so the distance ahead is
-// max_a e_a (0 at the spike itself), and the cap where some e_a < 0 (the spike lies behind on that axis).
-// Checks radii (8 octants of a 5^3 grid) against that rule, the odd macrocell (2, 2, 2) at distance 0.
-void expect_cubes_ahead_of_the_centre(const MacrocellGrid& g, const std::vector<std::uint8_t>& ahead) {
-    ASSERT_EQ(ahead.size(), 8u * 125u);
+// octant_radii by hand, on the spike of EmptyRadiusIs...: for octant o (signs s per axis) the cube ahead
+// of an empty m, m + (i s0, j s1, k s2) for 0 <= i, j, k < r, reaches the one non-empty macrocell
+// (2, 2, 2) only if every e_a = s_a (2 - m_a) >= 0, and then first at r = max_a e_a + 1: so the distance
+// ahead is max_a e_a, and the cap where some e_a < 0 (the spike lies behind on that axis). The spike
+// itself, whose 7 neighbours ahead (or the grid's edge) are all of the other kind, has the cube of
+// itself: 1. Checks signed radii (8 octants of a 5^3 grid) against that rule, `sign` the sign of every
+// macrocell but the centre (+ empty, - not), whose own is the other.
+void expect_cubes_ahead_of_the_centre(const MacrocellGrid& g, const std::vector<std::int32_t>& radii, int sign) {
+    ASSERT_EQ(radii.size(), 8u * 125u);
     for (int o = 0; o < 8; ++o) {
         const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
-        each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t) {
+        each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) {
             std::int64_t want = 0;
             for (int a = 0; a < 3; ++a) {
                 const std::int64_t e = s[a] * (2 - m[a]);
                 want = e < 0 || want == MacrocellGrid::kMaxEmptyRadius ? MacrocellGrid::kMaxEmptyRadius : std::max(want, e);
             }
-            EXPECT_EQ(ahead[std::size_t(o) * 125 + std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], want)
+            const std::int64_t signed_want = d == 0 ? -sign : sign * want;
+            EXPECT_EQ(radii[std::size_t(o) * 125 + std::size_t(m[0] + 5 * (m[1] + 5 * m[2]))], signed_want)
                 << "octant " << o << " at " << m[0] << "," << m[1] << "," << m[2];
         });
     }
 }
 
-TEST(MacrocellGrid, OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell) {
+TEST(MacrocellGrid, OctantRadiusOfAnEmptyMacrocellIsTheCubeAheadOfIt) {
     std::vector<double> values(41 * 41 * 41, 0.0);
     values[std::size_t(20 + 41 * (20 + 41 * 20))] = 1.0;
-    with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) { expect_cubes_ahead_of_the_centre(g, g.octant_empty_radii()); });
+    with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) { expect_cubes_ahead_of_the_centre(g, g.octant_radii(), +1); });
 }
 
-// The same against brute force on scattered spikes (as EmptyRadiusMatchesBruteForce): the largest r (up
-// to the grid's 7, then the cap) whose cube ahead holds only macrocells of m's kind (empty for
-// octant_empty_radii, non-empty for octant_solid_radii); the empty one never below empty_radius (the
-// symmetric box holds the cube ahead of that size).
-TEST(MacrocellGrid, OctantRadiiMatchBruteForce) {
-    with_ramp_grid(57, scattered_spikes(777, 9), [&](const MacrocellGrid& g) {
-        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
-        for (const bool of_empty : {true, false}) {
-            const std::vector<std::uint8_t> ahead = of_empty ? g.octant_empty_radii() : g.octant_solid_radii();
-            int capped = 0, finite = 0;
-            for (int o = 0; o < 8; ++o) {
-                const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
-                for (std::int64_t k = 0; k < 7; ++k)
-                    for (std::int64_t j = 0; j < 7; ++j)
-                        for (std::int64_t i = 0; i < 7; ++i) {
-                            auto cube_of_kind = [&](std::int64_t r) {
-                                for (std::int64_t c = 0; c < r; ++c)
-                                    for (std::int64_t b = 0; b < r; ++b)
-                                        for (std::int64_t a = 0; a < r; ++a) {
-                                            const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
-                                            const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
-                                            if (in && g.empty(q) != of_empty) return false;
-                                        }
-                                return true;
-                            };
-                            std::int64_t want = 0;
-                            while (want < 7 && cube_of_kind(want + 1)) ++want;
-                            if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
-                            if (want == MacrocellGrid::kMaxEmptyRadius) ++capped;
-                            else if (want > 0) ++finite;
-                            const std::int64_t got = ahead[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
-                            EXPECT_EQ(got, want) << (of_empty ? "empty" : "solid") << ", octant " << o << " at " << i << "," << j << "," << k;
-                            if (of_empty) EXPECT_GE(got, g.empty_radius({i, j, k}));
-                        }
-            }
-            if (of_empty) EXPECT_GT(capped, 100);
-            EXPECT_GT(finite, of_empty ? 500 : 50);
-        }
-    });
-}
-
-// octant_solid_radii by hand, the complement of OctantEmptyRadiusIsTheCubeAheadOfTheMacrocell: a 41^3
-// volume of ones whose voxels 16..24 per axis (exactly those macrocell (2, 2, 2) reads) are 0, so (2, 2, 2)
-// is the one empty macrocell (its neighbours also read ones), and the solid distance ahead of every other
-// macrocell follows the same rule; without the hole every solid distance is the cap.
-TEST(MacrocellGrid, OctantSolidRadiusIsTheCubeAheadOfTheMacrocell) {
+// The complement: a 41^3 volume of ones whose voxels 16..24 per axis (exactly those macrocell (2, 2, 2)
+// reads) are 0, so (2, 2, 2) is the one empty macrocell (its neighbours also read ones), and the solid
+// distance ahead of every other macrocell follows the same rule, negative; without the hole every
+// radius is minus the cap.
+TEST(MacrocellGrid, OctantRadiusOfANonEmptyMacrocellIsTheCubeAheadOfIt) {
     for (const bool hole : {true, false}) {
         std::vector<double> values(41 * 41 * 41, 1.0);
         if (hole)
@@ -318,15 +280,56 @@ TEST(MacrocellGrid, OctantSolidRadiusIsTheCubeAheadOfTheMacrocell) {
                 for (int j = 16; j <= 24; ++j)
                     for (int i = 16; i <= 24; ++i) values[std::size_t(i + 41 * (j + 41 * k))] = 0.0;
         with_ramp_grid(41, std::move(values), [&](const MacrocellGrid& g) {
-            const std::vector<std::uint8_t> solid = g.octant_solid_radii();
+            const std::vector<std::int32_t> radii = g.octant_radii();
             if (hole) {
-                expect_cubes_ahead_of_the_centre(g, solid);
+                expect_cubes_ahead_of_the_centre(g, radii, -1);
             } else {
-                for (const std::uint8_t r : solid) EXPECT_EQ(r, MacrocellGrid::kMaxEmptyRadius);
+                for (const std::int32_t r : radii) EXPECT_EQ(r, -MacrocellGrid::kMaxEmptyRadius);
             }
             each_around_the_centre(g, [&](const MacrocellGrid::Index& m, std::int64_t d) { EXPECT_EQ(g.empty(m), hole && d == 0); });
         });
     }
+}
+
+// The same against brute force on scattered spikes (as EmptyRadiusMatchesBruteForce): the largest r (up
+// to the grid's 7, then the cap) whose cube ahead holds only macrocells of m's kind, + for an empty m,
+// - for a non-empty one; the empty ones never below empty_radius (the symmetric box holds the cube
+// ahead of that size).
+TEST(MacrocellGrid, OctantRadiiMatchBruteForce) {
+    with_ramp_grid(57, scattered_spikes(777, 9), [&](const MacrocellGrid& g) {
+        ASSERT_EQ(g.counts(), (MacrocellGrid::Index{7, 7, 7}));
+        const std::vector<std::int32_t> radii = g.octant_radii();
+        int capped = 0, finite_empty = 0, finite_solid = 0;
+        for (int o = 0; o < 8; ++o) {
+            const std::int64_t s[3] = {(o & 1) ? -1 : 1, (o & 2) ? -1 : 1, (o & 4) ? -1 : 1};
+            for (std::int64_t k = 0; k < 7; ++k)
+                for (std::int64_t j = 0; j < 7; ++j)
+                    for (std::int64_t i = 0; i < 7; ++i) {
+                        const bool kind = g.empty({i, j, k});
+                        auto cube_of_kind = [&](std::int64_t r) {
+                            for (std::int64_t c = 0; c < r; ++c)
+                                for (std::int64_t b = 0; b < r; ++b)
+                                    for (std::int64_t a = 0; a < r; ++a) {
+                                        const MacrocellGrid::Index q{i + a * s[0], j + b * s[1], k + c * s[2]};
+                                        const bool in = q[0] >= 0 && q[0] < 7 && q[1] >= 0 && q[1] < 7 && q[2] >= 0 && q[2] < 7;
+                                        if (in && g.empty(q) != kind) return false;
+                                    }
+                            return true;
+                        };
+                        std::int64_t want = 0;
+                        while (want < 7 && cube_of_kind(want + 1)) ++want;
+                        if (want == 7) want = MacrocellGrid::kMaxEmptyRadius;
+                        if (want == MacrocellGrid::kMaxEmptyRadius) ++capped;
+                        else if (want > 1) ++(kind ? finite_empty : finite_solid);
+                        const std::int64_t got = radii[std::size_t(o) * 343 + std::size_t(i + 7 * (j + 7 * k))];
+                        EXPECT_EQ(got, kind ? want : -want) << "octant " << o << " at " << i << "," << j << "," << k;
+                        if (kind) EXPECT_GE(got, g.empty_radius({i, j, k}));
+                    }
+        }
+        EXPECT_GT(capped, 100);
+        EXPECT_GT(finite_empty, 300);
+        EXPECT_GT(finite_solid, 0);
+    });
 }
 
 // One non-zero voxel in a 20^3 volume of zeros (19 cells per axis: macrocells of 8, 8 and 3 cells):

@@ -103,13 +103,8 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     in.termination = early_termination(ctx.render);
     in.macrocells = ctx.macrocells;
     if (in.macrocells) {  // skipping decided on the lanes (PacketKernels-inl.h, VectorSkip)
-        // Per octant of directions and macrocell: the empty distance ahead where it is empty, minus
-        // the solid distance ahead where it is not (8 copies of the grid, octant o at o * count).
-        const std::vector<std::uint8_t> ahead = in.macrocells->octant_empty_radii();
-        const std::vector<std::uint8_t> solid = in.macrocells->octant_solid_radii();
-        skip_radius_.resize(ahead.size());
-        for (std::size_t i = 0; i < ahead.size(); ++i)
-            skip_radius_[i] = ahead[i] > 0 ? std::int32_t(ahead[i]) : -std::int32_t(solid[i]);
+        // Per octant of directions and macrocell: the distance ahead, + where it is empty, - where not.
+        skip_radius_ = in.macrocells->octant_radii();
         in.skip_radius = skip_radius_.data();
     }
     if (fast) {

@@ -111,7 +111,7 @@ struct PacketCompositeInputs {
     double pre_x0 = 0.0, pre_inv_dx = 1.0;
     // Skipping decided on the lanes (PacketKernels-inl.h, VectorSkip): per octant of ray directions and
     // macrocell, the empty distance ahead where it is empty, else minus the solid distance ahead
-    // (MacrocellGrid::octant_empty_radii, octant_solid_radii), as int32 (CompositeIntegrator's copy);
+    // (MacrocellGrid::octant_radii, held by CompositeIntegrator);
     // null: no skipping.
     const std::int32_t* skip_radius = nullptr;
 };

@@ -96,8 +96,8 @@ struct SimdLanes {
 // what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
     // Per octant o of ray directions and macrocell m, at o * (macrocells) + linear(m): the empty distance
-    // ahead (MacrocellGrid::octant_empty_radii) if m is empty, else minus the solid distance ahead
-    // (octant_solid_radii) (CompositeIntegrator's copy).
+    // ahead if m is empty, else minus the solid distance ahead (MacrocellGrid::octant_radii, held by
+    // CompositeIntegrator).
     const std::int32_t* radius = nullptr;
     std::int64_t counts[3] = {1, 1, 1};    // macrocells per axis
     std::int64_t dims[3] = {1, 1, 1};      // voxels per axis
@@ -115,7 +115,7 @@ struct VectorSkip {
 // cell the kernel's trilinear read uses, cell = min(floor(clamp((p - origin) / s, 0, n - 1)), n - 2),
 // (origin: the grid's on double lanes, 0 on float lanes, whose positions are local), and its macrocell
 // m = cell / M (M = kMacrocellSize, 8); where the empty distance ahead of m for the lane's octant o of
-// directions is r >= 1 (MacrocellGrid::octant_empty_radii: the macrocells m + (i s0, j s1, k s2),
+// directions is r >= 1 (MacrocellGrid::octant_radii: the macrocells m + (i s0, j s1, k s2),
 // 0 <= i, j, k < r, s the direction's signs, are all empty), the ray stays in that cube B for dt = the
 // distance to B's exit face along the ray (index space, per axis: B spans cells [m M, (m + r) M) where
 // the ray moves up (or not at all), [(m - r + 1) M, (m + 1) M) where it moves down), less 0.01 cell
@@ -125,7 +125,7 @@ struct VectorSkip {
 // lane's new segment is placed in the same step (and checked again), replacing the empty sample; with
 // pre-integrated segments the segment at p is kept (its ends may lie outside B) and the lane moves on
 // after it. Lanes whose p lies outside the grid's index range (clamped) are not moved. A lane in a
-// non-empty m whose solid distance ahead is r (octant_solid_radii: the cube of r^3 macrocells ahead of m,
+// non-empty m whose solid distance ahead is r (octant_radii: the cube of r^3 macrocells ahead of m,
 // as above, all non-empty) is not checked again before it leaves that cube (the same exit, with r),
 // since no empty macrocell lies in it.
 template <typename T>

@@ -21,11 +21,7 @@ std::string first_line(std::string why) {
 }
 
 int fail(const std::string& message, char* error, std::size_t size) {
-    if (size > 0) {
-        const std::size_t n = std::min(size - 1, message.size());
-        std::copy(message.begin(), message.begin() + std::ptrdiff_t(n), error);
-        error[n] = '\0';
-    }
+    volref::image_files::copy_message(message, error, size);
     return 1;
 }
 

@@ -8,8 +8,10 @@
 // pixels, which channels, premultiplied or not) stay in libvolref_tools (ImageWriter.cpp,
 // ComparedImage.cpp), so the module only moves pixels between memory and a file.
 #pragma once
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 namespace volref::image_files {
 
@@ -42,6 +44,15 @@ struct ReadResult {
     int bits = 0;                 // bits per integer sample (8 for PNG), 0 for floating point
     int unassociated_alpha = 0;   // the file stores colour divided by alpha
 };
+
+// A C entry point's message: `message` copied into error[0, size), cut to fit, NUL-terminated (the
+// plugin's entry points and ImageWriter.h's volref_check_output_path / volref_write_image).
+inline void copy_message(std::string_view message, char* error, std::size_t size) {
+    if (size == 0) return;
+    const std::size_t n = std::min(size - 1, message.size());
+    std::copy(message.begin(), message.begin() + std::ptrdiff_t(n), error);
+    error[n] = '\0';
+}
 
 }  // namespace volref::image_files
 

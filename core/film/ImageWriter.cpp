@@ -117,11 +117,7 @@ int with_message(F&& f, char* error, std::size_t size) {
         f();
         return 0;
     } catch (const std::exception& e) {
-        if (size > 0) {
-            const std::size_t n = std::min(size - 1, std::char_traits<char>::length(e.what()));
-            std::copy(e.what(), e.what() + n, error);
-            error[n] = '\0';
-        }
+        volref::image_files::copy_message(e.what(), error, size);
         return 1;
     }
 }

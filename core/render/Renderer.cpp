@@ -198,12 +198,14 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     }
     const int W = scene.image.width, H = scene.image.height;
 
+    // The channels beyond RGBA this render writes (asked once: each is a virtual call).
+    const bool depth = prepared.writes_depth(), error = prepared.writes_error(), fault = prepared.writes_fault();
     std::vector<std::string> channels{"R", "G", "B", "A"};
-    if (prepared.writes_depth()) channels.push_back("Z");
+    if (depth) channels.push_back("Z");
     const std::size_t error_channel = channels.size();
-    if (prepared.writes_error()) channels.push_back("error");
+    if (error) channels.push_back("error");
     const std::size_t fault_channel = channels.size();
-    if (prepared.writes_fault()) channels.push_back("fault");  // issue 28: 1 where the mirrored program does not finish
+    if (fault) channels.push_back("fault");  // issue 28: 1 where the mirrored program does not finish
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : tile_side(W, H, arena.max_concurrency());
@@ -238,9 +240,9 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
                         prepared.pixels(px, py, count, values, options.simd, scratch);  // Embree packets per volume
                         for (int i = 0; i < count; ++i) {
                             for (int c = 0; c < 4; ++c) image.at(px[i], py[i], std::size_t(c)) = values[i].rgba[c];
-                            if (prepared.writes_depth()) image.at(px[i], py[i], 4) = values[i].depth;
-                            if (prepared.writes_error()) image.at(px[i], py[i], error_channel) = values[i].error;
-                            if (prepared.writes_fault()) image.at(px[i], py[i], fault_channel) = values[i].fault ? 1.0 : 0.0;
+                            if (depth) image.at(px[i], py[i], 4) = values[i].depth;
+                            if (error) image.at(px[i], py[i], error_channel) = values[i].error;
+                            if (fault) image.at(px[i], py[i], fault_channel) = values[i].fault ? 1.0 : 0.0;
                         }
                     }
                 progress.tile_done();
@@ -258,7 +260,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     if (scene.render.profile != ProfileId::VtkJs) {
         for (int y = 0; y < H; ++y)
             for (int x = 0; x < W; ++x) {
-                if (prepared.writes_fault() && image.at(x, y, fault_channel) != 0.0) continue;
+                if (fault && image.at(x, y, fault_channel) != 0.0) continue;
                 for (std::size_t c = 0; c < 4; ++c)
                     if (std::isnan(image.at(x, y, c)))
                         throw Error("render: pixel (" + std::to_string(x) + ", " + std::to_string(y) +

@@ -361,9 +361,12 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
         }
     }
 
-    // The lanes in `stop` (opaque, terminated) take no more samples.
+    // The lanes in `stop` (opaque, terminated) take no more samples; `done` holds them as a mask for
+    // a step already placed and fetched before they stopped (the pipelined loop below).
+    M done = hn::FirstN(d, 0);
     auto retire = [&](M stop) HWY_ATTR {
         if (hn::AllFalse(d, stop)) return;
+        done = hn::Or(done, stop);
         hn::Store(hn::IfThenElseZero(stop, one), d, buf);
         for (std::size_t l = 0; l < L; ++l)
             if (buf[l] != T(0)) {
@@ -371,53 +374,82 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 packet.retire(l);
             }
     };
-    // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
-    V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
-    while (packet.next()) {
-        const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
-        const M alive = hn::Gt(hn::Load(d, packet.live), zero);
-        if constexpr (kFast) {
-            if (pre) {
-                const PreSample<T> s = pre_sample<T>(in, trilinear, Ox, Oy, Oz, Dx, Dy, Dz, t, seg, alive, prev_end, prev_value);
-                if (hn::AllFalse(d, s.visible)) continue;
-                const V alpha = segment_alpha<SL>(s.tau);
-                acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
-                const M stop = acc.stops(s.visible, in.termination);
-                retire(stop);
-                continue;
-            }
+    bool marched = false;
+    if constexpr (kFast) {
+      if (pre) {
+        marched = true;
+        // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
+        V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
+        while (packet.next()) {
+            const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
+            const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+            const PreSample<T> s = pre_sample<T>(in, trilinear, Ox, Oy, Oz, Dx, Dy, Dz, t, seg, alive, prev_end, prev_value);
+            if (hn::AllFalse(d, s.visible)) continue;
+            const V alpha = segment_alpha<SL>(s.tau);
+            acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
+            retire(acc.stops(s.visible, in.termination));
         }
-        const V P[3] = {hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz))};
-        const V v = trilinear(P[0], P[1], P[2]);
-        // Transfer function.
-        const V x = transfer_coordinate<T>(in, v);
-        const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x, opacity_reg);
-        V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, opacity_reg);
-        V g[3];
-        bool have_gradient = false;
-        if (in.gradient_opacity_rows > 0) {
-            // a = clamp(a factor(|grad f|), 0, 1)
-            gradient(P, v, g);
-            have_gradient = true;
-            const V glen = hn::Sqrt(dot3<SL>(g, g));
-            const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen, gradient_reg);
-            const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, gradient_reg);
-            a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
-        }
-        // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
-        if (hn::AllFalse(d, hn::And(alive, hn::Gt(a, zero)))) continue;
-        const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, l_unit);
-        {
-            const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x, color_reg);
-            V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, color_reg),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, color_reg),
-                      table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, color_reg)};
-            if (in.shaded) {
-                if (!have_gradient) gradient(P, v, g);
-                shade<T>(in, shading, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
+      }
+    }
+    if (!marched) {
+        // One step of every lane: its segment (midpoint t, length seg), the live lanes, the sample
+        // position and the reconstructed value.
+        struct Step {
+            V t, seg, P[3], v;
+            M alive;
+        };
+        auto fetch = [&](Step& s) HWY_ATTR {
+            if (!packet.next()) return false;
+            s.t = hn::Load(d, packet.tm);
+            s.seg = hn::Load(d, packet.len);
+            s.alive = hn::Gt(hn::Load(d, packet.live), zero);
+            s.P[0] = hn::Add(Ox, hn::Mul(s.t, Dx));
+            s.P[1] = hn::Add(Oy, hn::Mul(s.t, Dy));
+            s.P[2] = hn::Add(Oz, hn::Mul(s.t, Dz));
+            s.v = trilinear(s.P[0], s.P[1], s.P[2]);
+            return true;
+        };
+        // Pipelined by one step: the next step is placed and its voxels fetched before this step is
+        // classified and composited, so that the fetch's latency overlaps this step's work (the
+        // branches below depend on the values). A lane that stops in this step has its next step
+        // fetched already; `done` masks it out. Each lane takes the same samples in the same order.
+        Step cur, nxt;
+        bool have = fetch(cur);
+        while (have) {
+            const bool have_next = fetch(nxt);
+            const M alive = hn::AndNot(done, cur.alive);
+            const V v = cur.v, t = cur.t;
+            // Transfer function.
+            const V x = transfer_coordinate<T>(in, v);
+            const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in.opacity_rows, x, opacity_reg);
+            V a = table_channel(d, ot, tab.opacity_y, in.opacity_rows, 1, 0, opacity_reg);
+            V g[3];
+            bool have_gradient = false;
+            if (in.gradient_opacity_rows > 0) {
+                // a = clamp(a factor(|grad f|), 0, 1)
+                gradient(cur.P, v, g);
+                have_gradient = true;
+                const V glen = hn::Sqrt(dot3<SL>(g, g));
+                const TableLookup<T> gt = locate_rows(d, tab.gradient_opacity_x, in.gradient_opacity_rows, glen, gradient_reg);
+                const V factor = table_channel(d, gt, tab.gradient_opacity_y, in.gradient_opacity_rows, 1, 0, gradient_reg);
+                a = hn::Min(hn::Max(hn::Mul(a, factor), zero), one);
             }
-            acc.add(o.visible, o.solid, o.tau, o.alpha, m);
-            retire(hn::Or(o.solid, acc.stops(o.partial, in.termination)));
+            // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
+            if (!hn::AllFalse(d, hn::And(alive, hn::Gt(a, zero)))) {
+                const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, cur.seg, l_unit);
+                const TableLookup<T> ct = locate_rows(d, tab.color_x, in.color_rows, x, color_reg);
+                V m[3] = {table_channel(d, ct, tab.color_y, in.color_rows, 3, 0, color_reg),
+                          table_channel(d, ct, tab.color_y, in.color_rows, 3, 1, color_reg),
+                          table_channel(d, ct, tab.color_y, in.color_rows, 3, 2, color_reg)};
+                if (in.shaded) {
+                    if (!have_gradient) gradient(cur.P, v, g);
+                    shade<T>(in, shading, m, g, view, kFast ? hn::Add(t, t_ref) : t);  // depth: the world t
+                }
+                acc.add(o.visible, o.solid, o.tau, o.alpha, m);
+                retire(hn::Or(o.solid, acc.stops(o.partial, in.termination)));
+            }
+            cur = nxt;
+            have = have_next;
         }
     }
     {

@@ -593,10 +593,16 @@ struct PacketTrilinearT {
                 if (pairs) {
                     // x-neighbours f(i, j, k), f(i + 1, j, k) as one 64-bit load: four fetches of
                     // pairs instead of eight gathers (Levoy's order: f1 f2, f4 f3, f5 f6, f8 f7).
-                    x_pair(p, idx, f[0], f[1]);
-                    x_pair(p, hn::Add(idx, offy32), f[3], f[2]);
-                    x_pair(p, hn::Add(idx, offz32), f[4], f[5]);
-                    x_pair(p, hn::Add(hn::Add(idx, offz32), offy32), f[7], f[6]);
+                    // The lanes' indices stored once; the four rows of a cell are the same indices
+                    // from four base pointers (p, p + ny, p + nz, p + ny + nz: the offsets are per grid),
+                    // so each lane's index is read once, not once per row.
+                    HWY_ALIGN std::uint32_t ix[RayPacketT<T>::kLanes];
+                    hn::Store(hn::BitCast(DU32(), idx), DU32(), ix);
+                    const std::int32_t oy = hn::GetLane(offy32), oz = hn::GetLane(offz32);
+                    x_pair(p, ix, f[0], f[1]);
+                    x_pair(p + oy, ix, f[3], f[2]);
+                    x_pair(p + oz, ix, f[4], f[5]);
+                    x_pair(p + oz + oy, ix, f[7], f[6]);
                     break;
                 }
                 eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(df32, p, i)); }, f);
@@ -629,16 +635,12 @@ struct PacketTrilinearT {
     // (load_pairs: the halves joined by Combine, no round trip through memory), then split into even
     // and odd floats (promoted on double lanes). Plain loads, not gather instructions: gathers are microcoded on AMD's CPUs (the
     // speed-limit note; here 5% faster on the fast profile's benchmark frame than 64-bit gathers).
-    HWY_INLINE void x_pair(const float* p, hn::Vec<DI32> idx, V& first, V& second) const {
+    HWY_INLINE void x_pair(const float* p, const std::uint32_t* ix, V& first, V& second) const {
         const D d;
 #if HWY_TARGET == HWY_SCALAR
-        (void)p, (void)idx, (void)d;  // pairs is false on the scalar target
+        (void)p, (void)ix, (void)d;  // pairs is false on the scalar target
         first = second = V();
 #else
-        constexpr std::size_t kMax = RayPacketT<T>::kLanes;
-        // The indices as unsigned (they are >= 0): a 32-bit move zero-extends them, no sign extension.
-        HWY_ALIGN std::uint32_t ix[kMax];
-        hn::Store(hn::BitCast(DU32(), idx), DU32(), ix);
         const std::size_t n = hn::Lanes(d);
         if constexpr (kFloat) {
             const V lo = load_pairs(d, p, ix);  // p[i0] p[i0 + 1] p[i1] ...

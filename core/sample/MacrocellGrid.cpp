@@ -129,6 +129,14 @@ std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii() const {
     return out;
 }
 
+std::size_t MacrocellGrid::bytes_for(const std::int64_t dims[3], bool octant_radii) {
+    constexpr std::int64_t M = conventions::kMacrocellSize;
+    std::size_t count = 1;
+    for (int a = 0; a < 3; ++a) count *= std::size_t((std::max<std::int64_t>(dims[a] - 1, 1) + M - 1) / M);
+    const std::size_t per = sizeof(std::array<double, 2>) + 2 + sizeof(std::int64_t) + 1 + (octant_radii ? 8 * sizeof(std::int32_t) : 0);
+    return count * per;
+}
+
 std::vector<std::int32_t> MacrocellGrid::octant_radii() const {
     const std::size_t total = empty_.size();
     constexpr std::int64_t far = kMaxEmptyRadius;

@@ -45,6 +45,11 @@ public:
 
     // Macrocells per axis: ceil(cells / M), cells = max(n - 1, 1).
     const Index& counts() const { return counts_; }
+    // At most the bytes a grid over a volume of `dims` voxels takes (for --max-memory, before it is
+    // built): per macrocell its range (16), empty flag and empty radius (1 + 1) and the construction's
+    // transient distance field (8 + 1); with `octant_radii`, the composite packets' 8 signed radii (32,
+    // the copy CompositeIntegrator holds).
+    static std::size_t bytes_for(const std::int64_t dims[3], bool octant_radii);
     std::int64_t empty_count() const { return empty_count_; }
     // [min, max] of the voxels the samples in macrocell m read ([-inf, +inf] if one is not finite).
     std::array<double, 2> range(const Index& m) const { return ranges_[linear(m)]; }

@@ -21,6 +21,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/render/Renderer.h"
+#include "core/sample/MacrocellGrid.h"
 #include "geometry/TriangleMesh.h"
 
 namespace fs = std::filesystem;
@@ -166,6 +167,27 @@ TEST(MemoryLimit, RefusesAnImageAndAGradientCache) {
     EXPECT_NE(error_of([&] { render_scene(s); }).find("volume.gradient.cache"), std::string::npos);
     set_memory_limit(400'000);
     EXPECT_NO_THROW(render_scene(s));
+}
+
+// The macrocell grid of empty-space skipping is counted before it is built: 21 x 19 x 23 voxels are
+// 20 x 18 x 22 cells, ceil(/ 8) = 3 x 3 x 3 = 27 macrocells of 16 (range) + 2 (flag, radius) + 9 (the
+// construction's distance field) + 32 (the composite packets' 8 radii) = 59 bytes: 1593 bytes.
+TEST(MemoryLimit, CountsTheMacrocellGrid) {
+    MemoryLimitGuard guard;
+    const std::int64_t dims[3] = {21, 19, 23};
+    EXPECT_EQ(MacrocellGrid::bytes_for(dims, true), 27u * 59u);
+    EXPECT_EQ(MacrocellGrid::bytes_for(dims, false), 27u * 27u);
+    Scene s = ml_scene();
+    s.image.width = s.image.height = 8;
+    const std::size_t volume = 21 * 19 * 23 * sizeof(double), image = 8 * 8 * 6 * sizeof(double), grid = 27 * 59;
+    set_memory_limit(volume + image + grid - 1);
+    EXPECT_NE(error_of([&] { render_scene(s); }).find("volume: the macrocell grid of empty-space skipping"), std::string::npos)
+        << error_of([&] { render_scene(s); });
+    set_memory_limit(volume + image + grid);
+    EXPECT_NO_THROW(render_scene(s));
+    // Without skipping no grid is built, so nothing is asked for it.
+    set_memory_limit(volume + image + grid - 1);
+    EXPECT_NO_THROW(render_scene(s, {.empty_space_skipping = false}));
 }
 
 TEST_F(Robustness, MaxMemoryOnTheCommandLine) {

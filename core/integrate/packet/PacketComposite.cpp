@@ -374,24 +374,21 @@ void composite_lanes(const PacketCompositeInputs& in, const Ray* rays, const std
                 packet.retire(l);
             }
     };
-    bool marched = false;
-    if constexpr (kFast) {
-      if (pre) {
-        marched = true;
-        // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
-        V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
-        while (packet.next()) {
-            const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
-            const M alive = hn::Gt(hn::Load(d, packet.live), zero);
-            const PreSample<T> s = pre_sample<T>(in, trilinear, Ox, Oy, Oz, Dx, Dy, Dz, t, seg, alive, prev_end, prev_value);
-            if (hn::AllFalse(d, s.visible)) continue;
-            const V alpha = segment_alpha<SL>(s.tau);
-            acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
-            retire(acc.stops(s.visible, in.termination));
+    if (pre) {
+        if constexpr (kFast) {  // (pre is false on double lanes)
+            // Pre-integrated segments: each lane's last segment's back end (t, -inf before the first) and value.
+            V prev_end = hn::Set(d, -std::numeric_limits<T>::infinity()), prev_value = zero;
+            while (packet.next()) {
+                const V t = hn::Load(d, packet.tm), seg = hn::Load(d, packet.len);
+                const M alive = hn::Gt(hn::Load(d, packet.live), zero);
+                const PreSample<T> s = pre_sample<T>(in, trilinear, Ox, Oy, Oz, Dx, Dy, Dz, t, seg, alive, prev_end, prev_value);
+                if (hn::AllFalse(d, s.visible)) continue;
+                const V alpha = segment_alpha<SL>(s.tau);
+                acc.add(s.visible, hn::FirstN(d, 0), s.tau, alpha, s.colour);  // never solid: a < 1
+                retire(acc.stops(s.visible, in.termination));
+            }
         }
-      }
-    }
-    if (!marched) {
+    } else {
         // One step of every lane: its segment (midpoint t, length seg), the live lanes, the sample
         // position and the reconstructed value.
         struct Step {

@@ -278,23 +278,20 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     // The macrocell grid of empty-space skipping, kept only if some macrocell is empty; for mip and
     // minip (the fixed step's SIMD path), the grid's value bounds (SegmentWalk.h, extremum mode).
     // The grid's bytes (MacrocellGrid::bytes_for, an upper bound; with the composite packets' radii)
-    // are checked before it is built.
-    auto check_macrocells = [&](bool octant_radii) {
-        const std::size_t grid_bytes = MacrocellGrid::bytes_for(volume.dims.data(), octant_radii);
-        check_memory(held_bytes + bytes + image_bytes + grid_bytes, key + ": the macrocell grid of empty-space skipping");
-        bytes += grid_bytes;
-        return grid_bytes;
+    // are checked before it is built and counted while it is kept.
+    auto grid_bytes = [&](bool octant_radii) {
+        const std::size_t b = MacrocellGrid::bytes_for(volume.dims.data(), octant_radii);
+        check_memory(held_bytes + bytes + image_bytes + b, key + ": the macrocell grid of empty-space skipping");
+        return b;
     };
     if (options.empty_space_skipping && skipping_applies(vs, scene.render, *classifier, volume)) {
-        const std::size_t grid_bytes = check_macrocells(is_composite(scene.render.projection));
+        const std::size_t b = grid_bytes(is_composite(scene.render.projection));
         macrocells = std::make_unique<MacrocellGrid>(
             *model.cartesian, *classifier, preclassified ? MacrocellGrid::Classification::Pre : MacrocellGrid::Classification::Post);
-        if (macrocells->empty_count() == 0) {
-            macrocells.reset();
-            bytes -= grid_bytes;
-        }
+        if (macrocells->empty_count() == 0) macrocells.reset();
+        else bytes += b;
     } else if (options.empty_space_skipping && extremum_skipping_applies(vs, scene.render, options, model.cartesian.get())) {
-        check_macrocells(false);
+        bytes += grid_bytes(false);
         macrocells = std::make_unique<MacrocellGrid>(*model.cartesian, *classifier, MacrocellGrid::Classification::Post);
     }
 

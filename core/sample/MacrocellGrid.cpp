@@ -33,10 +33,8 @@ std::array<double, 2> MacrocellGrid::reconstruction_bounds(Interpolation interpo
 MacrocellGrid::MacrocellGrid(const VolumeSampler& sampler, const Classifier& classifier, Classification classification)
     : sampler_(sampler) {
     const Volume& v = sampler.volume();
-    for (int a = 0; a < 3; ++a) {
-        cells_[a] = std::max<std::int64_t>(v.dims[a] - 1, 1);
-        counts_[a] = (cells_[a] + M - 1) / M;
-    }
+    for (int a = 0; a < 3; ++a) cells_[a] = std::max<std::int64_t>(v.dims[a] - 1, 1);
+    counts_ = counts_for(v.dims.data());
     apron_ = sampler.is_tricubic() ? 1 : 0;
     const std::size_t total = std::size_t(counts_[0] * counts_[1] * counts_[2]);
     ranges_.resize(total);
@@ -129,12 +127,18 @@ std::vector<std::uint8_t> MacrocellGrid::chebyshev_radii() const {
     return out;
 }
 
+MacrocellGrid::Index MacrocellGrid::counts_for(const std::int64_t dims[3]) {
+    Index counts;
+    for (int a = 0; a < 3; ++a) counts[a] = (std::max<std::int64_t>(dims[a] - 1, 1) + M - 1) / M;
+    return counts;
+}
+
 std::size_t MacrocellGrid::bytes_for(const std::int64_t dims[3], bool octant_radii) {
-    constexpr std::int64_t M = conventions::kMacrocellSize;
-    std::size_t count = 1;
-    for (int a = 0; a < 3; ++a) count *= std::size_t((std::max<std::int64_t>(dims[a] - 1, 1) + M - 1) / M);
-    const std::size_t per = sizeof(std::array<double, 2>) + 2 + sizeof(std::int64_t) + 1 + (octant_radii ? 8 * sizeof(std::int32_t) : 0);
-    return count * per;
+    const Index c = counts_for(dims);
+    // ranges_, empty_, empty_radius_; chebyshev_radii's distance field and result while it runs.
+    std::size_t per = sizeof(std::array<double, 2>) + sizeof(unsigned char) + sizeof(std::uint8_t) + sizeof(std::int64_t) + sizeof(std::uint8_t);
+    if (octant_radii) per += 8 * sizeof(std::int32_t);
+    return std::size_t(c[0] * c[1] * c[2]) * per;
 }
 
 std::vector<std::int32_t> MacrocellGrid::octant_radii() const {

@@ -45,6 +45,8 @@ public:
 
     // Macrocells per axis: ceil(cells / M), cells = max(n - 1, 1).
     const Index& counts() const { return counts_; }
+    // The same for a volume of `dims` voxels (the one formula, also before a grid is built).
+    static Index counts_for(const std::int64_t dims[3]);
     // At most the bytes a grid over a volume of `dims` voxels takes (for --max-memory, before it is
     // built): per macrocell its range (16), empty flag and empty radius (1 + 1) and the construction's
     // transient distance field (8 + 1); with `octant_radii`, the composite packets' 8 signed radii (32,

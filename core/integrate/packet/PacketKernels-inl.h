@@ -479,6 +479,7 @@ struct PacketTrilinearT {
     V nx, nxy;
     hn::Vec<DI> offx, offy, offz;
     hn::Vec<DI32> offx32, offy32, offz32, nx32, nxy32;
+    std::int32_t row_y = 0, row_z = 0;  // offy32, offz32 as numbers: the pairs' rows (corners)
 
     PacketTrilinearT() = default;  // unset: assigned before use
     PacketTrilinearT(const void* data, ScalarType data_type, const std::int64_t dims[3], const double origin[3],
@@ -507,6 +508,8 @@ struct PacketTrilinearT {
         offx32 = hn::Set(di32, std::int32_t(fits32 ? (flat[0] ? 0 : 1) * unit : 0));
         offy32 = hn::Set(di32, std::int32_t(fits32 ? (flat[1] ? 0 : dims[0]) * unit : 0));
         offz32 = hn::Set(di32, std::int32_t(fits32 ? (flat[2] ? 0 : dims[0] * dims[1]) * unit : 0));
+        row_y = hn::GetLane(offy32);
+        row_z = hn::GetLane(offz32);
         nx32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] : 0));
         nxy32 = hn::Set(di32, std::int32_t(fits32 ? dims[0] * dims[1] : 0));
         constexpr bool little = std::endian::native == std::endian::little;
@@ -593,16 +596,16 @@ struct PacketTrilinearT {
                 if (pairs) {
                     // x-neighbours f(i, j, k), f(i + 1, j, k) as one 64-bit load: four fetches of
                     // pairs instead of eight gathers (Levoy's order: f1 f2, f4 f3, f5 f6, f8 f7).
-                    // The lanes' indices stored once; the four rows of a cell are the same indices
-                    // from four base pointers (p, p + ny, p + nz, p + ny + nz: the offsets are per grid),
-                    // so each lane's index is read once, not once per row.
+                    // The lanes' indices stored once (as unsigned: they are >= 0, so a 32-bit move
+                    // zero-extends them); the four rows of a cell are the same indices from four base
+                    // pointers (p, p + n_x, p + n_x n_y, p + n_x + n_x n_y), so each lane's index is
+                    // read once, not once per row.
                     HWY_ALIGN std::uint32_t ix[RayPacketT<T>::kLanes];
                     hn::Store(hn::BitCast(DU32(), idx), DU32(), ix);
-                    const std::int32_t oy = hn::GetLane(offy32), oz = hn::GetLane(offz32);
                     x_pair(p, ix, f[0], f[1]);
-                    x_pair(p + oy, ix, f[3], f[2]);
-                    x_pair(p + oz, ix, f[4], f[5]);
-                    x_pair(p + oz + oy, ix, f[7], f[6]);
+                    x_pair(p + row_y, ix, f[3], f[2]);
+                    x_pair(p + row_z, ix, f[4], f[5]);
+                    x_pair(p + row_z + row_y, ix, f[7], f[6]);
                     break;
                 }
                 eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(df32, p, i)); }, f);
@@ -630,7 +633,7 @@ struct PacketTrilinearT {
         }
     }
 
-    // f32 voxels: the floats p[i] and p[i + 1] for each lane's index i (in floats), each pair read as
+    // f32 voxels: the floats p[i] and p[i + 1] for each lane l's index i = ix[l] (in floats), each pair read as
     // one 64-bit load (little-endian: the lower half is p[i]) straight into a vector's 64-bit part
     // (load_pairs: the halves joined by Combine, no round trip through memory), then split into even
     // and odd floats (promoted on double lanes). Plain loads, not gather instructions: gathers are microcoded on AMD's CPUs (the

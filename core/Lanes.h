@@ -2,7 +2,7 @@
 // Accumulators.h), so that each formula is written once and instantiated for every lane type the
 // renderer uses: ScalarLanes<double> (the scalar reference path, traces, the adaptive integrator, the
 // mirror profiles) here, and SimdLanes<double> / SimdLanes<float> (Highway vectors: the packet path
-// and the fast profile) in core/integrate/packet/SimdLanes-inl.h, which supply the same names.
+// and the fast profile) in core/SimdLanes-inl.h, which supply the same names.
 //
 // A lane type L provides V (a value per lane), M (a mask per lane) and, on them:
 //   splat(x), all_lanes(), no_lanes(), select(m, a, b), select_zero(m, a), and_(a, b), or_(a, b), and_not(a, b) = !a && b,

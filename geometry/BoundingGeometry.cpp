@@ -10,6 +10,7 @@
 #include "core/Conventions.h"
 #include "core/Error.h"
 #include "geometry/BoxIntersection.h"
+#include "geometry/BoxIntervals.h"
 #include "geometry/MeshIntervals.h"
 #include "geometry/ShellIntersection.h"
 
@@ -22,6 +23,7 @@ struct BoxShape {
     glm::dvec3 domain_lo, domain_hi;
     int volume_id;
     bool is_domain = false;  // lo, hi = domain_lo, domain_hi
+    BoxShapeBounds bounds;   // the same as arrays, for the slab test's lanes (BoxIntersection-inl.h)
 };
 
 struct MeshShape {
@@ -94,13 +96,12 @@ void box_bounds(const RTCBoundsFunctionArguments* args) {
 
 // The ray's interval in the box AND its domain, in front of the origin (t >= 0), if not empty.
 // A box that is its domain (the usual case) takes one slab test: the second would repeat the first.
+// (box_shape_lanes, BoxIntersection-inl.h; box_shape_intervals for many rays at once.)
 bool box_interval(const BoxShape& box, const Ray& ray, Interval& out) {
-    Interval shape, domain;
-    if (!intersect_box(ray, box.lo, box.hi, shape)) return false;
-    if (box.is_domain) domain = shape;
-    else if (!intersect_box(ray, box.domain_lo, box.domain_hi, domain)) return false;
-    out = Interval{std::max({shape.t0, domain.t0, 0.0}), std::min(shape.t1, domain.t1)};
-    return out.t1 > out.t0;
+    const BoxShapeBounds& b = box.bounds;
+    const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+    return box_shape_lanes<Scalar>(o, d, b.lo, b.hi, b.is_domain ? nullptr : b.domain_lo, b.is_domain ? nullptr : b.domain_hi,
+                                   out.t0, out.t1);
 }
 
 void box_intersect(const RTCIntersectFunctionNArguments* args) {
@@ -236,7 +237,15 @@ BoundingGeometry::~BoundingGeometry() {
 int BoundingGeometry::add_box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& domain_lo,
                               const glm::dvec3& domain_hi) {
     const int id = impl_->next_id();
-    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id, lo == domain_lo && hi == domain_hi}));
+    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id, lo == domain_lo && hi == domain_hi, {}}));
+    BoxShapeBounds& b = impl_->boxes.back()->bounds;
+    for (int a = 0; a < 3; ++a) {
+        b.lo[a] = lo[a];
+        b.hi[a] = hi[a];
+        b.domain_lo[a] = domain_lo[a];
+        b.domain_hi[a] = domain_hi[a];
+    }
+    b.is_domain = impl_->boxes.back()->is_domain;
     impl_->attach(1, impl_->boxes.back().get(), box_bounds, box_intersect, "adding a box");
     impl_->volume_mesh.push_back(nullptr);
     impl_->volume_box.push_back(impl_->boxes.back().get());
@@ -358,10 +367,7 @@ void BoundingGeometry::intervals(const Ray* rays, int count, int volume_id, std:
     // A box needs no Embree query: its one interval is the slab test box_intersect would run (Embree's
     // float bounds are padded, so it calls box_intersect for every ray the double test can hit).
     if (const BoxShape* box = impl_->volume_box[v]) {
-        for (int i = 0; i < count; ++i) {
-            Interval iv;
-            if (box_interval(*box, rays[i], iv)) out[i].push_back(iv);
-        }
+        box_shape_intervals(box->bounds, rays, count, out);
         return;
     }
     thread_local RayRecord records[kPacket];

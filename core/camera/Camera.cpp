@@ -8,8 +8,14 @@
 #include <glm/matrix.hpp>
 
 #include "core/Conventions.h"
+#include "core/Lanes.h"
 
 namespace volref {
+
+#include "core/camera/CameraRay-inl.h"
+
+// CameraRays.cpp: the same rays on SIMD lanes.
+void camera_pixel_rays(const CameraRayConstants& k, const int* x, const int* y, int count, Ray* out);
 
 namespace {
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
@@ -33,14 +39,25 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
     switch (s.type) {
         case CameraSpec::Type::Perspective:
         case CameraSpec::Type::Orthographic:
+        {
             kind_ = s.type == CameraSpec::Type::Perspective ? Kind::Perspective : Kind::Orthographic;
-            eye_ = s.eye;
-            forward_ = glm::normalize(s.target - s.eye);
-            right_ = glm::normalize(glm::cross(forward_, s.up));
-            up_ = glm::cross(right_, forward_);
-            tan_half_fov_ = std::tan(radians(s.fov_y) / 2.0);
-            half_height_ = s.height / 2.0;
+            const glm::dvec3 forward = glm::normalize(s.target - s.eye);
+            const glm::dvec3 right = glm::normalize(glm::cross(forward, s.up));
+            const glm::dvec3 up = glm::cross(right, forward);
+            rays_.perspective = kind_ == Kind::Perspective;
+            rays_.width = double(width);
+            rays_.height = double(height);
+            rays_.aspect = aspect_;
+            rays_.tan_half_fov = std::tan(radians(s.fov_y) / 2.0);
+            rays_.half_height = s.height / 2.0;
+            for (int a = 0; a < 3; ++a) {
+                rays_.eye[a] = s.eye[a];
+                rays_.forward[a] = forward[a];
+                rays_.right[a] = right[a];
+                rays_.up[a] = up[a];
+            }
             break;
+        }
         default:
             kind_ = Kind::Matrices;
             view_ = s.view;
@@ -50,20 +67,26 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
     }
 }
 
+glm::dvec2 Camera::ndc(double fx, double fy) const {
+    glm::dvec2 n;
+    camera_ndc_lanes<Scalar>(double(width_), double(height_), fx, fy, n.x, n.y);
+    return n;
+}
+
 Ray Camera::ray(double fx, double fy) const {
-    const glm::dvec2 device = ndc(fx, fy);
-    const double nx = device.x, ny = device.y;
     Ray r;
     switch (kind_) {
         case Kind::Perspective:
-            r.origin = eye_;
-            r.direction = glm::normalize(forward_ + (nx * tan_half_fov_ * aspect_) * right_ + (ny * tan_half_fov_) * up_);
+        case Kind::Orthographic: {
+            double o[3], d[3];
+            camera_ray_lanes<Scalar>(rays_, fx, fy, o, d);
+            r.origin = {o[0], o[1], o[2]};
+            r.direction = {d[0], d[1], d[2]};
             break;
-        case Kind::Orthographic:
-            r.origin = eye_ + (nx * half_height_ * aspect_) * right_ + (ny * half_height_) * up_;
-            r.direction = forward_;
-            break;
+        }
         case Kind::Matrices: {
+            const glm::dvec2 device = ndc(fx, fy);
+            const double nx = device.x, ny = device.y;
             const glm::dvec4 n4 = inverse_view_projection_ * glm::dvec4(nx, ny, -1.0, 1.0);
             const glm::dvec4 f4 = inverse_view_projection_ * glm::dvec4(nx, ny, 1.0, 1.0);
             const glm::dvec3 n = glm::dvec3(n4) / n4.w, f = glm::dvec3(f4) / f4.w;
@@ -80,6 +103,14 @@ Ray Camera::ray(double fx, double fy) const {
 
 Ray Camera::pixel_ray(int x, int y) const {
     return ray(double(x) + conventions::kPixelCentre, double(y) + conventions::kPixelCentre);
+}
+
+void Camera::pixel_rays(const int* x, const int* y, int count, Ray* out) const {
+    if (kind_ == Kind::Matrices) {
+        for (int i = 0; i < count; ++i) out[i] = pixel_ray(x[i], y[i]);
+        return;
+    }
+    camera_pixel_rays(rays_, x, y, count, out);
 }
 
 }  // namespace volref

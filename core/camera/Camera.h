@@ -26,6 +26,14 @@
 
 namespace volref {
 
+// The constants of the perspective and orthographic cameras' rays (CameraRay-inl.h's formula).
+struct CameraRayConstants {
+    bool perspective = true;  // else orthographic
+    double width = 1.0, height = 1.0, aspect = 1.0;
+    double tan_half_fov = 0.0, half_height = 0.0;
+    double eye[3] = {}, forward[3] = {}, right[3] = {}, up[3] = {};
+};
+
 class Camera {
 public:
     // `bounds_min`/`bounds_max` are used by the default camera only.
@@ -35,17 +43,17 @@ public:
     // The ray through film point (fx, fy) (pixel centres at integer + 0.5).
     Ray ray(double fx, double fy) const;
     Ray pixel_ray(int x, int y) const;
+    // pixel_ray(x[i], y[i]) for i < count, the same rays; on SIMD lanes for the perspective and
+    // orthographic cameras (CameraRays.cpp).
+    void pixel_rays(const int* x, const int* y, int count, Ray* out) const;
     // The normalised device coordinates (nx, ny) of film point (fx, fy) that ray() uses.
-    glm::dvec2 ndc(double fx, double fy) const {
-        return {2.0 * fx / double(width_) - 1.0, 1.0 - 2.0 * fy / double(height_)};
-    }
+    glm::dvec2 ndc(double fx, double fy) const;
 
 private:
     enum class Kind { Perspective, Orthographic, Matrices } kind_;
     int width_, height_;
     double aspect_;
-    glm::dvec3 eye_{0.0}, forward_{0.0}, right_{0.0}, up_{0.0};
-    double tan_half_fov_ = 0.0, half_height_ = 0.0;
+    CameraRayConstants rays_;  // perspective and orthographic
     glm::dmat4 inverse_view_projection_{1.0}, inverse_view_{1.0}, view_{1.0};
 };
 

@@ -43,7 +43,7 @@ void PreparedScene::pixels(const int* x, const int* y, int count, PixelValue* ou
         return;
     }
     Ray rays[kMaxPacketRays];
-    for (int i = 0; i < count; ++i) rays[i] = camera->pixel_ray(x[i], y[i]);
+    camera->pixel_rays(x, y, count, rays);
     integrate(rays, count, out, simd, scratch);
 }
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
@@ -87,4 +88,56 @@ TEST(Camera, DefaultFitsTheBoundingSphere) {
     EXPECT_NEAR(r.origin.y, 1.0, 1e-15);
     EXPECT_NEAR(r.origin.z, 1.0 + d, 1e-13);
     EXPECT_NEAR(r.direction.z, -1.0, 1e-15);
+}
+
+// Camera::pixel_rays (SIMD lanes for the perspective and orthographic cameras, CameraRays.cpp) gives
+// each pixel the ray of Camera::pixel_ray, and both give the rays of the formula of conventions section
+// 10 evaluated here with glm, as the camera did before its lane template (the second method: glm's
+// normalize is v * (1 / sqrt(dot(v, v)))), bit for bit; for batches of every length up to 40 and an
+// oblique camera (no zero component), including the matrices camera (one by one).
+TEST(Camera, PixelRaysAreTheFormulaBitForBit) {
+    CameraSpec p;
+    p.type = CameraSpec::Type::Perspective;
+    p.eye = {7.25, -3.5, 11.0};
+    p.target = {0.3, 0.2, -0.1};
+    p.up = {0.1, 0.2, 1.0};
+    p.fov_y = 37;
+    CameraSpec o = p;
+    o.type = CameraSpec::Type::Orthographic;
+    o.height = 9.5;
+    CameraSpec m;
+    m.type = CameraSpec::Type::Matrices;
+    m.view = glm::lookAt(p.eye, p.target, p.up);
+    m.projection = glm::perspective(p.fov_y * std::numbers::pi / 180.0, 13.0 / 7.0, 0.1, 100.0);
+    const int W = 13, H = 7;
+    for (const CameraSpec& spec : {p, o, m}) {
+        const Camera cam(spec, W, H, glm::dvec3(0), glm::dvec3(1));
+        // The formula with glm.
+        const glm::dvec3 f = glm::normalize(spec.target - spec.eye), r = glm::normalize(glm::cross(f, spec.up)),
+                         u = glm::cross(r, f);
+        const double aspect = double(W) / double(H), tan_half = std::tan(spec.fov_y * std::numbers::pi / 180.0 / 2.0);
+        std::vector<int> xs, ys;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) xs.push_back(x), ys.push_back(y);
+        for (int first = 0; first + 40 <= int(xs.size()); first += 17)
+            for (int count = 1; count <= 40; ++count) {
+                std::vector<Ray> rays(static_cast<std::size_t>(count));
+                cam.pixel_rays(xs.data() + first, ys.data() + first, count, rays.data());
+                for (int i = 0; i < count; ++i) {
+                    const int x = xs[std::size_t(first + i)], y = ys[std::size_t(first + i)];
+                    const Ray one = cam.pixel_ray(x, y);
+                    EXPECT_EQ(rays[std::size_t(i)].origin, one.origin);
+                    EXPECT_EQ(rays[std::size_t(i)].direction, one.direction);
+                    if (spec.type == CameraSpec::Type::Matrices) continue;
+                    const double nx = 2.0 * (x + 0.5) / double(W) - 1.0, ny = 1.0 - 2.0 * (y + 0.5) / double(H);
+                    if (spec.type == CameraSpec::Type::Perspective) {
+                        EXPECT_EQ(one.origin, spec.eye);
+                        EXPECT_EQ(one.direction, glm::normalize(f + (nx * tan_half * aspect) * r + (ny * tan_half) * u));
+                    } else {
+                        EXPECT_EQ(one.origin, spec.eye + (nx * (spec.height / 2.0) * aspect) * r + (ny * (spec.height / 2.0)) * u);
+                        EXPECT_EQ(one.direction, f);
+                    }
+                }
+            }
+    }
 }

@@ -1,7 +1,12 @@
 // Ray intervals through Embree against hand-computed chords.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
+#include <utility>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -82,4 +87,78 @@ TEST(RayIntervals, NormalizeSortsAndMerges) {
     EXPECT_EQ(v[0].t1, 4.0);
     EXPECT_EQ(v[1].t0, 5.0);
     EXPECT_EQ(v[1].t1, 6.0);
+}
+
+// Many rays at once (BoundingGeometry::intervals over a batch: SIMD lanes, BoxIntervals.cpp) give
+// each ray the interval that a plain slab test written out here gives it (the second method: std::max /
+// std::min and an early return per axis, as the scalar code was before the lane template), bit for bit;
+// batches of every length up to 37 (not multiples of the lanes), directions parallel to faces, origins
+// inside, boxes behind, and a box that is not its domain.
+namespace {
+bool plain_slab_test(const glm::dvec3& lo, const glm::dvec3& hi, const Ray& ray, double& t0, double& t1) {
+    t0 = -std::numeric_limits<double>::infinity();
+    t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        const double o = ray.origin[a], d = ray.direction[a];
+        if (d == 0.0) {
+            if (o < lo[a] || o > hi[a]) return false;
+            continue;
+        }
+        double ta = (lo[a] - o) / d, tb = (hi[a] - o) / d;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 <= t1;
+}
+}  // namespace
+
+TEST(BoxIntervals, BatchesAreThePlainSlabTestRayByRay) {
+    const glm::dvec3 lo(-3, -2, -1), hi(4, 5, 6), dlo(-1, -1, -1), dhi(2, 3, 4);
+    BoundingGeometry g;
+    const int own = g.add_box(lo, hi, lo, hi);      // the box is its domain
+    const int clipped = g.add_box(lo, hi, dlo, dhi);  // the domain inside the box
+    g.commit();
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> pos(-12.0, 12.0), dir(-1.0, 1.0);
+    std::uniform_int_distribution<int> kind(0, 5);
+    std::vector<Ray> rays(37);
+    int hits = 0, parallel = 0;
+    for (int round = 0; round < 40; ++round) {
+        for (Ray& r : rays) {
+            r.origin = {pos(rng), pos(rng), pos(rng)};
+            glm::dvec3 d(dir(rng), dir(rng), dir(rng));
+            const int k = kind(rng);  // some directions parallel to one or two faces' axes
+            if (k < 3) d[k] = 0.0;
+            if (k == 3) d[0] = d[1] = 0.0;
+            if (k == 4) r.origin = {0.5, 1.0, 1.5};  // inside both
+            r.direction = glm::normalize(d);
+        }
+        for (int count = 1; count <= int(rays.size()); count += 1 + round % 5)
+            for (int id : {own, clipped}) {
+                std::vector<std::vector<Interval>> out(std::size_t(count), std::vector<Interval>(1, Interval{-7, -7}));
+                g.intervals(rays.data(), count, id, out.data());
+                for (int i = 0; i < count; ++i) {
+                    const Ray& r = rays[std::size_t(i)];
+                    double s0, s1, e0, e1;
+                    bool hit = plain_slab_test(lo, hi, r, s0, s1);
+                    if (id == clipped) hit = hit && plain_slab_test(dlo, dhi, r, e0, e1);
+                    else e0 = s0, e1 = s1;
+                    const double t0 = std::max({s0, e0, 0.0}), t1 = std::min(s1, e1);
+                    hit = hit && t1 > t0;
+                    parallel += r.direction.x == 0.0 || r.direction.y == 0.0 || r.direction.z == 0.0;
+                    SCOPED_TRACE(testing::Message() << "round " << round << " count " << count << " ray " << i);
+                    if (!hit) {
+                        EXPECT_TRUE(out[std::size_t(i)].empty());
+                        continue;
+                    }
+                    ++hits;
+                    ASSERT_EQ(out[std::size_t(i)].size(), 1u);
+                    EXPECT_EQ(out[std::size_t(i)][0].t0, t0);
+                    EXPECT_EQ(out[std::size_t(i)][0].t1, t1);
+                }
+            }
+    }
+    EXPECT_GT(hits, 1000);  // the batches are not all misses
+    EXPECT_GT(parallel, 1000);
 }

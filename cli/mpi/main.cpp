@@ -242,11 +242,11 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
             store(px, k, span.t0, st);
         }
     };
-    // `volref render`'s order (Renderer.cpp): tiles of tile_side() pixels, one task each, of kBlock x kBlock
-    // blocks (one packet for one volume). The tiles keep neighbouring rays' voxels in cache: rows of blocks
-    // across the image made one rank's frame 1.37x `volref render`'s on a 256^3 volume (64 MiB).
-    constexpr int kBlock = 4;
-    static_assert(kBlock * kBlock == kMaxPacketRays);
+    static_assert(kPixelBlockWidth * kPixelBlockHeight <= kMaxPacketRays);
+    // `volref render`'s order (Renderer.h): tiles of tile_side() pixels, one task each, of kPixelBlockWidth x
+    // kPixelBlockHeight blocks (the packets of one call to the integrator). The tiles keep neighbouring
+    // rays' voxels in cache: rows of blocks across the image made one rank's frame 1.37x `volref
+    // render`'s on a 256^3 volume (64 MiB).
     tbb::task_arena arena(f.threads > 0 ? f.threads : tbb::task_arena::automatic);
     const int T = tile_side(f.width(), f.height(), arena.max_concurrency());
     const int tiles_x = (f.width() + T - 1) / T, tiles_y = (f.height() + T - 1) / T;
@@ -262,11 +262,11 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
             for (int tile = r.begin(); tile != r.end(); ++tile) {
                 const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
                 const int x_end = std::min(x0 + T, f.width()), y_end = std::min(y0 + T, f.height());
-                for (int by = y0; by < y_end; by += kBlock)
-                for (int bx = x0; bx < x_end; bx += kBlock) {
+                for (int by = y0; by < y_end; by += kPixelBlockHeight)
+                for (int bx = x0; bx < x_end; bx += kPixelBlockWidth) {
                     int n = 0;
-                    for (int y = by; y < std::min(by + kBlock, y_end); ++y)
-                        for (int x = bx; x < std::min(bx + kBlock, x_end); ++x) {
+                    for (int y = by; y < std::min(by + kPixelBlockHeight, y_end); ++y)
+                        for (int x = bx; x < std::min(bx + kPixelBlockWidth, x_end); ++x) {
                             if (V > 1) {
                                 one_pixel(x, y, vrays, vintervals);
                                 continue;

@@ -21,8 +21,9 @@ namespace volref {
 class MacrocellGrid;
 class SampleRecorder;
 
-// The largest number of rays the renderer hands to Integrator::integrate_packet at once.
-inline constexpr int kMaxPacketRays = 16;
+// The largest number of rays the renderer hands to Integrator::integrate_packet at once (a block of
+// pixels, Renderer.h: two 16-lane packets, whose steps the composite kernel interleaves).
+inline constexpr int kMaxPacketRays = 32;
 
 struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied

@@ -45,9 +45,6 @@
 
 namespace volref {
 
-// The pixel block of one packet (kMaxPacketRays pixels; measured in docs/performance.md, issue 19).
-constexpr int kPacketBlockWidth = 4;
-constexpr int kPacketBlockHeight = kMaxPacketRays / kPacketBlockWidth;
 
 std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec) {
     if (spec.source.memory) return spec.source.memory;  // complete: its own origin and spacing
@@ -217,10 +214,8 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         // One task per tile (grain 1, simple_partitioner): a free thread takes the next tile, so an
         // expensive tile never waits behind others in a chunk (conventions section 12, the tile side).
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
-            // Each tile is integrated in packets of blocks of kPacketBlockWidth x kPacketBlockHeight
-            // pixels (fewer at the tile's edges), in row order inside a block: neighbouring rays read
-            // neighbouring voxels (on 16-lane float vectors a 4 x 4 block, on 8-lane double vectors two
-            // 4 x 2 blocks). Each pixel's value does not depend on its packet (lanes are independent).
+            // Each tile is integrated in blocks of kPixelBlockWidth x kPixelBlockHeight pixels (Renderer.h:
+            // fewer at the tile's edges, in row order inside a block, one call to the integrator each).
             PreparedScene::Scratch scratch;
             PixelValue values[kMaxPacketRays];
             int px[kMaxPacketRays], py[kMaxPacketRays];
@@ -228,11 +223,11 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
                 if (cancel_requested()) return;  // SIGINT/SIGTERM: stop at the next tile (Cancellation.h)
                 const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
                 const int x_end = std::min(x0 + T, W), y_end = std::min(y0 + T, H);
-                for (int by = y0; by < y_end; by += kPacketBlockHeight)
-                    for (int bx = x0; bx < x_end; bx += kPacketBlockWidth) {
+                for (int by = y0; by < y_end; by += kPixelBlockHeight)
+                    for (int bx = x0; bx < x_end; bx += kPixelBlockWidth) {
                         int count = 0;
-                        for (int y = by; y < std::min(by + kPacketBlockHeight, y_end); ++y)
-                            for (int x = bx; x < std::min(bx + kPacketBlockWidth, x_end); ++x) {
+                        for (int y = by; y < std::min(by + kPixelBlockHeight, y_end); ++y)
+                            for (int x = bx; x < std::min(bx + kPixelBlockWidth, x_end); ++x) {
                                 px[count] = x;
                                 py[count] = y;
                                 ++count;

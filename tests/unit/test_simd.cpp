@@ -318,3 +318,38 @@ TEST(Simd, UnservedScenesTakeTheScalarPath) {
     s.lights.assign(9, LightSpec{});  // more than kMaxPacketLights
     EXPECT_FALSE(takes_packet_path(s));
 }
+
+// A call of several packets (a block of kMaxPacketRays rays) interleaves their steps (composite_all,
+// two packets in flight): each ray's pixel is the one it gets in a call of its own, bit for bit, for
+// both profiles, with early termination (packets that stop at different steps) and every count of rays
+// up to kMaxPacketRays (a ragged last packet).
+TEST(Simd, InterleavedPacketsGiveEachRayItsOwnPixel) {
+    for (ProfileId profile : {ProfileId::Reference, ProfileId::Fast})
+        for (bool early : {false, true}) {
+            Scene s = ml_scene(37, 23);
+            s.render.profile = profile;
+            if (early) s.render.early_termination = 0.6;
+            const PreparedScene prepared(s, {.threads = 1, .simd = true});
+            ASSERT_TRUE(takes_packet_path(s));
+            PreparedScene::Scratch scratch;
+            int xs[kMaxPacketRays], ys[kMaxPacketRays];
+            int opaque = 0;
+            for (int count = 1; count <= kMaxPacketRays; ++count) {
+                for (int i = 0; i < count; ++i) {  // a diagonal band of pixels through the volume
+                    xs[i] = (7 + 3 * i + count) % 37;
+                    ys[i] = (2 + i + count) % 23;
+                }
+                PixelValue together[kMaxPacketRays];
+                prepared.pixels(xs, ys, count, together, true, scratch);
+                for (int i = 0; i < count; ++i) {
+                    PixelValue alone;
+                    prepared.pixels(xs + i, ys + i, 1, &alone, true, scratch);
+                    for (int c = 0; c < 4; ++c)
+                        EXPECT_EQ(std::memcmp(&together[i].rgba[c], &alone.rgba[c], sizeof(double)), 0)
+                            << "count " << count << " ray " << i << " channel " << c;
+                    opaque += together[i].rgba.a > 0.5;
+                }
+            }
+            EXPECT_GT(opaque, 50);  // rays that composite, not an empty band
+        }
+}

@@ -542,12 +542,14 @@ private:
 
 }  // namespace
 
-// The packets of `count` rays: two at a time, their steps interleaved (a packet's next step waits on
-// its voxels and its skipping grid's cells; the other's work fills that wait), each packet's lanes taking
-// the same samples in the same order as alone. Pre-integrated segments: one packet after the other.
-// Packets in flight at once (composite_all): 2 measured 2-3% faster than 1 on blocks of two packets,
-// 4 slower (docs/performance.md, session 22).
-constexpr int kInterleaved = 2;
+// The packets of `count` rays. Float lanes (the fast profile): two at a time, their steps interleaved (a
+// packet's next step waits on its voxels and its skipping grid's cells; the other's work fills that
+// wait). Double lanes (the reference), and pre-integrated segments: one packet after the other. Each
+// packet's lanes take the same samples in the same order either way. Measured (docs/performance.md,
+// session 22): on float lanes 2 in flight 2-3% faster than 1 and 4 slower; on double lanes 2 in flight
+// 4% slower than 1 (twice the packets of a block, each twice the state).
+template <typename T>
+constexpr int kInFlight = std::is_same_v<T, float> ? 2 : 1;
 template <typename T>
 void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                    PixelValue* out, int count, const RaySpan* spans, RayState* states) {
@@ -568,7 +570,7 @@ void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::
         }
         return;
     }
-    std::optional<CompositeLanes<T>> slot[kInterleaved];
+    std::optional<CompositeLanes<T>> slot[kInFlight<T>];
     int next = 0;
     for (auto& s : slot)
         if (next < packets) make(s, next++);

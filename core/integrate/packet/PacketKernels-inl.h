@@ -15,6 +15,7 @@
 #include <hwy/contrib/math/math-inl.h>
 
 #include <bit>
+#include <new>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -109,7 +110,12 @@ struct RayPacketT {
     // (issue 18: 0.235 off at origin 5e5). t_ref = 0 and world coordinates otherwise.
     HWY_ALIGN double t_ref[kLanes] = {};
     HWY_ALIGN T t_ref_lane[kLanes] = {};
-    ForwardSegmentWalk walk[kLanes];
+    // Each real lane's walk, constructed in place for the lanes < count (the others are never read:
+    // inactive from the start), so that no walk is built twice (a default and then the real one).
+    static_assert(std::is_trivially_destructible_v<ForwardSegmentWalk>, "the union below never destroys a walk");
+    union {
+        ForwardSegmentWalk walk[kLanes];
+    };
     // Each lane's current run (ForwardSegmentWalk::next_run) in T (next(): double lanes count from the
     // interval's start, float lanes from their block's): its next segment k, the end of the run, the
     // interval's last segment, the base t0 (double: the interval's start; float: the block's start,
@@ -150,9 +156,10 @@ struct RayPacketT {
             dz[l] = T(r.direction.z);
             active[l] = real;
             const RaySpan span = spans && real ? spans[l] : RaySpan{};  // (march/RaySpan.h)
-            if (real)
-                walk[l] = extremum ? ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span)
-                                   : ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
+            if (real) {
+                if (extremum) new (&walk[l]) ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span);
+                else new (&walk[l]) ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
+            }
         }
         for (std::size_t l = 0; l < kLanes; ++l) recheck_[l] = -std::numeric_limits<T>::infinity();
         if (vskip_) {

@@ -45,6 +45,7 @@
 
 namespace volref {
 
+static_assert(kPixelBlockWidth * kPixelBlockHeight <= kMaxPacketRays, "a block is one call to the integrator");
 
 std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec) {
     if (spec.source.memory) return spec.source.memory;  // complete: its own origin and spacing

@@ -19,11 +19,8 @@ namespace volref {
 namespace {
 
 struct BoxShape {
-    glm::dvec3 lo, hi;
-    glm::dvec3 domain_lo, domain_hi;
+    BoxShapeBounds bounds;  // the box, its volume's domain, and whether they are the same (BoxIntervals.h)
     int volume_id;
-    bool is_domain = false;  // lo, hi = domain_lo, domain_hi
-    BoxShapeBounds bounds;   // the same as arrays, for the slab test's lanes (BoxIntersection-inl.h)
 };
 
 struct MeshShape {
@@ -91,7 +88,9 @@ double padding(const glm::dvec3& lo, const glm::dvec3& hi) {
 
 void box_bounds(const RTCBoundsFunctionArguments* args) {
     const auto* box = static_cast<const BoxShape*>(args->geometryUserPtr);
-    set_bounds(args->bounds_o, box->lo, box->hi, padding(box->lo, box->hi));
+    const glm::dvec3 lo(box->bounds.lo[0], box->bounds.lo[1], box->bounds.lo[2]);
+    const glm::dvec3 hi(box->bounds.hi[0], box->bounds.hi[1], box->bounds.hi[2]);
+    set_bounds(args->bounds_o, lo, hi, padding(lo, hi));
 }
 
 // The ray's interval in the box AND its domain, in front of the origin (t >= 0), if not empty.
@@ -237,15 +236,15 @@ BoundingGeometry::~BoundingGeometry() {
 int BoundingGeometry::add_box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& domain_lo,
                               const glm::dvec3& domain_hi) {
     const int id = impl_->next_id();
-    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{lo, hi, domain_lo, domain_hi, id, lo == domain_lo && hi == domain_hi, {}}));
-    BoxShapeBounds& b = impl_->boxes.back()->bounds;
+    BoxShapeBounds b;
     for (int a = 0; a < 3; ++a) {
         b.lo[a] = lo[a];
         b.hi[a] = hi[a];
         b.domain_lo[a] = domain_lo[a];
         b.domain_hi[a] = domain_hi[a];
     }
-    b.is_domain = impl_->boxes.back()->is_domain;
+    b.is_domain = lo == domain_lo && hi == domain_hi;
+    impl_->boxes.push_back(std::make_unique<BoxShape>(BoxShape{b, id}));
     impl_->attach(1, impl_->boxes.back().get(), box_bounds, box_intersect, "adding a box");
     impl_->volume_mesh.push_back(nullptr);
     impl_->volume_box.push_back(impl_->boxes.back().get());

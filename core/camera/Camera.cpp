@@ -22,14 +22,16 @@ double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 }  // namespace
 
 Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& bounds_min,
-               const glm::dvec3& bounds_max)
-    : width_(width), height_(height), aspect_(double(width) / double(height)) {
+               const glm::dvec3& bounds_max) {
+    rays_.width = double(width);
+    rays_.height = double(height);
+    rays_.aspect = rays_.width / rays_.height;
     CameraSpec s = spec;
     if (s.type == CameraSpec::Type::Default) {
         const glm::dvec3 c = 0.5 * (bounds_min + bounds_max);
         const double radius = 0.5 * glm::length(bounds_max - bounds_min);
         const double half_v = radians(s.fov_y) / 2.0;
-        const double half_h = std::atan(std::tan(half_v) * aspect_);
+        const double half_h = std::atan(std::tan(half_v) * rays_.aspect);
         const double theta = std::min(half_v, half_h);
         s.type = CameraSpec::Type::Perspective;
         s.target = c;
@@ -45,9 +47,6 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
             const glm::dvec3 right = glm::normalize(glm::cross(forward, s.up));
             const glm::dvec3 up = glm::cross(right, forward);
             rays_.perspective = kind_ == Kind::Perspective;
-            rays_.width = double(width);
-            rays_.height = double(height);
-            rays_.aspect = aspect_;
             rays_.tan_half_fov = std::tan(radians(s.fov_y) / 2.0);
             rays_.half_height = s.height / 2.0;
             for (int a = 0; a < 3; ++a) {
@@ -69,7 +68,7 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
 
 glm::dvec2 Camera::ndc(double fx, double fy) const {
     glm::dvec2 n;
-    camera_ndc_lanes<Scalar>(double(width_), double(height_), fx, fy, n.x, n.y);
+    camera_ndc_lanes<Scalar>(rays_.width, rays_.height, fx, fy, n.x, n.y);
     return n;
 }
 

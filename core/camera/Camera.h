@@ -26,7 +26,8 @@
 
 namespace volref {
 
-// The constants of the perspective and orthographic cameras' rays (CameraRay-inl.h's formula).
+// The film's size and the constants of the perspective and orthographic cameras' rays (CameraRay-inl.h's
+// formula).
 struct CameraRayConstants {
     bool perspective = true;  // else orthographic
     double width = 1.0, height = 1.0, aspect = 1.0;
@@ -51,9 +52,7 @@ public:
 
 private:
     enum class Kind { Perspective, Orthographic, Matrices } kind_;
-    int width_, height_;
-    double aspect_;
-    CameraRayConstants rays_;  // perspective and orthographic
+    CameraRayConstants rays_;  // the film (every kind) and the perspective and orthographic rays
     glm::dmat4 inverse_view_projection_{1.0}, inverse_view_{1.0}, view_{1.0};
 };
 

@@ -6,6 +6,7 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+#include <algorithm>
 #include <limits>
 #include <optional>
 #include <type_traits>
@@ -542,6 +543,38 @@ private:
 
 }  // namespace
 
+// The voxels of each ray's first sample, requested before the packets are built (float lanes, whole
+// rays). A prefetch retires at once, so the cache misses of a block's first samples (cold: nothing
+// read them before in this frame) overlap with one another and with the packets' set-up; the loads
+// themselves would hold up the core's reorder window. The cell of the first segment's midpoint
+// t = (t0 + min(t0 + h, t1)) / 2 of the first interval (SamplePlacement.h; where the march samples
+// first unless skipping moves it on), its four x-rows (y, z and their next): a hint, nothing is read.
+// Measured (docs/performance.md, session 23): 2-5% on the fast profile's frame, nothing on the
+// reference's (double lanes, which do not take it), nothing more from the second sample as well.
+HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+                                       int count) {
+    const auto* voxels = static_cast<const unsigned char*>(in.grid.voxels);
+    if (!voxels) return;
+    const std::int64_t bytes = std::int64_t(scalar_type_size(in.grid.voxel_type));
+    const std::int64_t stride[3] = {bytes, bytes * in.grid.dims[0], bytes * in.grid.dims[0] * in.grid.dims[1]};
+    for (int i = 0; i < count; ++i) {
+        if (intervals[i].empty()) continue;
+        const Interval& iv = intervals[i].front();
+        const double t = 0.5 * (iv.t0 + std::min(iv.t0 + in.step, iv.t1));
+        std::int64_t offset = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double u = (rays[i].origin[a] + t * rays[i].direction[a] - in.grid.origin[a]) * in.grid.inv_spacing[a];
+            const double top = double(std::max<std::int64_t>(in.grid.dims[a] - 2, 0));
+            offset += std::int64_t(u > 0.0 ? std::min(u, top) : 0.0) * stride[a];  // (NaN: 0)
+        }
+        const unsigned char* q = voxels + offset;
+        __builtin_prefetch(q);
+        __builtin_prefetch(q + stride[1]);
+        __builtin_prefetch(q + stride[2]);
+        __builtin_prefetch(q + stride[2] + stride[1]);
+    }
+}
+
 // The packets of `count` rays. Float lanes (the fast profile): two at a time, their steps interleaved (a
 // packet's next step waits on its voxels and its skipping grid's cells; the other's work fills that
 // wait). Double lanes (the reference), and pre-integrated segments: one packet after the other. Each
@@ -570,6 +603,7 @@ void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::
         }
         return;
     }
+    if (std::is_same_v<T, float> && !spans) prefetch_first_samples(in, rays, intervals, count);
     std::optional<CompositeLanes<T>> slot[kInFlight<T>];
     int next = 0;
     for (auto& s : slot)

@@ -664,6 +664,30 @@ struct PacketTrilinearT {
         return hn::Load(d, out);
     }
 
+    // A hint: the four x-rows of the cells at (x, y, z) of every kLaneStride-th lane requested (f32
+    // pairs only; nothing is read).
+    template <int kLaneStride>
+    HWY_INLINE void prefetch(V x, V y, V z) const {
+        if (!pairs) return;
+        using L = SimdLanes<T>;
+        const V X[3] = {x, y, z};
+        V cell[3], frac[3];
+        for (int a = 0; a < 3; ++a) cell_of<L>(clamped_index<L>(X[a], org[a], inv[a], maxi[a]), top[a], flat[a], cell[a], frac[a]);
+        const DI32 di32;
+        const auto idx = hn::Add(hn::Add(hn::ConvertTo(di32, cell[0]), hn::Mul(nx32, hn::ConvertTo(di32, cell[1]))),
+                                 hn::Mul(nxy32, hn::ConvertTo(di32, cell[2])));
+        HWY_ALIGN std::int32_t ix[RayPacketT<T>::kLanes];
+        hn::Store(idx, di32, ix);
+        const auto* p = static_cast<const float*>(voxels);
+        for (std::size_t l = 0; l < hn::Lanes(D()); l += kLaneStride) {
+            const float* q = p + ix[l];
+            __builtin_prefetch(q);
+            __builtin_prefetch(q + row_y);
+            __builtin_prefetch(q + row_z);
+            __builtin_prefetch(q + row_z + row_y);
+        }
+    }
+
     // VolumeSampler::trilinear on lanes: the same templates (Trilinear-inl.h), the corners gathered.
     HWY_INLINE V operator()(V x, V y, V z) const {
         using L = SimdLanes<T>;

@@ -8,6 +8,7 @@
 
 #include "TestScenes.h"
 #include "core/integrate/fixed/CompositeIntegrator.h"
+#include "core/integrate/march/SegmentWalk.h"
 #include "core/render/PreparedScene.h"
 
 using namespace volref;
@@ -352,4 +353,33 @@ TEST(Simd, InterleavedPacketsGiveEachRayItsOwnPixel) {
             }
             EXPECT_GT(opaque, 50);  // rays that composite, not an empty band
         }
+}
+
+// A lane whose ray has one interval of at most ForwardSegmentWalk::kMaxRun segments takes its one run
+// from the packet's constructor (no walk built: RayPacketT, skipping on the lanes); a longer chord,
+// several intervals or a span take the walk's runs. Both kinds in one packet (chords of 1.3 to 18 units
+// at 1.5e-4: 8.5k to 120k segments): the image is the same bit for bit as with skipping off (every lane
+// walked) and within the transcendentals' last bits of the scalar path; a one-run lane asking its
+// (unbuilt) walk for a second run crashes here.
+TEST(Simd, OneRunLanesAndWalkedLanesPlaceTheSameSegments) {
+    Scene s = ml_scene(9, 7);
+    s.render.step = 0.0003;  // voxels: 1.5e-4 world units; kMaxRun = 65,536 segments are 9.8 units, the chords 1.3 to 18
+    const PreparedScene prepared(s, {.threads = 1});
+    const double h = 0.0003 * 0.5;  // times the smallest spacing
+    int one_run = 0, several = 0;
+    for (int y = 0; y < 7; ++y)
+        for (int x = 0; x < 9; ++x) {
+            const std::vector<Interval> iv = prepared.intervals(prepared.pixel_ray(x, y));
+            if (iv.size() != 1) continue;
+            (segment_count(iv.front(), h) <= ForwardSegmentWalk::kMaxRun ? one_run : several) += 1;
+        }
+    ASSERT_GT(one_run, 0);
+    ASSERT_GT(several, 0);
+    for (ProfileId profile : {ProfileId::Reference, ProfileId::Fast}) {
+        s.render.profile = profile;
+        const Image on = render_scene(s, {.threads = 1, .empty_space_skipping = true, .simd = true});
+        const Image off = render_scene(s, {.threads = 1, .empty_space_skipping = false, .simd = true});
+        EXPECT_EQ(std::memcmp(on.pixels.data(), off.pixels.data(), on.pixels.size() * sizeof(double)), 0);
+        if (profile == ProfileId::Reference) EXPECT_LT(max_difference(s), 1e-12);
+    }
 }

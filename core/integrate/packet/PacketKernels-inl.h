@@ -156,6 +156,27 @@ struct RayPacketT {
             dz[l] = T(r.direction.z);
             active[l] = real;
             const RaySpan span = spans && real ? spans[l] : RaySpan{};  // (march/RaySpan.h)
+            if (real && vskip_ && intervals[l].size() == 1 && span.whole()) {
+                // One interval, the whole ray, skipping on the lanes (the walk places every segment): the
+                // walk would hand out one run, segments [0, n) of n <= kMaxRun, and no more; its values
+                // (next()'s refill with r.k = 0, r.end = n; on float lanes k_b = 0) set here, no walk built.
+                const Interval& iv = intervals[l].front();
+                const std::int64_t n = segment_count(iv, step);
+                if (n <= ForwardSegmentWalk::kMaxRun) {
+                    single_run_[l] = true;
+                    run_k[l] = T(0);
+                    run_end[l] = T(n);
+                    run_last[l] = T(n - 1);
+                    if constexpr (kFloatLanes) {
+                        run_t0[l] = T(iv.t0 + 0.0 * step - t_ref[l]);
+                        run_t1[l] = T(iv.t1 - t_ref[l]);
+                    } else {
+                        run_t0[l] = iv.t0;
+                        run_t1[l] = iv.t1;
+                    }
+                    continue;
+                }
+            }
             if (real) {
                 if (extremum) new (&walk[l]) ForwardSegmentWalk(grid, rays[l], intervals[l], step, extremum + l, maximum, span);
                 else new (&walk[l]) ForwardSegmentWalk(grid, rays[l], intervals[l], step, span);
@@ -223,7 +244,7 @@ struct RayPacketT {
             for (std::size_t l = 0; l < lanes; ++l) {
                 if (active[l] && run_k[l] >= run_end[l]) {
                     ForwardSegmentWalk::Run r;
-                    if (walk[l].next_run(r)) {
+                    if (!single_run_[l] && walk[l].next_run(r)) {
                         recheck_[l] = -std::numeric_limits<T>::infinity();
                         if constexpr (kFloatLanes) {
                             // The base is the start of the block of kFloatRunBlock segments holding the
@@ -413,6 +434,7 @@ private:
     // found in, -inf when due now (a new run, a moved lane, outside the grid).
     HWY_ALIGN T recheck_[kLanes];
     bool started_ = false;
+    bool single_run_[kLanes] = {};  // the lane's one run set by the constructor (no walk built)
     std::size_t live_count_ = 0;
 };
 using RayPacket = RayPacketT<double>;

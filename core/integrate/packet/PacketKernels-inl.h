@@ -158,22 +158,13 @@ struct RayPacketT {
             const RaySpan span = spans && real ? spans[l] : RaySpan{};  // (march/RaySpan.h)
             if (real && vskip_ && intervals[l].size() == 1 && span.whole()) {
                 // One interval, the whole ray, skipping on the lanes (the walk places every segment): the
-                // walk would hand out one run, segments [0, n) of n <= kMaxRun, and no more; its values
-                // (next()'s refill with r.k = 0, r.end = n; on float lanes k_b = 0) set here, no walk built.
+                // walk would hand out one run, segments [0, n) of n <= kMaxRun, and no more; taken here
+                // (take_run), no walk built.
                 const Interval& iv = intervals[l].front();
                 const std::int64_t n = segment_count(iv, step);
                 if (n <= ForwardSegmentWalk::kMaxRun) {
                     single_run_[l] = true;
-                    run_k[l] = T(0);
-                    run_end[l] = T(n);
-                    run_last[l] = T(n - 1);
-                    if constexpr (kFloatLanes) {
-                        run_t0[l] = T(iv.t0 + 0.0 * step - t_ref[l]);
-                        run_t1[l] = T(iv.t1 - t_ref[l]);
-                    } else {
-                        run_t0[l] = iv.t0;
-                        run_t1[l] = iv.t1;
-                    }
+                    take_run(l, ForwardSegmentWalk::Run{&iv, 0, n, n});
                     continue;
                 }
             }
@@ -245,27 +236,7 @@ struct RayPacketT {
                 if (active[l] && run_k[l] >= run_end[l]) {
                     ForwardSegmentWalk::Run r;
                     if (!single_run_[l] && walk[l].next_run(r)) {
-                        recheck_[l] = -std::numeric_limits<T>::infinity();
-                        if constexpr (kFloatLanes) {
-                            // The base is the start of the block of kFloatRunBlock segments holding the
-                            // run's first one: the same for every run in the block, so a span resumed
-                            // mid-ray (march/RaySpan.h) places its samples as the whole ray does.
-                            static_assert(kFloatRunBlock + ForwardSegmentWalk::kMaxRun <= (std::int64_t(1) << 24),
-                                          "indices within a block exact in float");
-                            const std::int64_t kb = r.k / kFloatRunBlock * kFloatRunBlock;
-                            run_k[l] = T(r.k - kb);
-                            run_end[l] = T(r.end - kb);
-                            // Only equality with k < end matters: a last segment beyond the run is never reached.
-                            run_last[l] = T(std::min<std::int64_t>(r.n - 1, r.end) - kb);
-                            run_t0[l] = T(r.iv->t0 + double(kb) * step - t_ref[l]);
-                            run_t1[l] = T(r.iv->t1 - t_ref[l]);
-                        } else {
-                            run_k[l] = double(r.k);
-                            run_end[l] = double(r.end);
-                            run_last[l] = double(r.n - 1);
-                            run_t0[l] = r.iv->t0;
-                            run_t1[l] = r.iv->t1;
-                        }
+                        take_run(l, r);
                     } else {
                         active[l] = false;
                     }
@@ -302,6 +273,31 @@ struct RayPacketT {
     }
 
 private:
+    // Lane l's run r (ForwardSegmentWalk::next_run) in T: next k, end, last segment, base t0 and t1 (the
+    // comment above run_k); the lane is due for skip_empty's check.
+    void take_run(std::size_t l, const ForwardSegmentWalk::Run& r) {
+        recheck_[l] = -std::numeric_limits<T>::infinity();
+        if constexpr (kFloatLanes) {
+            // The base is the start of the block of kFloatRunBlock segments holding the
+            // run's first one: the same for every run in the block, so a span resumed
+            // mid-ray (march/RaySpan.h) places its samples as the whole ray does.
+            static_assert(kFloatRunBlock + ForwardSegmentWalk::kMaxRun <= (std::int64_t(1) << 24),
+                          "indices within a block exact in float");
+            const std::int64_t kb = r.k / kFloatRunBlock * kFloatRunBlock;
+            run_k[l] = T(r.k - kb);
+            run_end[l] = T(r.end - kb);
+            // Only equality with k < end matters: a last segment beyond the run is never reached.
+            run_last[l] = T(std::min<std::int64_t>(r.n - 1, r.end) - kb);
+            run_t0[l] = T(r.iv->t0 + double(kb) * step - t_ref[l]);
+            run_t1[l] = T(r.iv->t1 - t_ref[l]);
+        } else {
+            run_k[l] = double(r.k);
+            run_end[l] = double(r.end);
+            run_last[l] = double(r.n - 1);
+            run_t0[l] = r.iv->t0;
+            run_t1[l] = r.iv->t1;
+        }
+    }
     // The live lanes of [i, i + lanes of T) due for skip_empty's check: their t at or past recheck_.
     HWY_INLINE hn::Mask<hn::ScalableTag<T>> due(std::size_t i) const {
         const hn::ScalableTag<T> d;
@@ -577,8 +573,7 @@ struct PacketTrilinearT {
         // float lanes compute it in int32 (a float holds integers exactly only up to 2^24).
         hn::Vec<DI32> idx;
         if constexpr (kFloat) {
-            idx = hn::Add(hn::Add(hn::ConvertTo(di32, cell0), hn::Mul(nx32, hn::ConvertTo(di32, cell1))),
-                          hn::Mul(nxy32, hn::ConvertTo(di32, cell2)));
+            idx = index32(cell0, cell1, cell2);
             if (kind == Kind::U16 || kind == Kind::I16) idx = hn::Add(idx, idx);
         } else {
             V index = hn::Add(hn::Add(cell0, hn::Mul(nx, cell1)), hn::Mul(nxy, cell2));
@@ -686,20 +681,29 @@ struct PacketTrilinearT {
         return hn::Load(d, out);
     }
 
+    // The cells and fractions of the points (x, y, z) (Trilinear-inl.h: clamped_index, cell_of).
+    HWY_INLINE void cells(V x, V y, V z, V cell[3], V frac[3]) const {
+        using L = SimdLanes<T>;
+        const V X[3] = {x, y, z};
+        for (int a = 0; a < 3; ++a) cell_of<L>(clamped_index<L>(X[a], org[a], inv[a], maxi[a]), top[a], flat[a], cell[a], frac[a]);
+    }
+    // Float lanes: the cells' index i + n_x j + n_x n_y k in int32 (exact: the grid fits 32 bits where
+    // it is read by index, `fits32`).
+    HWY_INLINE hn::Vec<DI32> index32(V cell0, V cell1, V cell2) const {
+        const DI32 di32;
+        return hn::Add(hn::Add(hn::ConvertTo(di32, cell0), hn::Mul(nx32, hn::ConvertTo(di32, cell1))),
+                       hn::Mul(nxy32, hn::ConvertTo(di32, cell2)));
+    }
+
     // A hint: the four x-rows of the cells at (x, y, z) of every kLaneStride-th lane requested (f32
     // pairs only; nothing is read).
     template <int kLaneStride>
     HWY_INLINE void prefetch(V x, V y, V z) const {
         if (!pairs) return;
-        using L = SimdLanes<T>;
-        const V X[3] = {x, y, z};
         V cell[3], frac[3];
-        for (int a = 0; a < 3; ++a) cell_of<L>(clamped_index<L>(X[a], org[a], inv[a], maxi[a]), top[a], flat[a], cell[a], frac[a]);
-        const DI32 di32;
-        const auto idx = hn::Add(hn::Add(hn::ConvertTo(di32, cell[0]), hn::Mul(nx32, hn::ConvertTo(di32, cell[1]))),
-                                 hn::Mul(nxy32, hn::ConvertTo(di32, cell[2])));
+        cells(x, y, z, cell, frac);
         HWY_ALIGN std::int32_t ix[RayPacketT<T>::kLanes];
-        hn::Store(idx, di32, ix);
+        hn::Store(index32(cell[0], cell[1], cell[2]), DI32(), ix);
         const auto* p = static_cast<const float*>(voxels);
         for (std::size_t l = 0; l < hn::Lanes(D()); l += kLaneStride) {
             const float* q = p + ix[l];
@@ -713,9 +717,8 @@ struct PacketTrilinearT {
     // VolumeSampler::trilinear on lanes: the same templates (Trilinear-inl.h), the corners gathered.
     HWY_INLINE V operator()(V x, V y, V z) const {
         using L = SimdLanes<T>;
-        const V X[3] = {x, y, z};
         V cell[3], frac[3];
-        for (int a = 0; a < 3; ++a) cell_of<L>(clamped_index<L>(X[a], org[a], inv[a], maxi[a]), top[a], flat[a], cell[a], frac[a]);
+        cells(x, y, z, cell, frac);
         V f[8];
         corners(cell[0], cell[1], cell[2], f);
         return trilinear_sum<L>(f, frac[0], frac[1], frac[2]);

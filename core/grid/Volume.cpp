@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include <sys/mman.h>
+
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 
@@ -86,6 +88,16 @@ std::size_t checked_voxel_count_unlimited(const std::array<std::int64_t, 3>& dim
         throw Error(what + ": dims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
                     std::to_string(dims[2]) + " need more than 256 GiB");
     return count;
+}
+
+void VoxelArray::advise_huge_pages(void* p, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+    const auto begin = reinterpret_cast<std::uintptr_t>(p);
+    const std::uintptr_t first = (begin + kHugePage - 1) / kHugePage * kHugePage, end = (begin + bytes) / kHugePage * kHugePage;
+    if (first < end) (void)madvise(reinterpret_cast<void*>(first), end - first, MADV_HUGEPAGE);
+#else
+    (void)p, (void)bytes;
+#endif
 }
 
 }  // namespace volref

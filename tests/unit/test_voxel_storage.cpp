@@ -130,6 +130,36 @@ TEST(VoxelArray, HoldsEachTypeInItsOwnSizeAndReadsItExactly) {
     EXPECT_EQ(i8.to_vector(), (std::vector<double>{-128.0}));
 }
 
+// A buffer of at least kHugeBufferBytes starts on a 2 MiB boundary (the transparent huge pages' advice,
+// VoxelArray.h), a smaller one on 64 bytes; swapping, moving and copying keep each buffer's own alignment
+// (the sanitizer build checks that each is freed with the alignment it was allocated with) and values.
+TEST(VoxelArray, LargeBuffersStartOnHugePageBoundaries) {
+    auto offset = [](const VoxelArray& a, std::size_t alignment) {
+        return (reinterpret_cast<std::uintptr_t>(a.raw()) - VoxelArray::kPadBytes) % alignment;
+    };
+    const std::size_t big_count = VoxelArray::kHugeBufferBytes / sizeof(float) + 5;  // 4 MiB + 20 bytes of f32
+    VoxelArray big(ScalarType::F32, big_count), small(ScalarType::F32, 1000);
+    EXPECT_EQ(offset(big, VoxelArray::kHugePage), 0u);
+    EXPECT_EQ(offset(small, VoxelArray::kAlignment), 0u);
+    big.set(0, 1.5);
+    big.set(big_count - 1, -2.25);
+    small.set(999, 7.0);
+    big.swap(small);
+    EXPECT_EQ(small[big_count - 1], -2.25);
+    EXPECT_EQ(big[999], 7.0);
+    EXPECT_EQ(offset(small, VoxelArray::kHugePage), 0u);
+    VoxelArray moved(std::move(small));
+    VoxelArray copied(moved);
+    EXPECT_EQ(offset(copied, VoxelArray::kHugePage), 0u);
+    EXPECT_EQ(copied[0], 1.5);
+    EXPECT_EQ(copied[big_count - 1], -2.25);
+    EXPECT_EQ(copied.size(), big_count);
+    copied = big;  // a large buffer replaced by a small one's copy
+    EXPECT_EQ(copied.size(), 1000u);
+    EXPECT_EQ(copied[999], 7.0);
+    EXPECT_EQ(offset(copied, VoxelArray::kAlignment), 0u);
+}
+
 TEST(VoxelArray, BehavesAsAVectorOfDoublesForF64) {
     VoxelArray a;
     for (int i = 0; i < 100; ++i) a.push_back(i * 0.5);

@@ -4,8 +4,8 @@
 // (Gathers). The same values either way: a speed choice that changes no bit (conventions section 12).
 // Auto, the default: Gathers on Intel CPUs, Loads on others. Measured (docs/performance.md, "Voxel pairs by
 // gathers on Intel (session 24)"): on an Intel Xeon with AVX-512 the gathers made the reference's benchmark
-// frame 9% and the fast profile's 2-4% faster; on AMD EPYC (Zen 4) loads measured 18% faster than 32-bit
-// gathers in session 16 (its gathers are microcoded), and 64-bit gathers were not measured there.
+// frame 7% and the fast profile's 3.5% faster; on the AMD EPYC of sessions 13 to 23 the loads measured 18%
+// faster than 32-bit gathers (session 16) and 25% faster than these 64-bit gathers (session 20).
 #pragma once
 
 namespace volref {

@@ -63,7 +63,10 @@ inline constexpr double kFastTransmittanceCutoff = 0x1p-10;
 // packet block), while the image has fewer than kTilesPerThread tiles per thread: tiles of very
 // different cost (the adaptive integrator's) then balance over many cores (issue 31, part 4;
 // bench/tile_balance: 128 x 128 adaptive, 64 tiles of 16 give 16 workers 13.0x, 256 of 8 15.5x).
-inline constexpr int kTileSize = 16;
+// 32 since session 24: on an Intel Xeon the fast profile's benchmark frame 2-3% faster than with 16 at one
+// thread and two (neighbouring blocks' voxels still in cache), the reference's the same (docs/performance.md,
+// "Tiles of 32 (session 24)"); on the EPYC 8 to 64 were within 2% (session 3).
+inline constexpr int kTileSize = 32;
 inline constexpr int kMinTileSize = 4;
 inline constexpr int kTilesPerThread = 16;
 

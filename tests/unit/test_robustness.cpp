@@ -320,16 +320,18 @@ TEST(Determinism, ThreadsTilesAndRuns) {
         }
 }
 
-// tile_side (Renderer.h; conventions::kTilesPerThread) by hand: 16 unless the image has fewer than 16
+// tile_side (Renderer.h; conventions::kTilesPerThread) by hand: 32 unless the image has fewer than 16
 // tiles per thread, then halved down to 4.
 TEST(Tiles, SideByHand) {
-    EXPECT_EQ(tile_side(512, 512, 16), 16);  // 1024 tiles >= 256
-    EXPECT_EQ(tile_side(128, 128, 2), 16);   // 64 >= 32
+    EXPECT_EQ(tile_side(512, 512, 2), 32);   // 256 tiles >= 32
+    EXPECT_EQ(tile_side(512, 512, 16), 32);  // 256 >= 256
+    EXPECT_EQ(tile_side(512, 512, 17), 16);  // 256 < 272; 1024 of 16
+    EXPECT_EQ(tile_side(128, 128, 2), 16);   // 16 < 32; 64 of 16
     EXPECT_EQ(tile_side(128, 128, 16), 8);   // 64 < 256; 256 of 8
     EXPECT_EQ(tile_side(128, 128, 32), 4);   // 256 < 512; 1024 of 4
-    EXPECT_EQ(tile_side(48, 48, 2), 8);      // 9 < 32; 36 of 8
+    EXPECT_EQ(tile_side(48, 48, 2), 8);      // 4, 9 < 32; 36 of 8
     EXPECT_EQ(tile_side(1, 1, 1), 4);        // never below a packet block
-    EXPECT_EQ(tile_side(100, 3, 0), 4);      // threads 0 counts as 1: 7 tiles of 16 < 16
+    EXPECT_EQ(tile_side(100, 3, 0), 4);      // threads 0 counts as 1: 4 tiles of 32, 7 of 16 < 16
 }
 
 // Fuzzing found PLY files on which assimp aborted, looped forever or allocated gigabytes; volref's

@@ -46,7 +46,7 @@ ap.add_argument("--frames", type=int, default=3, help="timed frames per run (vol
 ap.add_argument("--threads", default="1 2")
 ap.add_argument("--ref-step", type=float, default=0.125)
 ap.add_argument("--reference-steps", default="0.5 1 2 3 4")
-ap.add_argument("--fast-steps", default="1 2 2.25 2.3 2.5 3 4 6")
+ap.add_argument("--fast-steps", default="1 2 2.25 2.3 2.4 2.5 3 4 6")
 # issue 31: the fast profile with pre-integrated segments (render.profile_options.preintegration = the table's
 # intervals per axis), named "pre<table>-<step>"
 ap.add_argument("--pre-steps", default="2 3 4 6")

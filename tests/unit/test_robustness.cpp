@@ -20,6 +20,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
+#include "core/render/PreparedScene.h"
 #include "core/render/Renderer.h"
 #include "core/sample/MacrocellGrid.h"
 #include "geometry/TriangleMesh.h"
@@ -318,6 +319,35 @@ TEST(Determinism, ThreadsTilesAndRuns) {
                     EXPECT_TRUE(bitwise_equal(im, first)) << "threads " << threads << " tile " << tile << " simd " << simd;
                 }
         }
+}
+
+// The film (Renderer.cpp, write_tile: a tile's pixels, then its rows into the image by streaming stores where
+// a row starts on 16 bytes, else copied): every pixel's channels land where its own ray's value is. Checked
+// against PreparedScene::render_pixel (one ray, the scalar path) on the scalar path's image, with 4 channels
+// (R G B A: the streaming rows) and 5 (first-hit Z, on an odd width: rows off 16 bytes, copied), at tile
+// sides whose rows end mid-line (1, 5) and the default.
+TEST(Film, TilesWriteEachPixelWhereItsRayIs) {
+    Scene composite = ml_scene();
+    Scene hit = ml_scene();
+    hit.render.projection = Projection::FirstHit;
+    hit.render.isovalue = 0.5;
+    for (const Scene& s : {composite, hit}) {
+        const PreparedScene prepared(s, {.threads = 1});
+        for (int tile : {0, 1, 5}) {
+            const Image im = render_scene(s, {.threads = 2, .simd = false, .tile_size = tile});
+            const std::size_t C = im.channel_count();
+            ASSERT_EQ(C, s.render.projection == Projection::FirstHit ? 5u : 4u);
+            int lit = 0;
+            for (int y = 0; y < im.height; ++y)
+                for (int x = 0; x < im.width; ++x) {
+                    const PixelValue v = prepared.render_pixel(x, y);
+                    for (int c = 0; c < 4; ++c) ASSERT_EQ(im.at(x, y, std::size_t(c)), v.rgba[c]) << x << " " << y << " tile " << tile;
+                    if (C == 5) ASSERT_EQ(im.at(x, y, 4), v.depth) << x << " " << y;
+                    lit += v.rgba[3] > 0.0;
+                }
+            EXPECT_GT(lit, im.width * im.height / 8);  // (255 of 1,073 lit here)
+        }
+    }
 }
 
 // tile_side (Renderer.h; conventions::kTilesPerThread) by hand: 32 unless the image has fewer than 16

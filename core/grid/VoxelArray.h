@@ -145,7 +145,6 @@ public:
         std::swap(type_, o.type_);
         std::swap(size_, o.size_);
         std::swap(capacity_, o.capacity_);
-        std::swap(alignment_, o.alignment_);
     }
 
     // `count` samples of `type`; zero-filled when `zero`, otherwise left for the caller to fill (the
@@ -326,10 +325,9 @@ private:
     // A fresh buffer for `count` values of `type` (contents undefined), old one released.
     void reserve_bytes(ScalarType type, std::size_t count) {
         const std::size_t bytes = count * scalar_type_size(type);
-        const std::size_t total = bytes + 2 * kPadBytes;
-        alignment_ = total >= kHugeBufferBytes ? kHugePage : kAlignment;
-        base_ = static_cast<std::byte*>(::operator new(total, std::align_val_t(alignment_)));
-        if (alignment_ == kHugePage) advise_huge_pages(base_, total);
+        const std::size_t total = bytes + 2 * kPadBytes, alignment = alignment_of(total);
+        base_ = static_cast<std::byte*>(::operator new(total, std::align_val_t(alignment)));
+        if (alignment == kHugePage) advise_huge_pages(base_, total);
         std::memset(base_, 0, kPadBytes);
         std::memset(base_ + kPadBytes + bytes, 0, kPadBytes);
         data_ = base_ + kPadBytes;
@@ -354,19 +352,20 @@ private:
         if (o.size_ > 0) std::memcpy(data_, o.data_, o.bytes());
     }
     void release() {
-        if (base_) ::operator delete(base_, std::align_val_t(alignment_));
+        if (base_) ::operator delete(base_, std::align_val_t(alignment_of(capacity_ * scalar_type_size(type_) + 2 * kPadBytes)));
         base_ = nullptr;
         data_ = nullptr;
         size_ = capacity_ = 0;
         type_ = ScalarType::F64;
     }
 
+    // The alignment of a buffer of `total` bytes (samples and pads: capacity_ x the type's size + 2 kPadBytes).
+    static constexpr std::size_t alignment_of(std::size_t total) { return total >= kHugeBufferBytes ? kHugePage : kAlignment; }
     // madvise(MADV_HUGEPAGE) on the whole 2 MiB pages of [p, p + bytes) (Volume.cpp; nothing where the
     // system lacks it or refuses: the advice changes no value).
     static void advise_huge_pages(void* p, std::size_t bytes);
 
     std::byte* base_ = nullptr;
-    std::size_t alignment_ = kAlignment;
     void* data_ = nullptr;
     ScalarType type_ = ScalarType::F64;
     std::size_t size_ = 0;

@@ -636,27 +636,19 @@ struct PacketTrilinearT {
     // f32 voxels: the floats p[i] and p[i + 1] for each lane l's index i = ix[l] (in floats), each pair read as
     // one 64-bit load (little-endian: the lower half is p[i]) straight into a vector's 64-bit part
     // (load_pairs: the halves joined by Combine, no round trip through memory), then split into even
-    // and odd floats (promoted on double lanes). Plain loads, not gather instructions: gathers are microcoded on AMD's CPUs (the
-    // speed-limit note; here 5% faster on the fast profile's benchmark frame than 64-bit gathers).
+    // and odd floats (promoted on double lanes). Plain loads, not gather instructions, except where
+    // PairFetch.h chooses gathers (x_pair_gathered): gathers are microcoded on AMD's CPUs (the speed-limit
+    // note; on the EPYC 5% to 25% faster than 64-bit gathers), and faster on Intel's.
     HWY_INLINE void x_pair(const float* p, const std::uint32_t* ix, V& first, V& second) const {
         const D d;
 #if HWY_TARGET == HWY_SCALAR
         (void)p, (void)ix, (void)d;  // pairs is false on the scalar target
         first = second = V();
 #else
-        const std::size_t n = hn::Lanes(d);
         if constexpr (kFloat) {
-            const V lo = load_pairs(d, p, ix);  // p[i0] p[i0 + 1] p[i1] ...
-            const V hi = load_pairs(d, p, ix + n / 2);
-            first = hn::ConcatEven(d, hi, lo);
-            second = hn::ConcatOdd(d, hi, lo);
+            split_pairs(load_pairs(d, p, ix), load_pairs(d, p, ix + hn::Lanes(d) / 2), first, second);  // p[i0] p[i0 + 1] p[i1] ...
         } else {
-            // Double lanes: the n pairs fill a float vector of 2n lanes; its even and odd floats,
-            // promoted exactly.
-            const hn::Repartition<float, D> df2;
-            const auto pr = load_pairs(df2, p, ix);
-            first = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatEven(df2, pr, pr)));
-            second = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatOdd(df2, pr, pr)));
+            split_pairs(load_pairs(hn::Repartition<float, D>(), p, ix), first, second);
         }
 #endif
     }
@@ -673,20 +665,34 @@ struct PacketTrilinearT {
             // n float lanes: two gathers of n / 2 words, the lanes' lower and upper halves.
             const hn::Repartition<std::int64_t, D> d64;
             const hn::Half<DI32> dh32;
-            const auto lo = hn::BitCast(d, hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::LowerHalf(dh32, idx)))));
-            const auto hi = hn::BitCast(d, hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::UpperHalf(dh32, idx)))));
-            first = hn::ConcatEven(d, hi, lo);
-            second = hn::ConcatOdd(d, hi, lo);
+            split_pairs(hn::BitCast(d, hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::LowerHalf(dh32, idx))))),
+                        hn::BitCast(d, hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::UpperHalf(dh32, idx))))),
+                        first, second);
         } else {
-            // n double lanes: one gather of n words, a float vector of 2n lanes (as x_pair).
+            // n double lanes: one gather of n words.
             const hn::RebindToSigned<D> d64;
-            const hn::Repartition<float, D> df2;
-            const auto pr = hn::BitCast(df2, hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, idx))));
-            first = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatEven(df2, pr, pr)));
-            second = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatOdd(df2, pr, pr)));
+            split_pairs(hn::BitCast(hn::Repartition<float, D>(), hn::GatherOffset(d64, words, hn::ShiftLeft<2>(hn::PromoteTo(d64, idx)))),
+                        first, second);
         }
 #endif
     }
+#if HWY_TARGET != HWY_SCALAR
+    // The lanes' pairs in lane order (float lanes: `lo` the lower half's lanes, `hi` the upper's) split into
+    // the even floats p[i] (first) and the odd p[i + 1] (second).
+    static HWY_INLINE void split_pairs(V lo, V hi, V& first, V& second) {
+        const D d;
+        first = hn::ConcatEven(d, hi, lo);
+        second = hn::ConcatOdd(d, hi, lo);
+    }
+    // Double lanes: the n pairs fill a float vector of 2n lanes; its even and odd floats, promoted exactly.
+    template <class VF>
+    static HWY_INLINE void split_pairs(VF pairs, V& first, V& second) {
+        const D d;
+        const hn::Repartition<float, D> df2;
+        first = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatEven(df2, pairs, pairs)));
+        second = hn::PromoteTo(d, hn::LowerHalf(hn::ConcatOdd(df2, pairs, pairs)));
+    }
+#endif
 #if HWY_TARGET != HWY_SCALAR
     // The pairs p[ix[j]], p[ix[j] + 1] for j < (lanes of DP) / 2, in order: a 64-bit load per pair,
     // the halves of a wider vector built the same way and joined.

@@ -9,7 +9,8 @@
 //   none(m), gt/ge/lt/le/eq(a, b), is_finite(a), neg(a), abs(a), exp(a), expm1(a), log1p(a), min(a, b),
 //   max(a, b), floor(a), sqrt(a), pow(a, n) (a >= 0, n a double);
 // and V's own +, -, *, /. The scalar lanes call the C library (glibc: < 1 ulp); the SIMD lanes call
-// Highway's vector functions (exp, expm1 and log1p within 1, 4 and 2 ulp; conventions section 12).
+// Highway's vector functions (exp, expm1 and log1p within 1, 4 and 2 ulp; conventions section 12),
+// except float lanes' expm1 and log1p, volref's own (core/SimdLanes-inl.h; within 2 ulp; section 9b).
 // No operation fuses a multiply and an add (-ffp-contract=off).
 #pragma once
 #include <algorithm>

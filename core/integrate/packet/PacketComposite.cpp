@@ -307,6 +307,9 @@ struct CompositeShared {
     const PacketGradient<T> gradient;
     const ShadingConstants shading;
     const RegisterTable<T> opacity_reg, color_reg, gradient_reg;
+    // The opacity correction's d / l (sample_opacity) as (d (1 / l)) / 1 on float lanes, 1 / l rounded to
+    // float once (conventions section 9b: no division per step); d / l itself on double lanes.
+    const T segment_scale, unit_distance;
 
     explicit CompositeShared(const PacketCompositeInputs& inputs)
         : in(inputs),
@@ -319,7 +322,9 @@ struct CompositeShared {
           shading(shading_constants(inputs)),
           opacity_reg(DT<T>(), tab.opacity_x, tab.opacity_y, inputs.opacity_rows, 1),
           color_reg(DT<T>(), tab.color_x, tab.color_y, inputs.color_rows, 3),
-          gradient_reg(DT<T>(), tab.gradient_opacity_x, tab.gradient_opacity_y, inputs.gradient_opacity_rows, 1) {
+          gradient_reg(DT<T>(), tab.gradient_opacity_x, tab.gradient_opacity_y, inputs.gradient_opacity_rows, 1),
+          segment_scale(kFast ? T(1.0 / inputs.unit_distance) : T(1)),
+          unit_distance(kFast ? T(1) : T(inputs.unit_distance)) {
         if (in.skip_radius) {
             vskip.radius = in.skip_radius;
             for (int a = 0; a < 3; ++a) {
@@ -455,7 +460,8 @@ public:
         }
         // A step where no lane sees opacity changes nothing: no optical depth (log1p, expm1) for it.
         if (!hn::AllFalse(d, hn::And(alive, hn::Gt(a, zero)))) {
-            const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, cur.seg, hn::Set(d, T(in_.unit_distance)));
+            const V seg = kFast ? hn::Mul(cur.seg, hn::Set(d, s_.segment_scale)) : cur.seg;
+            const SampleOpacity<SL> o = sample_opacity<SL>(alive, a, seg, hn::Set(d, s_.unit_distance));
             const TableLookup<T> ct = locate_rows(d, tab.color_x, in_.color_rows, x, s_.color_reg);
             V m[3] = {table_channel(d, ct, tab.color_y, in_.color_rows, 3, 0, s_.color_reg),
                       table_channel(d, ct, tab.color_y, in_.color_rows, 3, 1, s_.color_reg),

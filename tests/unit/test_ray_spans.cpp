@@ -175,12 +175,28 @@ TEST(RaySpans, EmptyAndWholeSpans) {
 }
 
 // The packet form (SIMD lanes, each with its own span and state) resumes as the scalar form, with
-// empty-space skipping on; the scalar form is checked against integrate() above.
+// empty-space skipping on; the scalar form is checked against integrate() above. With empty space (no
+// opacity below 0.3: empty macrocells, so the lanes skip) every lane of one interval takes its span's
+// segments as one run (RayPacketT's one-run lanes, owned_segments), the others walk.
 TEST(RaySpans, PacketsResumeAsTheScalarPath) {
     std::mt19937 rng(11);
-    for (bool terminated : {false, true}) {
+    for (int variant = 0; variant < 3; ++variant) {
+        const bool terminated = variant == 1, empty_space = variant == 2;
         Scene s = ml_scene(Projection::Composite);
         if (terminated) s.render.early_termination = 0.5;
+        if (empty_space) {  // a Gaussian blob's shell at 0.6: empty macrocells around and inside it
+            FieldSpec g;
+            g.kind = FieldSpec::Kind::Gaussian;
+            g.dims = {37, 29, 33};
+            g.center = {12.0, 14.0, 15.0};
+            g.sigma = 6.0;
+            const Scene blob = field_scene(g, glm::dvec3(0.0), glm::dvec3(0.7, 1.0, 0.9));
+            s.volume().source = blob.volume().source;
+            s.volume().origin = blob.volume().origin;
+            s.volume().spacing = blob.volume().spacing;
+            s.volume().transfer.opacity = {{0.0, 0.0}, {0.55, 0.0}, {0.6, 0.8}, {0.65, 0.0}};
+        }
+        SCOPED_TRACE(variant);
         const PreparedScene ps(s, RenderOptions{.threads = 1});
         const Integrator& integrator = ps.integrator();
         const std::vector<RayCase> cases = rays_of(ps);

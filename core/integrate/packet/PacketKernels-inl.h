@@ -157,15 +157,17 @@ struct RayPacketT {
             dz[l] = T(r.direction.z);
             active[l] = real;
             const RaySpan span = spans && real ? spans[l] : RaySpan{};  // (march/RaySpan.h)
-            if (real && vskip_ && intervals[l].size() == 1 && span.whole()) {
-                // One interval, the whole ray, skipping on the lanes (the walk places every segment): the
-                // walk would hand out one run, segments [0, n) of n <= kMaxRun, and no more; taken here
-                // (take_run), no walk built.
+            if (real && vskip_ && intervals[l].size() == 1) {
+                // One interval, skipping on the lanes (the walk places every segment): the walk would hand
+                // out one run, the segments [k0, k1) of the n whose midpoints the span owns ([0, n) for the
+                // whole ray: owned_segments, as the walk's own start), when k1 - k0 <= kMaxRun, and no more;
+                // taken here (take_run), no walk built. (k0 = k1: the lane takes no sample, as with a walk.)
                 const Interval& iv = intervals[l].front();
                 const std::int64_t n = segment_count(iv, step);
-                if (n <= ForwardSegmentWalk::kMaxRun) {
+                const auto [k0, k1] = owned_segments(iv, step, n, span);
+                if (k1 - k0 <= ForwardSegmentWalk::kMaxRun) {
                     single_run_[l] = true;
-                    take_run(l, ForwardSegmentWalk::Run{&iv, 0, n, n});
+                    take_run(l, ForwardSegmentWalk::Run{&iv, k0, k1, n});
                     continue;
                 }
             }

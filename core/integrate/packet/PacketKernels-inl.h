@@ -442,7 +442,8 @@ using RayPacket = RayPacketT<double>;
 // u = clamp((x - origin) inv_spacing, 0, n - 1), cell min(floor(u), n - 2), Levoy's sum in order).
 // The voxels are read in their storage type (VoxelArray) and converted to double exactly, so the sum
 // is the same whatever the type. One switch on the type per packet sample, then per type:
-//   f64: 64-bit index gathers (as before);
+//   f64: each x-neighbour pair as one 128-bit load per lane (four rows, split into even and odd lanes;
+//     since session 25), 64-bit index gathers on a grid one voxel wide in x or the one-lane target;
 //   f32: each x-neighbour pair f(i, j, k), f(i + 1, j, k) as one 64-bit load (x_pair), promoted;
 //   i32, u32: 32-bit gathers with int32 indices, promoted to double (u32: read as i32, plus 2^32
 //     where negative, exact);
@@ -568,6 +569,24 @@ struct PacketTrilinearT {
             const auto idx = hn::Add(hn::ConvertTo(di, hn::Add(cell0, hn::Mul(nx, cell1))), hn::ConvertTo(di, hn::Mul(nxy, cell2)));
             if (kind == Kind::F64) {
                 const auto* p = static_cast<const double*>(voxels);
+#if HWY_TARGET != HWY_SCALAR
+                if (!flat[0]) {
+                    // x-neighbours f(i, j, k), f(i + 1, j, k) as one 128-bit load per lane, four rows (as
+                    // x_pair for f32): the same doubles as the eight gathers below, half the loads.
+                    HWY_ALIGN std::int64_t ix[RayPacketT<T>::kLanes];
+                    hn::Store(idx, di, ix);
+                    const std::int64_t ry = hn::GetLane(offy), rz = hn::GetLane(offz);
+                    const std::size_t half = hn::Lanes(d) / 2;
+                    auto pair_row = [&](const double* row, V& first, V& second) HWY_ATTR {
+                        split_pairs(load_pairs(d, row, ix), load_pairs(d, row, ix + half), first, second);
+                    };
+                    pair_row(p, f[0], f[1]);
+                    pair_row(p + ry, f[3], f[2]);
+                    pair_row(p + rz, f[4], f[5]);
+                    pair_row(p + rz + ry, f[7], f[6]);
+                    return;
+                }
+#endif
                 eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return hn::GatherIndex(d, p, i); }, f);
             } else {
                 eight(idx, offx, offy, offz, [&](hn::Vec<DI> i) HWY_ATTR { return lanes(i); }, f);
@@ -696,10 +715,10 @@ struct PacketTrilinearT {
     }
 #endif
 #if HWY_TARGET != HWY_SCALAR
-    // The pairs p[ix[j]], p[ix[j] + 1] for j < (lanes of DP) / 2, in order: a 64-bit load per pair,
-    // the halves of a wider vector built the same way and joined.
-    template <class DP>
-    static HWY_INLINE hn::Vec<DP> load_pairs(DP dp, const float* p, const std::uint32_t* ix) {
+    // The pairs p[ix[j]], p[ix[j] + 1] for j < (lanes of DP) / 2, in order: a load of two elements per pair
+    // (64 bits of f32, 128 of f64), the halves of a wider vector built the same way and joined.
+    template <class DP, typename E, typename I>
+    static HWY_INLINE hn::Vec<DP> load_pairs(DP dp, const E* p, const I* ix) {
         if constexpr (hn::MaxLanes(DP()) <= 2) {
             return hn::LoadU(dp, p + ix[0]);
         } else {

@@ -541,6 +541,16 @@ struct PacketTrilinearT {
         f[6] = g(hn::Add(hn::Add(idz, ox), oy));
         f[7] = g(hn::Add(idz, oy));
     }
+    // The same eight corners as x-neighbour pairs, four rows from the cells' first voxels `row`
+    // (Levoy's order: f1 f2, f4 f3, f5 f6, f8 f7): pair(row, first, second) reads the pairs of the rows
+    // at row, row + ry (the next y), row + rz (the next z) and row + rz + ry.
+    template <class E, class I, class G>
+    static HWY_INLINE void four_pairs(const E* row, I ry, I rz, const G& pair, V f[8]) {
+        pair(row, f[0], f[1]);
+        pair(row + ry, f[3], f[2]);
+        pair(row + rz, f[4], f[5]);
+        pair(row + rz + ry, f[7], f[6]);
+    }
 
     // A 32-bit word ending with each 1- or 2-byte sample, shifted down to the sample.
     template <int kShift, bool kSigned>
@@ -577,13 +587,9 @@ struct PacketTrilinearT {
                     hn::Store(idx, di, ix);
                     const std::int64_t ry = hn::GetLane(offy), rz = hn::GetLane(offz);
                     const std::size_t half = hn::Lanes(d) / 2;
-                    auto pair_row = [&](const double* row, V& first, V& second) HWY_ATTR {
+                    four_pairs(p, ry, rz, [&](const double* row, V& first, V& second) HWY_ATTR {
                         split_pairs(load_pairs(d, row, ix), load_pairs(d, row, ix + half), first, second);
-                    };
-                    pair_row(p, f[0], f[1]);
-                    pair_row(p + ry, f[3], f[2]);
-                    pair_row(p + rz, f[4], f[5]);
-                    pair_row(p + rz + ry, f[7], f[6]);
+                    }, f);
                     return;
                 }
 #endif
@@ -608,25 +614,21 @@ struct PacketTrilinearT {
             case Kind::F32: {
                 const auto* p = static_cast<const float*>(voxels);
                 if (pair_gathers) {  // the same pairs, gathered (PairFetch.h)
-                    x_pair_gathered(p, idx, f[0], f[1]);
-                    x_pair_gathered(p + row_y, idx, f[3], f[2]);
-                    x_pair_gathered(p + row_z, idx, f[4], f[5]);
-                    x_pair_gathered(p + row_z + row_y, idx, f[7], f[6]);
+                    four_pairs(p, row_y, row_z, [&](const float* row, V& first, V& second) HWY_ATTR {
+                        x_pair_gathered(row, idx, first, second);
+                    }, f);
                     break;
                 }
                 if (pairs) {
                     // x-neighbours f(i, j, k), f(i + 1, j, k) as one 64-bit load: four fetches of
-                    // pairs instead of eight gathers (Levoy's order: f1 f2, f4 f3, f5 f6, f8 f7).
+                    // pairs instead of eight gathers (four_pairs).
                     // The lanes' indices stored once (as unsigned: they are >= 0, so a 32-bit move
                     // zero-extends them); the four rows of a cell are the same indices from four base
                     // pointers (p, p + n_x, p + n_x n_y, p + n_x + n_x n_y), so each lane's index is
                     // read once, not once per row.
                     HWY_ALIGN std::uint32_t ix[RayPacketT<T>::kLanes];
                     hn::Store(hn::BitCast(DU32(), idx), DU32(), ix);
-                    x_pair(p, ix, f[0], f[1]);
-                    x_pair(p + row_y, ix, f[3], f[2]);
-                    x_pair(p + row_z, ix, f[4], f[5]);
-                    x_pair(p + row_z + row_y, ix, f[7], f[6]);
+                    four_pairs(p, row_y, row_z, [&](const float* row, V& first, V& second) HWY_ATTR { x_pair(row, ix, first, second); }, f);
                     break;
                 }
                 eight(idx, offx32, offy32, offz32, [&](hn::Vec<DI32> i) HWY_ATTR { return to_lanes(d, hn::GatherIndex(df32, p, i)); }, f);

@@ -5,6 +5,7 @@
 // brick owns.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -223,6 +224,70 @@ TEST(RaySpans, PacketsResumeAsTheScalarPath) {
             }
         }
     }
+}
+
+// owned_segments finds its run's ends from the closed form and a local correction; here against the
+// definition counted segment by segment (the owned k are those with t0 <= midpoint < t1) and against
+// a bisection on k, over random intervals, steps and spans, spans ending exactly on midpoints, on the
+// interval's ends, at +-inf and NaN, and a long interval (2^20 segments).
+TEST(RaySpans, OwnedSegmentsAsBisection) {
+    auto bisection = [](const Interval& iv, double step, std::int64_t n, double t) {
+        std::int64_t lo = 0, hi = n;
+        while (lo < hi) {
+            const std::int64_t mid = lo + (hi - lo) / 2;
+            if (segment(iv, step, mid, n).midpoint() >= t) hi = mid;
+            else lo = mid + 1;
+        }
+        return lo;
+    };
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-300.0, 300.0), h(0.01, 7.0);
+    const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+    int checked = 0;
+    for (int c = 0; c < 4000; ++c) {
+        double a = u(rng), b = u(rng);
+        if (a > b) std::swap(a, b);
+        Interval iv{a, b};
+        double step = h(rng);
+        if (c == 0) iv = Interval{-17.25, -17.25 + 1048576.0 * 0.5}, step = 0.5;  // 2^20 segments
+        const std::int64_t n = segment_count(iv, step);
+        auto pick = [&](int kind) {
+            std::uniform_int_distribution<std::int64_t> k(0, n - 1);
+            switch (kind) {
+                case 0: return u(rng);
+                case 1: return segment(iv, step, k(rng), n).midpoint();  // exactly on a midpoint
+                case 2: return std::nextafter(segment(iv, step, k(rng), n).midpoint(), -inf);
+                case 3: return iv.t0;
+                case 4: return iv.t1;
+                case 5: return -inf;
+                case 6: return inf;
+                default: return nan;
+            }
+        };
+        for (int k0 = 0; k0 < 8; ++k0) {
+            const RaySpan span{pick(k0), pick((k0 + c) % 8)};
+            const auto [first, end] = owned_segments(iv, step, n, span);
+            if (span.whole()) {
+                EXPECT_EQ(first, 0);
+                EXPECT_EQ(end, n);
+                continue;
+            }
+            const std::int64_t b0 = bisection(iv, step, n, span.t0);
+            EXPECT_EQ(first, b0) << iv.t0 << " " << iv.t1 << " " << step << " " << span.t0;
+            EXPECT_EQ(end, std::max(b0, bisection(iv, step, n, span.t1))) << span.t1;
+            // The definition, segment by segment (not for a NaN end, which no midpoint reaches: the run
+            // then ends at n, as the bisection's).
+            if (n <= 4096 && !std::isnan(span.t0) && !std::isnan(span.t1)) {
+                std::int64_t lo = n, count = 0;
+                for (std::int64_t k = 0; k < n; ++k)
+                    if (span.owns(segment(iv, step, k, n).midpoint())) lo = std::min(lo, k), ++count;
+                EXPECT_EQ(end - first, count);
+                if (count > 0) EXPECT_EQ(first, lo);
+            }
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 25000);
 }
 
 // The fast profile's parts (product_state, SpanStates.h) by hand: C = C_f + T_f C_b, T = T_f T_b, and a

@@ -15,6 +15,7 @@
 //             rounding (composite: C = C_f + exp(-tau_f) C_b, tau = tau_f + tau_b).
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -33,19 +34,24 @@ struct RaySpan {
 
 // The segments [first, end) of interval `iv` (n segments at `step`) whose midpoints `span` owns: the
 // midpoints increase with k (a + b with a = t0 + k h, b = t0 + (k + 1) h or t1, each monotone in k in
-// floating point), so they are one run, found by bisection on k.
+// floating point), so they are one run. Its ends are found from the closed form m_k ~ t0 + (k + 1/2) h:
+// k = ceil((t - t0) / h - 1/2), clamped to [0, n], then moved one segment at a time until
+// midpoint(k - 1) < t <= midpoint(k) holds with the midpoints computed exactly as the march computes
+// them (segment().midpoint()). The monotone predicate has one boundary, so this is the k a bisection
+// on k finds (tested against it: RaySpans.OwnedSegmentsAsBisection), in O(1) steps instead of
+// log2(n) dependent ones (a span's packet lanes start with it: volref-mpi's ranks).
 inline std::pair<std::int64_t, std::int64_t> owned_segments(const Interval& iv, double step, std::int64_t n,
                                                              const RaySpan& span) {
     if (span.whole()) return {0, n};
     // The first k in [0, n] whose midpoint is >= t (n: none).
     auto first_at_or_after = [&](double t) {
-        std::int64_t lo = 0, hi = n;
-        while (lo < hi) {
-            const std::int64_t mid = lo + (hi - lo) / 2;
-            if (segment(iv, step, mid, n).midpoint() >= t) hi = mid;
-            else lo = mid + 1;
-        }
-        return lo;
+        const double x = (t - iv.t0) / step - 0.5;
+        std::int64_t k = n;  // (also t NaN: no midpoint is >= it)
+        if (x <= 0.0) k = 0;
+        else if (x < double(n)) k = std::int64_t(std::ceil(x));
+        while (k > 0 && segment(iv, step, k - 1, n).midpoint() >= t) --k;
+        while (k < n && segment(iv, step, k, n).midpoint() < t) ++k;
+        return k;
     };
     const std::int64_t first = first_at_or_after(span.t0);
     return {first, std::max(first, first_at_or_after(span.t1))};

@@ -102,6 +102,26 @@ std::size_t WorkBins::bin_of(const Lattice& cells, const glm::dvec3& u) const {
     return std::size_t(b[0] + bins[0] * (b[1] + bins[1] * b[2]));
 }
 
+void add_packet_work(const std::vector<LaneSample>* lanes, int count, std::vector<double>& work) {
+    constexpr double kShares = 840.0;  // lcm(1, ..., 8): a step's cost in whole units for 1 to 8 lanes
+    static_assert(kWorkPacketLanes <= 8);
+    std::size_t steps = 0;
+    for (int l = 0; l < count; ++l) steps = std::max(steps, lanes[l].size());
+    for (std::size_t j = 0; j < steps; ++j) {
+        std::int64_t seen[kWorkPacketLanes];
+        int live = 0, distinct = 0;
+        for (int l = 0; l < count; ++l) {
+            if (j >= lanes[l].size()) continue;
+            ++live;
+            const std::int64_t line = lanes[l][j].line;
+            if (std::find(seen, seen + distinct, line) == seen + distinct) seen[distinct++] = line;
+        }
+        const double share = (kWorkStepCost + double(distinct)) * (kShares / double(live));
+        for (int l = 0; l < count; ++l)
+            if (j < lanes[l].size()) work[lanes[l][j].bin] += share;
+    }
+}
+
 std::vector<Brick> split_lattice(const Lattice& cells_box, int count, const WorkBins* work) {
     Brick whole;
     std::int64_t cells = 1;

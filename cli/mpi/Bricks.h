@@ -48,6 +48,22 @@ struct WorkBins {
 };
 std::vector<Brick> split_lattice(const Lattice& cells, int count, const WorkBins* work = nullptr);
 
+// The work of a SIMD packet (Balance.h's packet count; conventions §14): the fixed-step integrators step
+// kWorkPacketLanes neighbouring rays together, and a step's time goes with the voxels its lanes wait for, so
+// step j of a packet costs kWorkStepCost + (the distinct cache lines of kWorkLineBytes that the lanes with a
+// j-th sample start their cells on), in units of one line. kWorkStepCost = 16 was measured (docs/
+// performance.md, "Session 26"). The cost is shared equally among those lanes' bins in units of 1 / 840
+// (840 = lcm(1, ..., 8)), so every value added is an integer and the ranks' sums are exact in any order.
+inline constexpr int kWorkPacketLanes = 8;
+inline constexpr double kWorkStepCost = 16.0;
+inline constexpr std::int64_t kWorkLineBytes = 64;
+struct LaneSample {
+    std::size_t bin;     // WorkBins::bin_of the sample's position
+    std::int64_t line;   // the cache line its cell's first voxel lies on: (i + n_x (j + n_y k)) bytes / kWorkLineBytes
+};
+// Adds the packet of `lanes[0 .. count)` (count <= kWorkPacketLanes; each lane's samples in order) to `work`.
+void add_packet_work(const std::vector<LaneSample>* lanes, int count, std::vector<double>& work);
+
 // A grid: `dims` voxels at origin + i * spacing in its own space, placed in the world by `to_world`
 // (null: its space is world space).
 struct GridBox {

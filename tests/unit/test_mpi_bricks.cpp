@@ -4,6 +4,7 @@
 // build, the sanitizers' included.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include <glm/mat4x4.hpp>
@@ -65,6 +66,29 @@ TEST(MpiBricks, KdSplitByWorkByHand) {
     EXPECT_EQ(w.bin_of(cells, glm::dvec3(-3.0, 99.0, 4.0)), std::size_t(0 + 8 * (3 + 4 * 3)));
     std::fill(w.work.begin(), w.work.end(), 0.0);
     EXPECT_EQ(split_lattice(cells, 2, &w)[0].hi[0], 8);
+}
+
+// A packet's work (add_packet_work, Bricks.h), by hand: step j costs kWorkStepCost (16) + the distinct lines
+// of the lanes with a j-th sample, shared equally among those lanes' bins, in units of 1 / 840. Three lanes:
+// step 0 has all three, on lines 10, 10, 20 (2 distinct): 18 x 840 / 3 = 5040 each, to bins 0, 0, 2; step 1
+// has lanes 0 and 1, on lines 11 and 12 (2): 18 x 840 / 2 = 7560 each, to bin 1 twice. Eight lanes on one
+// line: 17 x 840 / 8 = 1785 each. Every share is an integer (840 = lcm(1, ..., 8)).
+TEST(MpiBricks, PacketWorkByHand) {
+    std::vector<LaneSample> lanes[kWorkPacketLanes];
+    lanes[0] = {{0, 10}, {1, 11}};
+    lanes[1] = {{0, 10}, {1, 12}};
+    lanes[2] = {{2, 20}};
+    std::vector<double> work(4, 0.0);
+    add_packet_work(lanes, 3, work);
+    EXPECT_EQ(work, (std::vector<double>{10080.0, 15120.0, 5040.0, 0.0}));
+    for (auto& l : lanes) l = {{3, 7}};
+    add_packet_work(lanes, kWorkPacketLanes, work);
+    EXPECT_EQ(work[3], 8 * 1785.0);
+    for (int live = 1; live <= kWorkPacketLanes; ++live)
+        for (int distinct = 1; distinct <= live; ++distinct) {
+            const double share = (kWorkStepCost + distinct) * (840.0 / live);
+            EXPECT_EQ(share, std::round(share)) << live << " " << distinct;
+        }
 }
 
 TEST(MpiBricks, EveryPointBelongsToExactlyOneBrick) {

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <new>
 #include <optional>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -99,6 +100,15 @@ public:
         }
         return {};
     }
+    // f(pixels, n, scratch) on the list cut into fixed batches of `batch` pixels (the last one shorter),
+    // the batches spread over the threads: a batch's pixels never depend on the thread count.
+    template <class F>
+    std::string run_batches(const std::vector<std::size_t>& list, std::size_t batch, F&& f) {
+        const std::size_t batches = (list.size() + batch - 1) / batch;
+        std::vector<std::size_t> first(batches);
+        for (std::size_t b = 0; b < batches; ++b) first[b] = b * batch;
+        return run(&first, [&](std::size_t i, PixelRays& scratch) { f(&list[i], std::min(batch, list.size() - i), scratch); });
+    }
     // The threads the loop runs on.
     int concurrency() const { return arena_ ? arena_->max_concurrency() : 1; }
 
@@ -123,7 +133,8 @@ constexpr std::size_t kChainReceiveWindow = 8;
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
 // kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
 // takes its round-j pixels' states from the ranks in front of it (receives posted at the start, in the
-// order they are sent, waited for here), runs step(px, scratch, state) on them, and sends them on to
+// order they are sent, waited for here), runs step(px, scratch, state) on them (or step(pixels, n,
+// scratch) on fixed batches of up to kMaxPacketRays of them, which reads and writes `state` itself), and sends them on to
 // the ranks behind (non-blocking). Every rank goes through the units (j, b) in the same order and a unit only waits for
 // (j - 1, b), which its sender did earlier in that order: no deadlock, and a rank waits only where it
 // overtakes the rank in front of it on the same block (no barrier per round, no image-wide reduction).
@@ -204,7 +215,10 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuff
         // In chunks of kChainChunkPerThread pixels a thread, progressing the sends and receives between them.
         for (std::size_t c0 = 0; c0 < mine.size() && err.empty(); c0 += chunk) {
             part.assign(mine.begin() + std::ptrdiff_t(c0), mine.begin() + std::ptrdiff_t(std::min(mine.size(), c0 + chunk)));
-            err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
+            if constexpr (std::is_invocable_v<Step, const std::size_t*, std::size_t, PixelRays&>)
+                err = loop.run_batches(part, std::size_t(kMaxPacketRays), step);
+            else
+                err = loop.run(&part, [&](std::size_t px, PixelRays& scratch) { step(px, scratch, &state[px * S]); });
             progress();
         }
         // Out: to each rank behind, in pixel order.
@@ -269,13 +283,44 @@ bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
     PartBuffer state(P * S, 0.0);  // fresh states (all zero)
-    hand_on(frame, order, S, state, false, bytes, [&](std::size_t px, PixelRays& scratch, double* s) {
+    const PreparedVolume& first = *frame.members[0].prepared;
+    auto one = [&](std::size_t px, PixelRays& scratch) {
+        double* s = &state[px * S];
         scratch.of(frame, px);
         RayState st = RayState::read(s);
         const RaySpan span = frame.span(scratch.rays[0]);
         if (frame.mixed()) frame.multi->composite_span(scratch.rays.data(), scratch.intervals.data(), span, st);
-        else frame.members[0].prepared->integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
+        else first.integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
         st.write(s);
+    };
+    // A batch of the block's pixels as one call of SIMD packets (integrate_parts' way, main.cpp): the
+    // rays with a span and a state not yet stopped; each lane takes the samples its scalar call would.
+    hand_on(frame, order, S, state, false, bytes, [&](const std::size_t* px, std::size_t n, PixelRays& scratch) {
+        if (frame.mixed() || !first.packets) {
+            for (std::size_t i = 0; i < n; ++i) one(px[i], scratch);
+            return;
+        }
+        const std::size_t W = std::size_t(frame.width());
+        Ray world[kMaxPacketRays], rays[kMaxPacketRays];
+        std::vector<Interval> intervals[kMaxPacketRays];
+        RaySpan spans[kMaxPacketRays];
+        RayState states[kMaxPacketRays];
+        std::size_t at[kMaxPacketRays];
+        for (std::size_t i = 0; i < n; ++i) world[i] = frame.camera->pixel_ray(int(px[i] % W), int(px[i] / W));
+        frame.volume_intervals(0, world, int(n), rays, intervals);
+        int count = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const RaySpan span = frame.span(rays[i]);
+            const RayState st = RayState::read(&state[px[i] * S]);
+            if (intervals[i].empty() || !(span.t0 < span.t1) || st.stopped != 0.0) continue;
+            std::swap(intervals[count], intervals[i]);
+            rays[count] = rays[i];
+            spans[count] = span;
+            states[count] = st;
+            at[count++] = px[i];
+        }
+        if (count > 0) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
+        for (int i = 0; i < count; ++i) states[i].write(&state[at[i] * S]);
     });
     const PartBuffer final_state = collect(frame, order, S, state, false, bytes);
     if (frame.rank != 0) return true;

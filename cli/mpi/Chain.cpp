@@ -306,19 +306,11 @@ bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
         RaySpan spans[kMaxPacketRays];
         RayState states[kMaxPacketRays];
         std::size_t at[kMaxPacketRays];
-        for (std::size_t i = 0; i < n; ++i) world[i] = frame.camera->pixel_ray(int(px[i] % W), int(px[i] / W));
-        frame.volume_intervals(0, world, int(n), rays, intervals);
-        int count = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const RaySpan span = frame.span(rays[i]);
-            const RayState st = RayState::read(&state[px[i] * S]);
-            if (intervals[i].empty() || !(span.t0 < span.t1) || st.stopped != 0.0) continue;
-            std::swap(intervals[count], intervals[i]);
-            rays[count] = rays[i];
-            spans[count] = span;
-            states[count] = st;
-            at[count++] = px[i];
-        }
+        for (std::size_t i = 0; i < n; ++i) world[i] = frame.camera->pixel_ray(int(px[i] % W), int(px[i] / W)), at[i] = px[i];
+        const int count = frame.owned_rays(world, int(n), rays, intervals, spans, at, [&](std::size_t p) {
+            return RayState::read(&state[p * S]).stopped != 0.0;
+        });
+        for (int i = 0; i < count; ++i) states[i] = RayState::read(&state[at[i] * S]);
         if (count > 0) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
         for (int i = 0; i < count; ++i) states[i].write(&state[at[i] * S]);
     });

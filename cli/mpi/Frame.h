@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/camera/Camera.h"
@@ -77,6 +78,25 @@ struct Frame {
     // The span of the ray this rank owns (`rays[0]`, the first volume's ray: the lattice's space);
     // empty ([+inf, +inf)) when the ray misses the brick's box (padded: every sample a rank owns lies in it).
     RaySpan span(const Ray& lattice_ray) const;
+    // The first volume's rays of `count` world rays (Embree packets, volume_intervals) that this rank owns
+    // a span of and `skip(at[i])` does not refuse, moved to the front in order with their intervals, spans
+    // and `at` (the caller's index of each ray, e.g. its pixel); returns how many. The SIMD packets'
+    // input (integrate_parts, the fixed-step chain).
+    template <class Skip>
+    int owned_rays(const Ray* world, int count, Ray* rays, std::vector<Interval>* intervals, RaySpan* spans,
+                   std::size_t* at, Skip&& skip) const {
+        volume_intervals(0, world, count, rays, intervals);
+        int owned = 0;
+        for (int i = 0; i < count; ++i) {
+            const RaySpan s = span(rays[i]);
+            if (intervals[i].empty() || !(s.t0 < s.t1) || skip(at[i])) continue;
+            std::swap(intervals[owned], intervals[i]);
+            rays[owned] = rays[i];
+            spans[owned] = s;
+            at[owned++] = at[i];
+        }
+        return owned;
+    }
     // Whether any of `count` world rays meets this rank's brick (span()'s first test, on the first
     // volume's rays): a block of rays that all miss it has no span, and is skipped before its intervals.
     bool meets_brick(const Ray* world, int count) const;

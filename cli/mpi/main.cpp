@@ -282,18 +282,9 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
                             at[n++] = std::size_t(y) * W + std::size_t(x);
                         }
                     if (n == 0 || !f.meets_brick(world, n)) continue;
-                    f.volume_intervals(0, world, n, rays, intervals);
-                    int count = 0;  // the rays with a span, moved to the front
-                    for (int i = 0; i < n; ++i) {
-                        const RaySpan span = f.span(rays[i]);
-                        if (intervals[i].empty() || !(span.t0 < span.t1)) continue;
-                        std::swap(intervals[count], intervals[i]);
-                        rays[count] = rays[i];
-                        spans[count] = span;
-                        states[count] = RayState{};
-                        at[count++] = at[i];
-                    }
+                    const int count = f.owned_rays(world, n, rays, intervals, spans, at, [](std::size_t) { return false; });
                     if (count == 0) continue;
+                    std::fill(states, states + count, RayState{});
                     if (first.packets) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
                     else
                         for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);

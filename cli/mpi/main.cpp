@@ -295,19 +295,28 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
     });
 }
 
-void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, const double (&mine)[2], double gather_s,
+void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, const double (&mine)[3], double gather_s,
                   double write_s, const Traffic& traffic) {
     double slowest[2] = {0.0, 0.0};
     MPI_Reduce(mine, slowest, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
     unsigned long long sent = traffic.sent, most = 0;
     MPI_Reduce(&sent, &most, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
-    if (f.rank == 0)
-        std::fprintf(stderr,
-                     "volref: timing {\"ranks\": %d, \"compositing\": \"%s\", \"bricks\": \"%s\", \"setup_s\": %.4f, \"render_s\": %.4f, "
-                     "\"gather_s\": %.4f, \"combine_write_s\": %.4f, \"bytes_sent_per_rank\": %llu, "
-                     "\"bytes_received_rank0\": %llu, \"image_bytes\": %zu}\n",
-                     f.size, chain ? "chain" : swap ? "swap" : "direct", bricks, slowest[0], slowest[1], gather_s, write_s, most,
-                     (unsigned long long)traffic.received, f.pixels() * std::size_t(f.channels()) * sizeof(double));
+    // Each rank's own integration time (rank order): how even the bricks' cut was.
+    std::vector<double> each(f.rank == 0 ? std::size_t(f.size) : 1);
+    MPI_Gather(&mine[2], 1, MPI_DOUBLE, each.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (f.rank != 0) return;
+    std::string ranks_s;
+    for (double t : each) {
+        char one[32];
+        std::snprintf(one, sizeof one, "%s%.4f", ranks_s.empty() ? "" : ", ", t);
+        ranks_s += one;
+    }
+    std::fprintf(stderr,
+                 "volref: timing {\"ranks\": %d, \"compositing\": \"%s\", \"bricks\": \"%s\", \"setup_s\": %.4f, \"render_s\": %.4f, "
+                 "\"render_s_ranks\": [%s], \"gather_s\": %.4f, \"combine_write_s\": %.4f, \"bytes_sent_per_rank\": %llu, "
+                 "\"bytes_received_rank0\": %llu, \"image_bytes\": %zu}\n",
+                 f.size, chain ? "chain" : swap ? "swap" : "direct", bricks, slowest[0], slowest[1], ranks_s.c_str(), gather_s, write_s,
+                 most, (unsigned long long)traffic.received, f.pixels() * std::size_t(f.channels()) * sizeof(double));
 }
 
 int run(const Args& args, int rank, int size) {
@@ -348,9 +357,11 @@ int run(const Args& args, int rank, int size) {
 
     const double t_setup = now();
     Traffic traffic;
+    double t_own = 0.0;  // when this rank's own integration ended (before any_error's all-reduce)
     if (chain) {
         if (!chained_pixels(f, chained_image, traffic.sent)) return 1;
-    } else if (any_error(guarded([&] { integrate_parts(f, part); }), rank, size)) {
+        t_own = now();
+    } else if (any_error(guarded([&] { integrate_parts(f, part), t_own = now(); }), rank, size)) {
         return 1;
     }
     const double t_render = now();
@@ -377,7 +388,7 @@ int run(const Args& args, int rank, int size) {
     const double t_write = now();
     if (any_error(err, rank, size)) return 1;
     if (args.timing)
-        print_timing(f, chain, swap, bricks, {t_setup - t_start, t_render - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
+        print_timing(f, chain, swap, bricks, {t_setup - t_start, t_render - t_setup, t_own - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
     if (args.compositing == "swap" && !power_of_two && args.compositing_given && rank == 0)
         std::fprintf(stderr, "volref-mpi: note: binary swap needs a power-of-two rank count; %d ranks used direct send\n",
                      size);
@@ -416,7 +427,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     rc->add_flag("--timing", args.timing,
                  "Print one line on stderr (rank 0): volref: timing {ranks, compositing, bricks (cells, work, work-same-cut), setup_s, render_s (the slowest "
-                 "rank's), gather_s, combine_write_s, bytes_sent_per_rank (the most any rank sent), bytes_received_rank0, "
+                 "rank's), render_s_ranks (each rank's), gather_s, combine_write_s, bytes_sent_per_rank (the most any rank sent), bytes_received_rank0, "
                  "image_bytes}");
     int status = 0;
     try {

@@ -652,7 +652,13 @@ if a.mode == "adaptive":
                                       (fixed, [], "cells")):
         r = mpirun(2, ["render", scene_path, "-o", os.path.join(a.work, "timing.img"), "--threads", "1", "--timing"] + extra)
         said = [l for l in r.stderr.splitlines() if l.startswith("volref: timing ")]
-        cut = json.loads(said[0][len("volref: timing "):])["bricks"] if said else None
+        timing = json.loads(said[0][len("volref: timing "):]) if said else {}
+        cut = timing.get("bricks")
+        # render_s_ranks: each rank's own integration, the slowest of them render_s (to the 4 decimals printed).
+        each = timing.get("render_s_ranks", [])
+        if len(each) != 2 or min(each) < 0.0 or abs(max(each) - timing.get("render_s", -1.0)) > 1.5e-4:
+            failures.append("%s %s: render_s_ranks %r against render_s %r" % (
+                os.path.basename(scene_path), extra, each, timing.get("render_s")))
         if r.returncode != 0 or cut not in (expect, expect + "-same-cut"):
             failures.append("%s %s: expected bricks %r in --timing, got %r (%d) %r" % (
                 os.path.basename(scene_path), extra, expect, cut, r.returncode, r.stderr[-300:]))

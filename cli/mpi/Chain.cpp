@@ -16,6 +16,7 @@
 
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/march/SpanStates.h"
+#include "core/render/Renderer.h"
 
 namespace volref::mpi {
 
@@ -123,7 +124,29 @@ private:
 // progress between chunks of 32 pixels a thread, and posts its receives before it starts (measured at
 // 2 ranks on the adaptive scene: the rank behind waited 0.52 s of a 1.5 s chain for states its front
 // rank had finished; with the sender's progress 0.11 s, a handshake per block; see performance.md).
-constexpr std::size_t kChainBlock = 256;
+// A block is a tile of kChainTile x kChainTile pixels (fewer at the image's edges), its pixels in
+// `volref render`'s order (Renderer.h): kPixelBlockWidth x kPixelBlockHeight blocks in row order, row
+// order inside each, so that a batch of kMaxPacketRays of them (fixed_chain) makes the render's packets
+// (4 x 4 on 16 float lanes) and not rows of 16 x 1: with blocks of 256 pixels in rows the fast profile's
+// chained frame was 1.15x slower at one rank (docs/performance.md, "Session 27").
+constexpr int kChainTile = 16;
+constexpr std::size_t kChainBlock = std::size_t(kChainTile) * kChainTile;
+static_assert(kChainTile % kPixelBlockWidth == 0 && kChainTile % kPixelBlockHeight == 0);
+// The chain's blocks in the order every rank takes them, each block's pixels in order.
+std::vector<std::vector<std::size_t>> chain_blocks(const Frame& frame) {
+    const int W = frame.width(), H = frame.height();
+    std::vector<std::vector<std::size_t>> blocks;
+    for (int ty = 0; ty < H; ty += kChainTile)
+        for (int tx = 0; tx < W; tx += kChainTile) {
+            std::vector<std::size_t>& b = blocks.emplace_back();
+            for (int by = ty; by < std::min(ty + kChainTile, H); by += kPixelBlockHeight)
+                for (int bx = tx; bx < std::min(tx + kChainTile, W); bx += kPixelBlockWidth)
+                    for (int y = by; y < std::min({by + kPixelBlockHeight, ty + kChainTile, H}); ++y)
+                        for (int x = bx; x < std::min({bx + kPixelBlockWidth, tx + kChainTile, W}); ++x)
+                            b.push_back(std::size_t(y) * std::size_t(W) + std::size_t(x));
+        }
+    return blocks;
+}
 // Pixels a thread between two of MPI's progress calls (about 2 ms of the adaptive scene's work).
 constexpr std::size_t kChainChunkPerThread = 32;
 // The posted receives each progress call tests (the next ones a rank will wait for; any test drives
@@ -143,7 +166,6 @@ constexpr std::size_t kChainReceiveWindow = 8;
 template <class Step>
 void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuffer& state, bool reverse,
              std::size_t& bytes, Step&& step) {
-    const std::size_t P = frame.pixels();
     auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
     const std::vector<int>& from = reverse ? order.behind : order.front;
     const std::vector<int>& to = reverse ? order.front : order.behind;
@@ -153,10 +175,11 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuff
         std::vector<std::size_t> pixels;
     };
     std::vector<Unit> units;
+    const std::vector<std::vector<std::size_t>> blocks = chain_blocks(frame);
     for (int j = 0; j < frame.size; ++j)
-        for (std::size_t b0 = 0; b0 < P; b0 += kChainBlock) {
+        for (const std::vector<std::size_t>& block : blocks) {
             Unit u{j, {}};
-            for (std::size_t px = b0; px < std::min(P, b0 + kChainBlock); ++px)
+            for (std::size_t px : block)
                 if (order.position[px] >= 0 && round_of(px) == j) u.pixels.push_back(px);
             if (!u.pixels.empty()) units.push_back(std::move(u));
         }
@@ -242,11 +265,11 @@ void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuff
     MPI_Waitall(int(sends.size()), sends.data(), MPI_STATUSES_IGNORE);
 }
 
-// The final states (on each pixel's last rank, or first with `first`) summed onto rank 0; zero elsewhere.
-PartBuffer collect(const Frame& frame, const RankOrder& order, std::size_t S, const PartBuffer& state,
-                            bool first, std::size_t& bytes) {
+// The final states (on each pixel's last rank, or first with `first`) summed onto rank 0 (`all`; `mine`
+// holds this rank's, zero elsewhere: both fresh from fresh_chain).
+const PartBuffer& collect(const Frame& frame, const RankOrder& order, std::size_t S, const PartBuffer& state,
+                          bool first, std::size_t& bytes, PartBuffer& mine, PartBuffer& all) {
     const std::size_t P = frame.pixels();
-    PartBuffer mine(P * S, 0.0), all(frame.rank == 0 ? P * S : 0);
     for (std::size_t px = 0; px < P; ++px) {
         const bool holds = order.position[px] >= 0 && order.position[px] == (first ? 0 : order.count[px] - 1);
         if (holds) std::copy(&state[px * S], &state[px * S] + S, &mine[px * S]);
@@ -271,7 +294,7 @@ bool span_keys(const Frame& frame, std::vector<double>& key, Has&& has) {
 
 // The fixed step with early termination: RayState resumed span after span (the volume's integrator,
 // or the several-volume mix); pixels R G B A on rank 0.
-bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
+bool fixed_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
     const std::size_t P = frame.pixels(), S = RayState::kDoubles;
     std::vector<double> key;
     const bool ok = span_keys(frame, key, [&](std::size_t, const RaySpan&, const PixelRays& scratch) {
@@ -282,7 +305,7 @@ bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
     if (!ok) return false;
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
-    PartBuffer state(P * S, 0.0);  // fresh states (all zero)
+    PartBuffer& state = buf.state;  // fresh states (all zero)
     const PreparedVolume& first = *frame.members[0].prepared;
     auto one = [&](std::size_t px, PixelRays& scratch) {
         double* s = &state[px * S];
@@ -314,9 +337,9 @@ bool fixed_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
         if (count > 0) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
         for (int i = 0; i < count; ++i) states[i].write(&state[at[i] * S]);
     });
-    const PartBuffer final_state = collect(frame, order, S, state, false, bytes);
+    const PartBuffer& final_state = collect(frame, order, S, state, false, bytes, buf.held, buf.summed);
     if (frame.rank != 0) return true;
-    pixels.assign(P * 4, 0.0);
+    PartBuffer& pixels = buf.pixels;
     // The slot's own finish (the reference's composite_state, the fast profile's product_state); a
     // composite's does not read the ray or its intervals (Frame::finish_reads_intervals).
     const Ray no_ray{};
@@ -376,7 +399,7 @@ bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vec
 // composite, MultiVolumeIntegrator::adaptive_composite), a piece belonging to the rank whose span
 // holds its midpoint; AdaptiveComposite's state front to back, then the error's sums back to front;
 // pixels R G B A error on rank 0.
-bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
+bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
     using Composite = AdaptiveIntegrator::Composite;
     using MixComposite = AdaptiveComposite<MultiVolumeIntegrator::AdaptiveMix>;
     const std::size_t P = frame.pixels(), V = frame.volumes(), S = std::size_t(Composite::kStateSize);
@@ -392,7 +415,7 @@ bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) 
     const double tolerance = frame.scene.render.tolerance;
     const double safety = V == 1 ? one->safety() : frame.multi->adaptive_safety();
     const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
-    PartBuffer state(P * S, 0.0);
+    PartBuffer& state = buf.state;
     const Composite fresh(none, tolerance, safety, 1.0);
     for (std::size_t px = 0; px < P; ++px) fresh.save(&state[px * S]);
     std::vector<std::vector<adaptive_detail::Leaf>> leaves(P);
@@ -428,7 +451,7 @@ bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) 
     // The error's sums, back to front: (behind R G B, colour_err, tau_err), from the opaque piece's T c
     // (the last rank's final state).
     constexpr std::size_t E = kErrorSums;
-    PartBuffer sums(P * E, 0.0);
+    PartBuffer& sums = buf.sums;  // (all zero)
     for (std::size_t px = 0; px < P; ++px)
         if (order.position[px] >= 0 && order.position[px] == order.count[px] - 1)
             for (std::size_t i = 0; i < 3; ++i) sums[px * E + i] = state[px * S + Composite::kStateOpaqueColour + i];
@@ -438,10 +461,10 @@ bool adaptive_chain(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) 
         Composite::error_sums(leaves[px], behind, colour_err, tau_err);
         q[0] = behind.r, q[1] = behind.g, q[2] = behind.b, q[3] = colour_err, q[4] = tau_err;
     });
-    const PartBuffer final_state = collect(frame, order, S, state, false, bytes);
-    const PartBuffer final_sums = collect(frame, order, E, sums, true, bytes);
+    const PartBuffer& final_state = collect(frame, order, S, state, false, bytes, buf.held, buf.summed);
+    const PartBuffer& final_sums = collect(frame, order, E, sums, true, bytes, buf.sums_held, buf.sums_summed);
     if (frame.rank != 0) return true;
-    pixels.assign(P * 5, 0.0);
+    PartBuffer& pixels = buf.pixels;
     for (std::size_t px = 0; px < P; ++px) {
         if (!(total[px] > 0.0)) continue;  // no interval: (0, 0, 0, 0), error 0 (as the single process)
         Composite st(none, tolerance, safety, total[px]);
@@ -470,8 +493,19 @@ bool chained(const Frame& frame) {
     return frame.mixed() ? frame.multi->composite_spans_in_order() : frame.members[0].prepared->integrator->spans_in_order();
 }
 
-bool chained_pixels(const Frame& frame, PartBuffer& pixels, std::size_t& bytes) {
-    return frame.adaptive() ? adaptive_chain(frame, pixels, bytes) : fixed_chain(frame, pixels, bytes);
+ChainBuffers fresh_chain(const Frame& frame) {
+    const std::size_t P = frame.pixels(), root = frame.rank == 0 ? 1 : 0;
+    const std::size_t S = frame.adaptive() ? std::size_t(AdaptiveIntegrator::Composite::kStateSize) : std::size_t(RayState::kDoubles);
+    const std::size_t E = frame.adaptive() ? kErrorSums : 0;
+    ChainBuffers b;
+    b.state.assign(P * S, 0.0), b.held.assign(P * S, 0.0), b.summed.assign(root * P * S, 0.0);
+    b.sums.assign(P * E, 0.0), b.sums_held.assign(P * E, 0.0), b.sums_summed.assign(root * P * E, 0.0);
+    b.pixels.assign(root * P * std::size_t(frame.channels()), 0.0);
+    return b;
+}
+
+bool chained_pixels(const Frame& frame, ChainBuffers& buffers, std::size_t& bytes) {
+    return frame.adaptive() ? adaptive_chain(frame, buffers, bytes) : fixed_chain(frame, buffers, bytes);
 }
 
 }  // namespace volref::mpi

@@ -11,12 +11,24 @@
 #include <vector>
 
 #include "cli/mpi/Frame.h"
+#include "cli/mpi/PartBuffer.h"
 
 namespace volref::mpi {
 
-// The finished pixels (Frame::channels() doubles each) on rank 0, and the bytes this rank sent; false
-// after an error (reported by rank 0 through any_error; every rank returns false).
-bool chained_pixels(const Frame& frame, PartBuffer& pixels, std::size_t& bytes_handed);
+// The chain's image-size arrays, made and first touched at set-up (fresh_chain), as the parts are
+// (main.cpp fresh_parts), so that render_s is the chain and not their pages' first touch: the states
+// handed on, collect's two (the final states this rank holds, their sum on rank 0), for the adaptive
+// chain the error sums and their two, and rank 0's pixels. Each is written once per run.
+struct ChainBuffers {
+    PartBuffer state, held, summed;           // P x the state's doubles (summed: rank 0 only), all zero
+    PartBuffer sums, sums_held, sums_summed;  // the adaptive chain's error sums, the same way
+    PartBuffer pixels;                        // rank 0: P x Frame::channels()
+};
+ChainBuffers fresh_chain(const Frame& frame);
+
+// The finished pixels (buffers.pixels, Frame::channels() doubles each) on rank 0, and the bytes this rank
+// sent; false after an error (reported by rank 0 through any_error; every rank returns false).
+bool chained_pixels(const Frame& frame, ChainBuffers& buffers, std::size_t& bytes_handed);
 
 // Whether the scene's composite is chained (rather than merged from independent parts).
 bool chained(const Frame& frame);

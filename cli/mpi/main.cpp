@@ -352,14 +352,15 @@ int run(const Args& args, int rank, int size) {
     }
     Frame& f = *frame;
     const bool chain = chained(f);
-    PartBuffer part, chained_image;
-    if (!chain && any_error(guarded([&] { part = fresh_parts(f); }), rank, size)) return 1;
+    PartBuffer part;
+    ChainBuffers chained_buffers;  // (its pixels: the image on rank 0)
+    if (any_error(guarded([&] { chain ? void(chained_buffers = fresh_chain(f)) : void(part = fresh_parts(f)); }), rank, size)) return 1;
 
     const double t_setup = now();
     Traffic traffic;
     double t_own = 0.0;  // when this rank's own integration ended (before any_error's all-reduce)
     if (chain) {
-        if (!chained_pixels(f, chained_image, traffic.sent)) return 1;
+        if (!chained_pixels(f, chained_buffers, traffic.sent)) return 1;
         t_own = now();
     } else if (any_error(guarded([&] { integrate_parts(f, part), t_own = now(); }), rank, size)) {
         return 1;
@@ -375,7 +376,7 @@ int run(const Args& args, int rank, int size) {
     if (rank == 0) image = std::make_unique<Image>(f.width(), f.height(), channels);
     double* pixels = rank == 0 ? image->pixels.data() : nullptr;
     if (chain) {
-        if (rank == 0) std::copy(chained_image.begin(), chained_image.end(), pixels);
+        if (rank == 0) std::copy(chained_buffers.pixels.begin(), chained_buffers.pixels.end(), pixels);
     } else if (swap) {
         binary_swap(f, part, pixels, traffic);
     } else {

@@ -153,6 +153,26 @@ constexpr std::size_t kChainChunkPerThread = 32;
 // every transfer, the window only bounds the call's cost on a frame of many blocks).
 constexpr std::size_t kChainReceiveWindow = 8;
 
+// This rank's units (round j, block b) in the order every rank takes them, each with its pixels (in the
+// block's order); `reverse`: the rounds counted from each pixel's last rank.
+struct ChainUnit {
+    int j;
+    std::vector<std::size_t> pixels;
+};
+std::vector<ChainUnit> chain_units(const Frame& frame, const RankOrder& order, bool reverse) {
+    auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
+    std::vector<ChainUnit> units;
+    const std::vector<std::vector<std::size_t>> blocks = chain_blocks(frame);
+    for (int j = 0; j < frame.size; ++j)
+        for (const std::vector<std::size_t>& block : blocks) {
+            ChainUnit u{j, {}};
+            for (std::size_t px : block)
+                if (order.position[px] >= 0 && round_of(px) == j) u.pixels.push_back(px);
+            if (!u.pixels.empty()) units.push_back(std::move(u));
+        }
+    return units;
+}
+
 // The state (S doubles a pixel) handed from rank to rank point to point: the image in blocks of
 // kChainBlock pixels; in round j (front to back, or from the last rank with `reverse`), block b, a rank
 // takes its round-j pixels' states from the ranks in front of it (receives posted at the start, in the
@@ -166,23 +186,9 @@ constexpr std::size_t kChainReceiveWindow = 8;
 template <class Step>
 void hand_on(const Frame& frame, const RankOrder& order, std::size_t S, PartBuffer& state, bool reverse,
              std::size_t& bytes, Step&& step) {
-    auto round_of = [&](std::size_t px) { return reverse ? order.count[px] - 1 - order.position[px] : order.position[px]; };
     const std::vector<int>& from = reverse ? order.behind : order.front;
     const std::vector<int>& to = reverse ? order.front : order.behind;
-    // This rank's units (round j, block b) in the order every rank takes them, each with its pixels.
-    struct Unit {
-        int j;
-        std::vector<std::size_t> pixels;
-    };
-    std::vector<Unit> units;
-    const std::vector<std::vector<std::size_t>> blocks = chain_blocks(frame);
-    for (int j = 0; j < frame.size; ++j)
-        for (const std::vector<std::size_t>& block : blocks) {
-            Unit u{j, {}};
-            for (std::size_t px : block)
-                if (order.position[px] >= 0 && round_of(px) == j) u.pixels.push_back(px);
-            if (!u.pixels.empty()) units.push_back(std::move(u));
-        }
+    const std::vector<ChainUnit> units = chain_units(frame, order, reverse);
     // In: every receive posted at once, unit by unit, from each rank in front (its pixels in pixel
     // order, as it sends them; a sender's messages to one rank match the receives in the order posted),
     // so that a state's handshake goes on while this rank computes and its data is there when needed.

@@ -295,7 +295,7 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
     });
 }
 
-void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, const double (&mine)[3], double gather_s,
+void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, const double (&mine)[2], double gather_s,
                   double write_s, const Traffic& traffic) {
     double slowest[2] = {0.0, 0.0};
     MPI_Reduce(mine, slowest, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
@@ -303,7 +303,7 @@ void print_timing(const Frame& f, bool chain, bool swap, const char* bricks, con
     MPI_Reduce(&sent, &most, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
     // Each rank's own integration time (rank order): how even the bricks' cut was.
     std::vector<double> each(f.rank == 0 ? std::size_t(f.size) : 1);
-    MPI_Gather(&mine[2], 1, MPI_DOUBLE, each.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    MPI_Gather(&mine[1], 1, MPI_DOUBLE, each.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     if (f.rank != 0) return;
     std::string ranks_s;
     for (double t : each) {
@@ -365,7 +365,6 @@ int run(const Args& args, int rank, int size) {
     } else if (any_error(guarded([&] { integrate_parts(f, part), t_own = now(); }), rank, size)) {
         return 1;
     }
-    const double t_render = now();
     MPI_Barrier(MPI_COMM_WORLD);  // (timing: the compositing below starts when the slowest rank is done)
     const double t_ready = now();
 
@@ -389,7 +388,7 @@ int run(const Args& args, int rank, int size) {
     const double t_write = now();
     if (any_error(err, rank, size)) return 1;
     if (args.timing)
-        print_timing(f, chain, swap, bricks, {t_setup - t_start, t_render - t_setup, t_own - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
+        print_timing(f, chain, swap, bricks, {t_setup - t_start, t_own - t_setup}, t_gather - t_ready, t_write - t_gather, traffic);
     if (args.compositing == "swap" && !power_of_two && args.compositing_given && rank == 0)
         std::fprintf(stderr, "volref-mpi: note: binary swap needs a power-of-two rank count; %d ranks used direct send\n",
                      size);

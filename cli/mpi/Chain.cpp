@@ -496,6 +496,7 @@ std::size_t chain_bytes(const Frame& frame) {
 bool chained(const Frame& frame) {
     if (!is_composite(frame.scene.render.projection)) return false;
     if (frame.adaptive()) return true;
+    if (frame.size == 1) return false;  // one span a pixel: nothing to hand on, the parts' path (as volref render)
     return frame.mixed() ? frame.multi->composite_spans_in_order() : frame.members[0].prepared->integrator->spans_in_order();
 }
 

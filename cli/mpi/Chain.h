@@ -30,7 +30,10 @@ ChainBuffers fresh_chain(const Frame& frame);
 // sent; false after an error (reported by rank 0 through any_error; every rank returns false).
 bool chained_pixels(const Frame& frame, ChainBuffers& buffers, std::size_t& bytes_handed);
 
-// Whether the scene's composite is chained (rather than merged from independent parts).
+// Whether the scene's composite is chained (rather than merged from independent parts): the adaptive
+// integrator's at any rank count, a fixed step's whose spans go in order (early termination, the fast
+// profile) at two ranks or more; at one rank each pixel has one span from a fresh state, which the parts'
+// path integrates as `volref render` does.
 bool chained(const Frame& frame);
 
 // The bytes the chain's fixed-size arrays take on this rank (--max-memory, checked before they are

@@ -484,10 +484,24 @@ bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
 
 }  // namespace
 
+namespace {
+
+// The doubles a pixel's state and (the adaptive chain) its error sums take: what fresh_chain allocates
+// and chain_bytes counts.
+struct ChainValues {
+    std::size_t state, sums;
+};
+ChainValues chain_values(const Frame& frame) {
+    if (frame.adaptive()) return {std::size_t(AdaptiveIntegrator::Composite::kStateSize), kErrorSums};
+    return {std::size_t(RayState::kDoubles), 0};
+}
+
+}  // namespace
+
 std::size_t chain_bytes(const Frame& frame) {
     const std::size_t P = frame.pixels(), ranks = std::size_t(frame.size), root = frame.rank == 0 ? 1 : 0;
-    const std::size_t handed = frame.adaptive() ? std::size_t(AdaptiveIntegrator::Composite::kStateSize) + kErrorSums
-                                                : std::size_t(RayState::kDoubles);
+    const ChainValues v = chain_values(frame);
+    const std::size_t handed = v.state + v.sums;
     const std::size_t per_pixel = (1 + ranks) * sizeof(double) + 4 * sizeof(int) + handed * sizeof(double) * (4 + root) +
                                   root * std::size_t(frame.channels()) * sizeof(double);
     return P * per_pixel;
@@ -502,8 +516,7 @@ bool chained(const Frame& frame) {
 
 ChainBuffers fresh_chain(const Frame& frame) {
     const std::size_t P = frame.pixels(), root = frame.rank == 0 ? 1 : 0;
-    const std::size_t S = frame.adaptive() ? std::size_t(AdaptiveIntegrator::Composite::kStateSize) : std::size_t(RayState::kDoubles);
-    const std::size_t E = frame.adaptive() ? kErrorSums : 0;
+    const auto [S, E] = chain_values(frame);
     ChainBuffers b;
     b.state.assign(P * S, 0.0), b.held.assign(P * S, 0.0), b.summed.assign(root * P * S, 0.0);
     b.sums.assign(P * E, 0.0), b.sums_held.assign(P * E, 0.0), b.sums_summed.assign(root * P * E, 0.0);

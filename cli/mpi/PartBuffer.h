@@ -4,8 +4,8 @@
 // image's parts on session 18's 2-core VM (about 3 ms per MB: a rank pays it whatever its share of the
 // work; 3-6 ms on session 26's); on 2 MiB transparent huge pages (madvise MADV_HUGEPAGE, which Debian's
 // default "madvise" mode honours) 0.9-5 ms, but 12-17 ms when the kernel compacts memory to find the huge
-// pages. Measured in docs/performance.md ("Session 18", "Session 26"). The parts are made at set-up
-// (main.cpp fresh_parts), outside render_s. Values are unaffected.
+// pages. Measured in docs/performance.md ("Session 18", "Session 26"). The parts and the chain's arrays are
+// made at set-up (main.cpp fresh_parts, Chain.h fresh_chain), outside render_s. Values are unaffected.
 #pragma once
 #include <sys/mman.h>
 

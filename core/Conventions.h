@@ -12,6 +12,11 @@ namespace volref::conventions {
 // The slack absorbs a remainder shorter than kSegmentSlack * h that is only rounding of L / h
 // (e.g. L = 0.3, h = 0.1), instead of creating a sliver segment.
 inline constexpr double kSegmentSlack = 1e-9;
+// A slicer's level count (issue 54; core/integrate/profiles/Slices.cpp, conventions section 9,
+// "Slice-order renderers"): with spacing s over the range's extent E, n = floor(E / s - o + kSliceSlack) + 1
+// levels (o = 0 or 1/2, `first`); with a period, n = ceil(E / D - kSliceSlack). The slack keeps a ratio
+// that is an integer up to rounding from gaining or losing a level.
+inline constexpr double kSliceSlack = 1e-9;
 
 // Intervals shorter than this (world units) are dropped: a ray grazing a box edge or face has a
 // chord of length 0 (or a rounding error of it) and contributes nothing.
@@ -161,9 +166,18 @@ inline constexpr double kMinMagnitude = 1e-100;
 inline constexpr double kMaxSamplesPerRay = 0x1p32;
 // Memory accounted per sample of `volref trace` (the record, plus its CSV or JSON text) and per triangle
 // of a tessellated shell (the mesh, its vertex map, Embree's BVH and the float copies), checked against
-// --max-memory before they are made.
+// --max-memory before they are made; a set of tetrahedra (geometry/TetrahedralMesh.h) counts 4 triangles
+// per tetrahedron (its faces: the face table, then at most that many boundary triangles).
 inline constexpr std::size_t kTraceBytesPerSampleOutput = 1024;
 inline constexpr std::size_t kMeshBytesPerTriangle = 256;
+// Tetrahedral bounds (volume.bounds type "tetrahedra", geometry/TetrahedralMesh.h): a tetrahedron
+// (a, b, c, d) is degenerate, and an error, when
+//   |det(b - a, c - a, d - a)| <= kTetrahedronDegenerateRelative * l^3,  l its longest edge
+// (det = 6 x its signed volume; det / l^3 is a shape measure, 1 / sqrt(2) for the regular tetrahedron,
+// 0 for a flat one). Rounding of det is a few eps l^3 when the coordinates are within about 1000 l of
+// each other, far below 1e-12 l^3, so a tetrahedron refused is flat to about 12 digits and one kept is
+// not flat by rounding. The sign of det only orients it (VTK files hold either orientation).
+inline constexpr double kTetrahedronDegenerateRelative = 1e-12;
 // SIGINT / SIGTERM are polled every this many samples inside a ray's march and every piece a reader
 // decodes (core/Cancellation.h), so that even a single ray of 2^32 samples stops within milliseconds.
 inline constexpr std::int64_t kCancellationPollSamples = 4096;

@@ -251,11 +251,12 @@ int BoundingGeometry::add_box(const glm::dvec3& lo, const glm::dvec3& hi, const 
     return id;
 }
 
-int BoundingGeometry::add_mesh(const TriangleMesh& mesh, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi) {
+int BoundingGeometry::add_mesh(const TriangleMesh& mesh, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi,
+                                Closedness rule) {
     const int id = impl_->next_id();
     auto shape = std::make_unique<MeshShape>();
     shape->mesh = mesh;
-    check_closed(shape->mesh, "bounding mesh");
+    check_closed(shape->mesh, "bounding mesh", rule);
     shape->domain_lo = domain_lo;
     shape->domain_hi = domain_hi;
     shape->scale = mesh_scale(shape->mesh);

@@ -42,9 +42,12 @@ public:
 
     // The bounding box [lo, hi] and the data domain [domain_lo, domain_hi].
     int add_box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi);
-    // A closed triangle mesh (see check_closed; it is checked again and oriented outward here, an
-    // Error naming "bounding mesh" if it is not closed) and the data domain.
-    int add_mesh(const TriangleMesh& mesh, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi);
+    // A closed triangle mesh (see check_closed; it is checked again, by `rule`, and oriented outward
+    // here, an Error naming "bounding mesh" if it is not closed) and the data domain. A set of
+    // tetrahedra bounds through its boundary (geometry/TetrahedralMesh.h: tetrahedra_boundary), a
+    // Closedness::Cycle.
+    int add_mesh(const TriangleMesh& mesh, const glm::dvec3& domain_lo, const glm::dvec3& domain_hi,
+                 Closedness rule = Closedness::Manifold);
     // Curvilinear shells (core/scene/ShellSpec.h): the shell is also the data domain.
     int add_cylindrical_shell(const CylindricalShell& shell);
     int add_spherical_shell(const SphericalShell& shell);

@@ -201,7 +201,7 @@ double signed_volume(const TriangleMesh& mesh) {
     return sum / 6.0;
 }
 
-void check_closed(TriangleMesh& mesh, const std::string& name) {
+void check_closed(TriangleMesh& mesh, const std::string& name, Closedness rule) {
     const std::size_t nv = mesh.vertices.size();
     for (const auto& t : mesh.triangles)
         for (const auto v : t)
@@ -233,6 +233,15 @@ void check_closed(TriangleMesh& mesh, const std::string& name) {
         std::size_t j = i;
         while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
         const std::size_t n = j - i;
+        if (rule == Closedness::Cycle) {
+            std::size_t forward = 0;
+            for (std::size_t k = i; k < j; ++k) forward += edges[k].forward;
+            if (2 * forward != n)
+                throw Error(name + ": the surface is not closed (" + where(edges[i]) + " is used " + std::to_string(forward) +
+                            " times in one direction and " + std::to_string(n - forward) + " in the other)");
+            i = j;
+            continue;
+        }
         if (n != 2)
             throw Error(name + ": the mesh is not closed (" + where(edges[i]) + " is used by " + std::to_string(n) +
                         (n == 1 ? " triangle)" : " triangles)"));

@@ -38,10 +38,19 @@ TriangleMesh read_mesh(const std::string& path);
 // vertices no triangle uses; triangle indices are remapped.
 void merge_coincident_vertices(TriangleMesh& mesh);
 
+// What check_closed asks of the edges.
+//   Manifold: every undirected edge is used by exactly two triangles, in opposite directions (a mesh
+//             file: a closed, consistently oriented 2-manifold).
+//   Cycle:    every undirected edge is used as often in one direction as in the other (a closed
+//             surface that may touch itself along an edge or at a vertex, or run twice over a face:
+//             the boundary of a set of tetrahedra, geometry/TetrahedralMesh.h). The ray test's
+//             winding number is well defined for it all the same (geometry/MeshIntervals.h).
+enum class Closedness { Manifold, Cycle };
+
 // Throws Error "NAME: the mesh is not closed (...)" / "NAME: the mesh is not consistently oriented (...)"
 // naming the first offending edge by its vertices' positions; otherwise removes triangles with a
 // repeated vertex and orients the mesh outward (positive signed volume). `name` is usually the file.
-void check_closed(TriangleMesh& mesh, const std::string& name);
+void check_closed(TriangleMesh& mesh, const std::string& name, Closedness rule = Closedness::Manifold);
 
 // read_mesh + check_closed.
 TriangleMesh read_closed_mesh(const std::string& path);

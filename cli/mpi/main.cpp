@@ -55,8 +55,9 @@ void check_supported(const Scene& scene) {
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
         const VolumeSpec& vs = scene.volumes[k];
         const std::string key = volume_key(scene, k);
-        if (vs.bounds.type != BoundsSpec::Type::Box && vs.bounds.type != BoundsSpec::Type::Mesh)
-            throw Error(key + ".bounds: volref-mpi supports box and mesh bounds only (shells are not supported yet)");
+        if (vs.bounds.type != BoundsSpec::Type::Box && vs.bounds.type != BoundsSpec::Type::Mesh &&
+            vs.bounds.type != BoundsSpec::Type::Tetrahedra)
+            throw Error(key + ".bounds: volref-mpi supports box, mesh and tetrahedra bounds only (shells are not supported yet)");
         // "auto" decides from the whole volume's voxels (resolve_gradient_cache), which no rank holds.
         if (vs.gradient.cache_auto)
             throw Error(key + ".gradient.cache: \"auto\" is not supported by volref-mpi yet (say true or false)");

@@ -66,6 +66,23 @@ Camera::Camera(const CameraSpec& spec, int width, int height, const glm::dvec3& 
     }
 }
 
+glm::dvec3 Camera::eye() const {
+    if (kind_ == Kind::Matrices) return glm::dvec3(inverse_view_ * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+    return glm::dvec3(rays_.eye[0], rays_.eye[1], rays_.eye[2]);
+}
+
+glm::dvec3 Camera::forward() const {
+    if (kind_ == Kind::Matrices) return glm::normalize(glm::dvec3(inverse_view_ * glm::dvec4(0.0, 0.0, -1.0, 0.0)));
+    return glm::dvec3(rays_.forward[0], rays_.forward[1], rays_.forward[2]);
+}
+
+// A `matrices` camera is perspective when two pixels' rays start at the same point (the eye).
+bool Camera::perspective() const {
+    if (kind_ != Kind::Matrices) return kind_ == Kind::Perspective;
+    const Ray a = ray(0.0, 0.0), b = ray(rays_.width, rays_.height);
+    return glm::length(a.origin - b.origin) <= 1e-9 * (1.0 + glm::length(a.origin));
+}
+
 glm::dvec2 Camera::ndc(double fx, double fy) const {
     glm::dvec2 n;
     camera_ndc_lanes<Scalar>(rays_.width, rays_.height, fx, fy, n.x, n.y);

@@ -49,6 +49,14 @@ public:
     void pixel_rays(const int* x, const int* y, int count, Ray* out) const;
     // The normalised device coordinates (nx, ny) of film point (fx, fy) that ray() uses.
     glm::dvec2 ndc(double fx, double fy) const;
+    // The eye E and the forward unit vector f (a `matrices` camera: the view's origin and -z axis), and
+    // whether rays start at the eye (perspective) or on its plane (orthographic): the slicers' surfaces
+    // (core/integrate/profiles/Slices.h) are placed from them.
+    glm::dvec3 eye() const;
+    glm::dvec3 forward() const;
+    bool perspective() const;
+    int width() const { return int(rays_.width); }
+    int height() const { return int(rays_.height); }
 
 private:
     enum class Kind { Perspective, Orthographic, Matrices } kind_;

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -16,6 +17,7 @@
 #include "core/MemoryLimit.h"
 #include "core/grid/ProceduralField.h"
 #include "core/integrate/packet/FastProfile.h"
+#include "core/camera/Camera.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
 #include "core/integrate/profiles/VtkJsIntegrator.h"
 #include "core/integrate/profiles/VtkFixedPointRenderer.h"
@@ -24,6 +26,7 @@
 #include "geometry/ClipPlanes.h"
 #include "geometry/CropRegions.h"
 #include "geometry/ShellTessellation.h"
+#include "geometry/TetrahedralMesh.h"
 #include "geometry/TriangleMesh.h"
 
 namespace volref {
@@ -79,8 +82,12 @@ std::string volume_key(const Scene& scene, std::size_t index) {
 
 int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const std::string& key,
                          const glm::dvec3& domain_lo, const glm::dvec3& domain_hi, glm::dvec3& lo, glm::dvec3& hi) {
-    if (vs.bounds.type == BoundsSpec::Type::Mesh) {
-        const TriangleMesh mesh = read_closed_mesh(vs.bounds.mesh.string());
+    if (vs.bounds.type == BoundsSpec::Type::Mesh || vs.bounds.type == BoundsSpec::Type::Tetrahedra) {
+        // Tetrahedra: the union's boundary, a closed surface handed to the same mesh path
+        // (geometry/TetrahedralMesh.h).
+        const bool tetrahedra = vs.bounds.type == BoundsSpec::Type::Tetrahedra;
+        const TriangleMesh mesh = tetrahedra ? read_tetrahedral_bounds(vs.bounds.mesh.string())
+                                             : read_closed_mesh(vs.bounds.mesh.string());
         glm::dvec3 mlo(std::numeric_limits<double>::infinity()), mhi(-std::numeric_limits<double>::infinity());
         for (const glm::dvec3& p : mesh.vertices) {
             mlo = glm::min(mlo, p);
@@ -88,7 +95,7 @@ int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const
         }
         lo = glm::max(mlo, domain_lo);
         hi = glm::min(mhi, domain_hi);
-        return geometry.add_mesh(mesh, domain_lo, domain_hi);
+        return geometry.add_mesh(mesh, domain_lo, domain_hi, tetrahedra ? Closedness::Cycle : Closedness::Manifold);
     }
     const glm::dvec3 box_lo = vs.bounds.min.value_or(domain_lo), box_hi = vs.bounds.max.value_or(domain_hi);
     if (!(box_lo.x <= box_hi.x && box_lo.y <= box_hi.y && box_lo.z <= box_hi.z))
@@ -358,7 +365,16 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     } else if (p.renderer == Profile::Renderer::VtkJs) {  // issue 22
         integrator = std::make_unique<VtkJsIntegrator>(*context, volume, vs, scene);
     } else {
-        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds);  // the preset or custom rules
+        // placement "slices" (issue 54): the surfaces are placed from the frame's camera (for one volume
+        // PreparedScene's, which frames this volume's box) and the geometry's box.
+        std::optional<Camera> camera;
+        SliceFrame frame;
+        if (p.placement == Profile::Placement::Slices) {
+            if (transform) throw Error("volume.transform: placement \"slices\" places its surfaces in the volume's own space (remove the transform)");
+            camera.emplace(scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
+            frame = SliceFrame{&*camera, &scene.camera, lo, hi};
+        }
+        integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds, camera ? &frame : nullptr);  // the preset or custom rules
     }
     // The SIMD packet paths shade and measure gradients in the grid's space: not for a transformed
     // volume whose gradient is used.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -104,10 +105,16 @@ struct GradientSpec {
 enum class Interpolation { Nearest, Trilinear, TricubicBSpline, TricubicCatmullRom };
 
 struct BoundsSpec {
-    enum class Type { Box, Mesh, Cylindrical, Spherical };
+    enum class Type { Box, Mesh, Cylindrical, Spherical, Tetrahedra };
+    // Tetrahedra: how overlapping tetrahedra count. Union: a point is inside once, however many cover
+    // it. "count" (OpenGL Volumizer drawing each tetrahedron, so overlaps count twice) is recognised by
+    // the loader and refused as not implemented yet (docs/scene-format.md).
+    enum class Overlap { Union };
     Type type = Type::Box;
     std::optional<glm::dvec3> min, max;  // box: absent = the volume's domain
-    std::filesystem::path mesh;          // mesh: a closed triangle mesh (.obj, .ply), absolute
+    std::filesystem::path mesh;          // mesh: a closed triangle mesh (.obj, .ply); tetrahedra: a VTK
+                                         // legacy UNSTRUCTURED_GRID (.vtk); absolute
+    Overlap overlap = Overlap::Union;    // tetrahedra only
     CylindricalShell cylinder;           // cylindrical shell (the grid is in beam space)
     SphericalShell sphere;               // spherical shell (the grid is in beam space)
     int tessellate = 0;                  // shells: > 0 = use a triangle mesh of about this many segments per turn
@@ -162,6 +169,9 @@ struct CameraSpec {
     double fov_y = 30.0;   // degrees, in (0, 180)
     double height = 1.0;   // orthographic view height, world units, > 0
     glm::dmat4 view{1.0}, projection{1.0};  // matrices (OpenGL conventions; given column-major)
+    // Clipping depths along the view direction (eye space, 0 < near < far): read by placement "slices"
+    // only (its range "view_volume" and its fragments' depth test; conventions section 9).
+    std::optional<double> near, far;
 };
 
 struct ImageSpec {
@@ -176,7 +186,7 @@ enum class StepUnits { Voxel, World };
 enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/profiles/Profile.h, conventions section 9);
 // Fast is volref's own float SIMD variant of the reference (core/integrate/packet/FastProfile.h).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs };
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs, Volumizer };
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {
     double density = 1.0;         // the lerp weight is col.a * density
@@ -218,6 +228,9 @@ struct ProfileOptions {
     // data range to unsigned shorts (rounded to nearest) read as v / 65535 (render.profile_options.
     // texture_format "unorm16"), or the values themselves ("float", the default).
     bool data_unorm16 = false;
+    // placement "slices" (issue 54): the render writes the "error" channel, the interval of what every
+    // rounding variant of the frame buffer stores (conventions section 9, "Slice-order renderers").
+    bool framebuffer_band = false;
     // fast (issue 31; transfer/PreIntegration.h): pre-integrated segments, the table's intervals per axis
     // (render.profile_options.preintegration); 0: off, samples at the segments' midpoints.
     int preintegration = 0;
@@ -229,7 +242,9 @@ struct ProfileOptions {
 struct ProfileRules {
     // Where the samples of an interval [t0, t1] lie: segment midpoints (the reference), from the entry
     // t0 + (first + k) h, or from the exit t1 - k h.
-    enum class Placement { Midpoints, FromEntry, FromExit };
+    // Slices: a slicer's sampling surfaces (issue 54; `slices` below, conventions section 9, "Slice-order
+    // renderers").
+    enum class Placement { Midpoints, FromEntry, FromExit, Slices };
     // From the entry or the exit: how many samples. ThroughExit: n = max(1, floor(L / h + 1 - first))
     // (samples up to and at t1, at least one); BeforeExit: n = max(0, ceil(L / h - first)) (t < t1).
     enum class StepCount { ThroughExit, BeforeExit };
@@ -253,7 +268,48 @@ struct ProfileRules {
     // domain, one-sided at its boundary (the reference's GradientField, conventions section 2).
     enum class Gradient { Central, Forward, CentralInDomain };
 
+    // The slicer's surfaces (placement "slices"; conventions section 9, "Slice-order renderers").
+    struct Slices {
+        enum class Orientation { Viewport, Axis, Spherical };
+        enum class Range { Object, ViewVolume };
+        enum class First { Bound, Half };
+        enum class Order { BackToFront, FrontToBack };
+        Orientation orientation = Orientation::Viewport;
+        Range range = Range::Object;
+        std::optional<double> spacing;              // in render.step_units; none of the three: the scene's step
+        std::optional<std::int64_t> count;          // Volumizer's samplesNumber
+        std::optional<glm::dvec3> period;           // Volumizer's samplingPeriod, voxels
+        std::optional<std::int64_t> max_count;      // n = min(n, max_count)
+        First first = First::Bound;
+        Order order = Order::BackToFront;
+        bool operator==(const Slices&) const = default;
+    };
+    enum class Texture { Texture3d, Texture2d };
+    enum class TexelFormat { Float, Unorm16, Unorm8 };
+    enum class TextureWindow { TransferRows, DataRange, Given };
+    enum class TableLookup { Texture, Linear, Nearest };
+    enum class TableFormat { Float, Unorm8 };
+    enum class SliceClassify { Post, PreUnweighted };
+    enum class FrameBuffer { Double, Rgba32f, Rgba16f, Rgba8 };
+    enum class Rounding { Nearest, Truncate };
+    enum class BlendProducts { Exact, Rounded };
+    enum class Blend { SrcAlpha, Premultiplied, Max };
+    enum class BlendAlpha { SrcAlpha, One };
+
     std::optional<Placement> placement;
+    std::optional<Slices> slices;
+    std::optional<Texture> texture;
+    std::optional<TexelFormat> texture_format;
+    std::optional<TextureWindow> texture_window;
+    glm::dvec2 texture_window_given{0.0, 1.0};  // TextureWindow::Given: [lo, hi], lo < hi
+    std::optional<TableLookup> table_lookup;
+    std::optional<TableFormat> table_format;
+    std::optional<SliceClassify> classify;
+    std::optional<FrameBuffer> framebuffer;
+    std::optional<Rounding> framebuffer_rounding;
+    std::optional<BlendProducts> blend_products;
+    std::optional<Blend> blend;
+    std::optional<BlendAlpha> blend_alpha;
     std::optional<double> first;  // from-entry: the first sample's distance from the entry, in steps
     std::optional<StepCount> step_count;
     std::optional<RayBox> ray_box;

@@ -382,6 +382,11 @@ BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ct
             r.allow({"type", "file"}, "for bounds type \"mesh\"");
             b.mesh = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
             return b;
+        case T::Tetrahedra:
+            r.allow({"type", "file", "overlap"}, "for bounds type \"tetrahedra\"");
+            b.mesh = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
+            b.overlap = r.choice<BoundsSpec::Overlap>("overlap", BoundsSpec::Overlap::Union, names::kOverlaps, {"count"});
+            return b;
         case T::Cylindrical:
         case T::Spherical:
             read_shell(r, b);
@@ -733,12 +738,12 @@ CameraSpec read_camera(const Json& v, const std::string& path, const Context& ct
     c.type = r.required_choice<T>("type", names::kCameras);
     switch (c.type) {
         case T::Perspective:
-            r.allow({"type", "eye", "target", "up", "fov_y"}, "for camera type \"perspective\"");
+            r.allow({"type", "eye", "target", "up", "fov_y", "near", "far"}, "for camera type \"perspective\"");
             read_look_at(r, c);
             c.fov_y = r.number("fov_y", 30.0, Range::open(0, 180));
             break;
         case T::Orthographic:
-            r.allow({"type", "eye", "target", "up", "height"}, "for camera type \"orthographic\"");
+            r.allow({"type", "eye", "target", "up", "height", "near", "far"}, "for camera type \"orthographic\"");
             read_look_at(r, c);
             c.height = r.number("height", 1.0, Range::positive());
             break;
@@ -749,6 +754,11 @@ CameraSpec read_camera(const Json& v, const std::string& path, const Context& ct
             break;
         case T::Default: break;  // not a value of "type"
     }
+    // Clipping depths (placement "slices" reads them): eye-space depths, 0 < near < far.
+    c.near = r.optional_number("near", Range::positive());
+    c.far = r.optional_number("far", Range::positive());
+    if (c.near.has_value() != c.far.has_value()) r.fail(c.near ? "near" : "far", "near and far are set together");
+    if (c.near && !(*c.near < *c.far)) r.fail("far", "must exceed near");
     return c;
 }
 
@@ -778,15 +788,66 @@ ProfileId read_profile_id(Reader& r, std::string_view key) {
 
 // render.profile as an object (issue 29): each rule of Profile.h by its key (scene-format.md,
 // "render.profile"); the renderers that are not rule-driven (vtk-cpu, vtk-js, fast) take none.
+// The slicers' rules (issue 54; conventions section 9, "Slice-order renderers"): `slices` and what a
+// slice fragment and the frame buffer compute.
+void read_slice_rules(ObjectReader& r, ProfileRules& out) {
+    using P = ProfileRules;
+    using S = P::Slices;
+    if (const Json* v = r.find("slices")) {
+        ObjectReader sr(*v, r.path("slices"), r.context());
+        sr.allow({"orientation", "range", "spacing", "count", "period", "max_count", "first", "order"});
+        S sl;
+        sl.orientation = sr.choice<S::Orientation>("orientation", S::Orientation::Viewport, names::kSliceOrientations);
+        sl.range = sr.choice<S::Range>("range", S::Range::Object, names::kSliceRanges);
+        sl.spacing = sr.optional_number("spacing", Range::positive());
+        if (sr.has("count")) sl.count = sr.integer("count", 1, Range::closed(1, 1LL << 32));
+        if (const Json* p = sr.find("period")) {
+            const std::vector<double> c = read_numbers(*p, sr.path("period"), r.context(), 3, Range::positive());
+            sl.period = glm::dvec3(c[0], c[1], c[2]);
+        }
+        if (int(sl.spacing.has_value()) + int(sl.count.has_value()) + int(sl.period.has_value()) > 1)
+            sr.fail(sl.count && sl.period ? "period" : sl.count ? "count" : "period", "set one of spacing, count and period");
+        if (sr.has("max_count")) sl.max_count = sr.integer("max_count", 1, Range::closed(1, 1LL << 32));
+        sl.first = sr.choice<S::First>("first", S::First::Bound, names::kSliceFirsts);
+        sl.order = sr.choice<S::Order>("order", S::Order::BackToFront, names::kSliceOrders);
+        out.slices = sl;
+    }
+    out.texture = r.optional_choice<P::Texture>("texture", names::kTextures);
+    out.texture_format = r.optional_choice<P::TexelFormat>("texture_format", names::kTexelFormats);
+    if (const Json* w = r.find("texture_window")) {
+        if (w->is_array()) {
+            const std::vector<double> c = read_numbers(*w, r.path("texture_window"), r.context(), 2);
+            if (!(c[0] < c[1])) r.fail("texture_window", "expected [lo, hi] with lo < hi");
+            out.texture_window = P::TextureWindow::Given;
+            out.texture_window_given = glm::dvec2(c[0], c[1]);
+        } else {
+            out.texture_window = r.choice<P::TextureWindow>("texture_window", P::TextureWindow::TransferRows, names::kTextureWindows);
+        }
+    }
+    out.table_lookup = r.optional_choice<P::TableLookup>("table_lookup", names::kTableLookups);
+    out.table_format = r.optional_choice<P::TableFormat>("table_format", names::kTableFormats);
+    out.classify = r.optional_choice<P::SliceClassify>("classify", names::kSliceClassifies);
+    out.framebuffer = r.optional_choice<P::FrameBuffer>("framebuffer", names::kFrameBuffers);
+    out.framebuffer_rounding = r.optional_choice<P::Rounding>("framebuffer_rounding", names::kRoundings);
+    out.blend_products = r.optional_choice<P::BlendProducts>("blend_products", names::kBlendProducts);
+    out.blend = r.optional_choice<P::Blend>("blend", names::kBlends);
+    out.blend_alpha = r.optional_choice<P::BlendAlpha>("blend_alpha", names::kBlendAlphas);
+}
+
 ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     using P = ProfileRules;
     static constexpr std::string_view kKeys[] = {
         "placement", "first",      "step_count",  "ray_box",  "step_voxel", "correction",    "correction_floor",
         "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
-        "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded"};  // jitter "off": nothing to apply
+        "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded",
+        // the slicers' rules (issue 54)
+        "slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
+        "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha"};  // jitter "off": nothing to apply
     r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
              "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
-             "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter"});
+             "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter", "slices", "texture",
+             "texture_format", "texture_window", "table_lookup", "table_format", "classify", "framebuffer", "framebuffer_rounding",
+             "blend_products", "blend", "blend_alpha"});
     P out;
     for (std::string_view k : kKeys)
         if (r.has(k)) out.keys.emplace_back(k);
@@ -846,6 +907,7 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     if (r.has("clamp_shaded")) out.clamp_shaded = r.boolean("clamp_shaded", false);
     // volref never jitters (every pixel its own deterministic ray): "off" is the only value.
     r.choice<bool>("jitter", false, {{"off", false}});
+    read_slice_rules(r, out);
     return out;
 }
 
@@ -884,9 +946,14 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         po.allow({"preintegration"});
         s.profile_options.preintegration =
             int(po.integer("preintegration", 0, Range::closed(2, kPreIntegrationMaxIntervals)));
+    } else if (const Json* o = r.find("profile_options");
+               o && (s.profile == ProfileId::Volumizer || s.profile_rules.placement == ProfileRules::Placement::Slices)) {  // issue 54
+        ObjectReader po(*o, r.path("profile_options"), ctx);
+        po.allow({"framebuffer_band"});
+        s.profile_options.framebuffer_band = po.boolean("framebuffer_band", false);
     } else if (const Json* o = r.find("profile_options")) {
         if (s.profile != ProfileId::CudaCurvilinear && s.profile != ProfileId::GlslBasic && s.profile != ProfileId::VtkGpu)
-            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu, vtk-js and fast profiles have options");
+            r.fail("profile_options", "only the cuda-curvilinear, glsl-basic, vtk-gpu, vtk-js, fast and volumizer profiles (and placement \"slices\") have options");
         ObjectReader po(*o, r.path("profile_options"), ctx);
         if (s.profile == ProfileId::GlslBasic) po.allow({"intensity", "texture_unit", "texture_band"});
         else if (s.profile == ProfileId::VtkGpu) po.allow({"texture_unit", "texture_band"});

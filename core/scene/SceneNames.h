@@ -28,7 +28,10 @@ inline constexpr Choice<FieldSpec::Kind> kFields[] = {{"constant", FieldSpec::Ki
 inline constexpr Choice<BoundsSpec::Type> kBounds[] = {{"box", BoundsSpec::Type::Box},
                                                        {"mesh", BoundsSpec::Type::Mesh},
                                                        {"cylindrical", BoundsSpec::Type::Cylindrical},
-                                                       {"spherical", BoundsSpec::Type::Spherical}};
+                                                       {"spherical", BoundsSpec::Type::Spherical},
+                                                       {"tetrahedra", BoundsSpec::Type::Tetrahedra}};
+// volume.bounds.overlap (tetrahedra); "count" is planned (SceneLoader: not implemented yet).
+inline constexpr Choice<BoundsSpec::Overlap> kOverlaps[] = {{"union", BoundsSpec::Overlap::Union}};
 // A spherical shell's "axes": the data's axis order (SphericalShell::axes holds these indices).
 inline constexpr Choice<int> kSphericalAxes[] = {{"longitude", 0}, {"latitude", 1}, {"radius", 2}};
 inline constexpr Choice<TransferSpec::Domain> kTransferDomains[] = {{"data", TransferSpec::Domain::Data},
@@ -71,7 +74,8 @@ inline constexpr Choice<ProfileId> kProfiles[] = {{"reference", ProfileId::Refer
                                                   {"cuda-curvilinear", ProfileId::CudaCurvilinear},
                                                   {"vtk-cpu", ProfileId::VtkCpu},
                                                   {"fast", ProfileId::Fast},
-                                                  {"vtk-js", ProfileId::VtkJs}};
+                                                  {"vtk-js", ProfileId::VtkJs},
+                                                  {"volumizer", ProfileId::Volumizer}};
 // TextureUnit::Admissible has no name (tests only). "hardware": a deprecated alias of "h100".
 inline constexpr Choice<ProfileOptions::TextureUnit> kTextureUnits[] = {{"exact", ProfileOptions::TextureUnit::Exact},
                                                                        {"h100", ProfileOptions::TextureUnit::H100},
@@ -85,7 +89,8 @@ inline constexpr Choice<bool> kVtkJsRayBoxes[] = {{"texel", false}, {"domain", t
 using Rules = ProfileRules;
 inline constexpr Choice<Rules::Placement> kPlacements[] = {{"midpoints", Rules::Placement::Midpoints},
                                                            {"from-entry", Rules::Placement::FromEntry},
-                                                           {"from-exit", Rules::Placement::FromExit}};
+                                                           {"from-exit", Rules::Placement::FromExit},
+                                                           {"slices", Rules::Placement::Slices}};
 inline constexpr Choice<Rules::StepCount> kStepCounts[] = {{"through-exit", Rules::StepCount::ThroughExit},
                                                            {"before-exit", Rules::StepCount::BeforeExit}};
 // RayBox::Given is written as {"min", "max"}.
@@ -112,6 +117,40 @@ inline constexpr Choice<Rules::Arithmetic> kArithmetics[] = {{"double", Rules::A
 inline constexpr Choice<Rules::Gradient> kRuleGradients[] = {{"central", Rules::Gradient::Central},
                                                              {"forward", Rules::Gradient::Forward},
                                                              {"central-in-domain", Rules::Gradient::CentralInDomain}};
+// The slicers' rules (issue 54; conventions section 9, "Slice-order renderers").
+using SliceRules = Rules::Slices;
+inline constexpr Choice<SliceRules::Orientation> kSliceOrientations[] = {{"viewport", SliceRules::Orientation::Viewport},
+                                                                       {"axis", SliceRules::Orientation::Axis},
+                                                                       {"spherical", SliceRules::Orientation::Spherical}};
+inline constexpr Choice<SliceRules::Range> kSliceRanges[] = {{"object", SliceRules::Range::Object},
+                                                           {"view_volume", SliceRules::Range::ViewVolume}};
+inline constexpr Choice<SliceRules::First> kSliceFirsts[] = {{"bound", SliceRules::First::Bound}, {"half", SliceRules::First::Half}};
+inline constexpr Choice<SliceRules::Order> kSliceOrders[] = {{"back-to-front", SliceRules::Order::BackToFront},
+                                                           {"front-to-back", SliceRules::Order::FrontToBack}};
+inline constexpr Choice<Rules::Texture> kTextures[] = {{"3d", Rules::Texture::Texture3d}, {"2d", Rules::Texture::Texture2d}};
+inline constexpr Choice<Rules::TexelFormat> kTexelFormats[] = {{"float", Rules::TexelFormat::Float},
+                                                              {"unorm16", Rules::TexelFormat::Unorm16},
+                                                              {"unorm8", Rules::TexelFormat::Unorm8}};
+// TextureWindow::Given is written [lo, hi].
+inline constexpr Choice<Rules::TextureWindow> kTextureWindows[] = {{"transfer-rows", Rules::TextureWindow::TransferRows},
+                                                                  {"data-range", Rules::TextureWindow::DataRange}};
+inline constexpr Choice<Rules::TableLookup> kTableLookups[] = {{"texture", Rules::TableLookup::Texture},
+                                                              {"linear", Rules::TableLookup::Linear},
+                                                              {"nearest", Rules::TableLookup::Nearest}};
+inline constexpr Choice<Rules::TableFormat> kTableFormats[] = {{"float", Rules::TableFormat::Float}, {"unorm8", Rules::TableFormat::Unorm8}};
+inline constexpr Choice<Rules::SliceClassify> kSliceClassifies[] = {{"post", Rules::SliceClassify::Post},
+                                                                   {"pre-unweighted", Rules::SliceClassify::PreUnweighted}};
+inline constexpr Choice<Rules::FrameBuffer> kFrameBuffers[] = {{"double", Rules::FrameBuffer::Double},
+                                                              {"rgba32f", Rules::FrameBuffer::Rgba32f},
+                                                              {"rgba16f", Rules::FrameBuffer::Rgba16f},
+                                                              {"rgba8", Rules::FrameBuffer::Rgba8}};
+inline constexpr Choice<Rules::Rounding> kRoundings[] = {{"nearest", Rules::Rounding::Nearest}, {"truncate", Rules::Rounding::Truncate}};
+inline constexpr Choice<Rules::BlendProducts> kBlendProducts[] = {{"exact", Rules::BlendProducts::Exact},
+                                                                 {"rounded", Rules::BlendProducts::Rounded}};
+inline constexpr Choice<Rules::Blend> kBlends[] = {{"src-alpha", Rules::Blend::SrcAlpha},
+                                                  {"premultiplied", Rules::Blend::Premultiplied},
+                                                  {"max", Rules::Blend::Max}};
+inline constexpr Choice<Rules::BlendAlpha> kBlendAlphas[] = {{"src-alpha", Rules::BlendAlpha::SrcAlpha}, {"one", Rules::BlendAlpha::One}};
 inline constexpr Choice<bool> kNormals[] = {{"-gradient", false}, {"+gradient", true}};  // normal_along_gradient
 
 // The name `value` is written as: the table's first entry for it. A value with no name (a Default, a

@@ -67,6 +67,10 @@ json bounds_json(const BoundsSpec& b) {
             if (b.max) j["max"] = vec(*b.max);
             return j;
         case T::Mesh: j["file"] = b.mesh.string(); return j;
+        case T::Tetrahedra:
+            j["file"] = b.mesh.string();
+            j["overlap"] = name_of(names::kOverlaps, b.overlap);
+            return j;
         case T::Cylindrical: {
             const CylindricalShell& c = b.cylinder;
             j["center"] = vec(c.center);
@@ -208,6 +212,8 @@ json camera_json(const CameraSpec& c) {
         j["fov_y"] = c.fov_y;
     else
         j["height"] = c.height;
+    if (c.near) j["near"] = *c.near;
+    if (c.far) j["far"] = *c.far;
     return j;
 }
 
@@ -231,6 +237,7 @@ json profile_options_json(const RenderSpec& r) {
         j["kernel"] = name_of(names::kKernels, o.kernel);  // issue 28
     if (r.profile == ProfileId::CudaCurvilinear && o.tricubic) j["tricubic"] = true;
     if (r.profile == ProfileId::Fast && o.preintegration > 0) j["preintegration"] = o.preintegration;  // issue 31
+    if (o.framebuffer_band) j["framebuffer_band"] = true;  // issue 54: volumizer, placement "slices"
     if (r.profile == ProfileId::VtkJs)  // issue 22
         j = {{"jitter", o.jitter},
              {"fixed_normal", o.fixed_normal},
@@ -310,6 +317,33 @@ nlohmann::json profile_rules_object(const ProfileRules& r) {
     if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
     if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
     if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;
+    if (r.slices) {  // issue 54
+        const P::Slices& s = *r.slices;
+        nlohmann::json o;
+        o["orientation"] = name_of(names::kSliceOrientations, s.orientation);
+        o["range"] = name_of(names::kSliceRanges, s.range);
+        if (s.spacing) o["spacing"] = *s.spacing;
+        if (s.count) o["count"] = *s.count;
+        if (s.period) o["period"] = {s.period->x, s.period->y, s.period->z};
+        if (s.max_count) o["max_count"] = *s.max_count;
+        o["first"] = name_of(names::kSliceFirsts, s.first);
+        o["order"] = name_of(names::kSliceOrders, s.order);
+        j["slices"] = o;
+    }
+    if (r.texture) j["texture"] = name_of(names::kTextures, *r.texture);
+    if (r.texture_format) j["texture_format"] = name_of(names::kTexelFormats, *r.texture_format);
+    if (r.texture_window == P::TextureWindow::Given)
+        j["texture_window"] = {r.texture_window_given.x, r.texture_window_given.y};
+    else if (r.texture_window)
+        j["texture_window"] = name_of(names::kTextureWindows, *r.texture_window);
+    if (r.table_lookup) j["table_lookup"] = name_of(names::kTableLookups, *r.table_lookup);
+    if (r.table_format) j["table_format"] = name_of(names::kTableFormats, *r.table_format);
+    if (r.classify) j["classify"] = name_of(names::kSliceClassifies, *r.classify);
+    if (r.framebuffer) j["framebuffer"] = name_of(names::kFrameBuffers, *r.framebuffer);
+    if (r.framebuffer_rounding) j["framebuffer_rounding"] = name_of(names::kRoundings, *r.framebuffer_rounding);
+    if (r.blend_products) j["blend_products"] = name_of(names::kBlendProducts, *r.blend_products);
+    if (r.blend) j["blend"] = name_of(names::kBlends, *r.blend);
+    if (r.blend_alpha) j["blend_alpha"] = name_of(names::kBlendAlphas, *r.blend_alpha);
     return j;
 }
 

@@ -128,12 +128,40 @@ Profile make_vtk_js() {
     return p;
 }
 
+// OpenGL Volumizer (SGI, 1998; seed 003, ../shared/notes/volumizer.md; issue 54): planes parallel to
+// the viewport through the geometry's bounding box (samplingMode VIEWPORT_ALIGNED, samplingSpace OBJECT,
+// the first plane on the far bound: L1202, L1231-1233), spaced by the scene's step (the guide's
+// samplingPeriod of one voxel is `slices.period`), 3D textures of 8-bit texels over dataScaleRange
+// (here the transfer function's rows, L1446), 256-entry 8-bit LUMINANCE_ALPHA tables read at the
+// nearest entry (SGI_color_table, Example 3-1), no opacity correction for the spacing, blended back to
+// front by glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA) into an 8-bit frame buffer (L1338, L1880).
+// Axis slices with 2D textures (the guide's other mode) are `slices.orientation "axis"`, `texture "2d"`.
+Profile make_volumizer() {
+    Profile p;
+    p.id = ProfileId::Volumizer;
+    p.name = "volumizer";
+    p.placement = Profile::Placement::Slices;
+    p.correction = Profile::Correction::None;
+    p.compositing = Profile::Compositing::OpacitySum;  // not read: the frame buffer blends
+    p.table_entries = 256;
+    p.table_lookup = Profile::TableLookup::Nearest;
+    p.table_format = Profile::TableFormat::Unorm8;
+    p.texel_format = Profile::TexelFormat::Unorm8;
+    p.texture_window = Profile::TextureWindow::TransferRows;
+    p.framebuffer = Profile::FrameBuffer::Rgba8;
+    p.framebuffer_rounding = Profile::Rounding::Nearest;
+    p.blend = Profile::Blend::SrcAlpha;
+    p.blend_alpha = Profile::BlendAlpha::SrcAlpha;
+    return p;
+}
+
 }  // namespace
 
 const Profile& profile(ProfileId id) {
     static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), vtk_cpu = make_vtk_cpu(),
                          glsl_basic = make_glsl_basic(),
-                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear(), vtk_js = make_vtk_js();
+                         ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear(), vtk_js = make_vtk_js(),
+                         volumizer = make_volumizer();
     switch (id) {
         case ProfileId::Reference: return reference;
         case ProfileId::VtkGpu: return vtk_gpu;
@@ -142,6 +170,7 @@ const Profile& profile(ProfileId id) {
         case ProfileId::Ospray: return ospray;
         case ProfileId::CudaCurvilinear: return cuda_curvilinear;
         case ProfileId::VtkJs: return vtk_js;
+        case ProfileId::Volumizer: return volumizer;
         case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
     }
     throw Error("render.profile: unknown profile");
@@ -150,7 +179,7 @@ const Profile& profile(ProfileId id) {
 const std::vector<ProfileId>& preset_ids() {
     static const std::vector<ProfileId> ids{ProfileId::Reference, ProfileId::Fast,  ProfileId::VtkGpu,
                                             ProfileId::VtkCpu,    ProfileId::VtkJs, ProfileId::GlslBasic,
-                                            ProfileId::Ospray,    ProfileId::CudaCurvilinear};
+                                            ProfileId::Ospray,    ProfileId::CudaCurvilinear, ProfileId::Volumizer};
     return ids;
 }
 
@@ -212,6 +241,21 @@ Profile resolve_profile(const RenderSpec& render) {
         p.gradient_offset = 0.0;
     }
     if (r.clamp_shaded) p.clamp_shaded = *r.clamp_shaded;
+    if (r.slices) p.slices = *r.slices;
+    if (r.texture) p.texture = *r.texture;
+    if (r.texture_format) p.texel_format = *r.texture_format;
+    if (r.texture_window) {
+        p.texture_window = *r.texture_window;
+        p.texture_window_given = r.texture_window_given;
+    }
+    if (r.table_lookup) p.table_lookup = *r.table_lookup;
+    if (r.table_format) p.table_format = *r.table_format;
+    if (r.classify) p.classify = *r.classify;
+    if (r.framebuffer) p.framebuffer = *r.framebuffer;
+    if (r.framebuffer_rounding) p.framebuffer_rounding = *r.framebuffer_rounding;
+    if (r.blend_products) p.blend_products = *r.blend_products;
+    if (r.blend) p.blend = *r.blend;
+    if (r.blend_alpha) p.blend_alpha = *r.blend_alpha;
     return p;
 }
 
@@ -223,16 +267,17 @@ nlohmann::json profile_rules_json(const Profile& p) {
     ProfileRules r;
     r.placement = p.placement;
     if (p.placement == Profile::Placement::FromEntry) r.first = p.first;  // the rules a placement reads
-    if (p.placement != Profile::Placement::Midpoints) r.step_count = p.step_count;
+    if (p.placement == Profile::Placement::FromEntry || p.placement == Profile::Placement::FromExit) r.step_count = p.step_count;
     r.ray_box = p.ray_box;
     if (p.ray_box == Profile::RayBox::Given) r.box = p.box;
     r.step_voxel = p.voxel_length;
     r.correction = p.correction;
     r.correction_floor = p.correction_floor;
     r.density_scale = p.density_scale;
-    r.compositing = p.compositing;
+    const bool slicer = p.placement == Profile::Placement::Slices;  // its compositing is the frame buffer's blend
+    if (!slicer) r.compositing = p.compositing;
     const Termination& t = p.termination;
-    r.termination = t.test_alpha_above ? ProfileRules::Stop::AlphaAbove
+    if (!slicer) r.termination = t.test_alpha_above ? ProfileRules::Stop::AlphaAbove
                     : t.test_alpha_at_least ? ProfileRules::Stop::AlphaAtLeast
                     : t.test_transmittance ? ProfileRules::Stop::TransmittanceAtMost
                                            : ProfileRules::Stop::None;
@@ -244,6 +289,21 @@ nlohmann::json profile_rules_json(const Profile& p) {
     if (p.gradient_offset_texture > 0.0) r.gradient_offset_texture = p.gradient_offset_texture;
     else r.gradient_offset = p.gradient_offset;
     r.clamp_shaded = p.clamp_shaded;
+    if (p.placement == Profile::Placement::Slices) {  // the rules a slicer reads (issue 54)
+        r.slices = p.slices;
+        r.texture = p.texture;
+        r.texture_format = p.texel_format;
+        r.texture_window = p.texture_window;
+        r.texture_window_given = p.texture_window_given;
+        r.table_lookup = p.table_lookup;
+        r.table_format = p.table_format;
+        r.classify = p.classify;
+        r.framebuffer = p.framebuffer;
+        r.framebuffer_rounding = p.framebuffer_rounding;
+        r.blend_products = p.blend_products;
+        r.blend = p.blend;
+        r.blend_alpha = p.blend_alpha;
+    }
     j.update(profile_rules_object(r));
     j["jitter"] = "off";
     return j;

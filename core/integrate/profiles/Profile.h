@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json_fwd.hpp>
 
@@ -137,6 +138,34 @@ struct Profile {
         BrightnessTimesMaximum,  // seed 001: g = brightness max_k s_k
     };
     Xray xray = Xray::LineIntegral;
+
+    // --- slicers (placement Slices; issue 54; Slices.h, FrameBuffer.h) ------------------------------
+    // The sampling surfaces, what a slice fragment computes and the frame buffer that blends them
+    // (conventions section 9, "Slice-order renderers"); read only under placement Slices.
+    ProfileRules::Slices slices{};
+    using Texture = ProfileRules::Texture;
+    Texture texture = Texture::Texture3d;
+    using TexelFormat = ProfileRules::TexelFormat;
+    TexelFormat texel_format = TexelFormat::Float;
+    using TextureWindow = ProfileRules::TextureWindow;
+    TextureWindow texture_window = TextureWindow::TransferRows;
+    glm::dvec2 texture_window_given{0.0, 1.0};
+    using TableLookup = ProfileRules::TableLookup;
+    TableLookup table_lookup = TableLookup::Texture;
+    using TableFormat = ProfileRules::TableFormat;
+    TableFormat table_format = TableFormat::Float;
+    using SliceClassify = ProfileRules::SliceClassify;
+    SliceClassify classify = SliceClassify::Post;
+    using FrameBuffer = ProfileRules::FrameBuffer;
+    FrameBuffer framebuffer = FrameBuffer::Double;
+    using Rounding = ProfileRules::Rounding;
+    Rounding framebuffer_rounding = Rounding::Nearest;
+    using BlendProducts = ProfileRules::BlendProducts;
+    BlendProducts blend_products = BlendProducts::Exact;
+    using Blend = ProfileRules::Blend;
+    Blend blend = Blend::SrcAlpha;
+    using BlendAlpha = ProfileRules::BlendAlpha;
+    BlendAlpha blend_alpha = BlendAlpha::SrcAlpha;
 };
 
 // The preset a scene names (render.profile, or its "base").

@@ -17,6 +17,7 @@
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/Slices.h"
 #include "core/integrate/profiles/TextureUnit.h"
 #include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"
@@ -43,7 +44,7 @@ void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, con
 }
 
 ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
-                                     const BoundsSpec* bounds)
+                                     const BoundsSpec* bounds, const SliceFrame* slice_frame)
     : OneLoopIntegrator(ctx), p_(profile) {
     check_profile_applies(p_, ctx.pipeline, ctx.render);
     if (p_.renderer != Profile::Renderer::RayCaster)
@@ -107,6 +108,14 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         tricubic_ = true;
     }
     check_rules(ctx.render, cartesian != nullptr);
+    if (p_.placement == Profile::Placement::Slices) {
+        if (!slice_frame) throw Error("render.profile.placement: \"slices\" needs the frame's camera");
+        const auto [smin, smax] = volume.value_range();
+        lo_ = smin;
+        width_ = smax - smin;
+        prepare_slices(volume, *slice_frame);
+        return;  // the slicer's table and texels (prepare_slices): nothing below is read
+    }
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
                                                : p_.gradient_offset * volume.spacing;
     const auto [vmin, vmax] = volume.value_range();
@@ -142,7 +151,18 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
                 fail(k, "seed 001's float32 kernel runs the program's own loop, whose rules are fixed (set render.profile.arithmetic "
                         "\"double\" to render with other rules)");
     if (r.first && p_.placement != Profile::Placement::FromEntry) fail("first", "the first sample's offset applies to placement \"from-entry\"");
-    if (r.step_count && p_.placement == Profile::Placement::Midpoints)
+    if (p_.placement != Profile::Placement::Slices) {  // the slicers' rules (issue 54)
+        for (const char* k : {"slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
+                              "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha"})
+            if (std::find(r.keys.begin(), r.keys.end(), k) != r.keys.end())
+                fail(k, "applies to placement \"slices\" (a slicer's rule)");
+        if (render.profile_options.framebuffer_band)
+            throw Error("render.profile_options.framebuffer_band: applies to placement \"slices\"");
+    } else if (r.step_count || r.first || r.compositing || r.termination || (r.ray_box && *r.ray_box != ProfileRules::RayBox::Domain)) {
+        fail(r.step_count ? "step_count" : r.first ? "first" : r.compositing ? "compositing" : r.termination ? "termination" : "ray_box",
+             "not read by placement \"slices\" (its samples are the surfaces' crossings, its compositing the frame buffer's blend)");
+    }
+    if (r.step_count && (p_.placement == Profile::Placement::Midpoints))
         fail("step_count", "applies to the placements \"from-entry\" and \"from-exit\" (midpoints: segment_count, conventions section 4)");
     if (r.ray_box && *r.ray_box != ProfileRules::RayBox::Domain && !cartesian) fail("ray_box", "a texel or given box needs a Cartesian grid");
     const Termination& t = p_.termination;
@@ -451,6 +471,7 @@ std::string ProfileIntegrator::fault_reason(const Ray& ray) const {
 template <class Rec>
 PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     if (kernel_) return seed_kernel(ray, rec);
+    if (lattice_) return slices(ray, intervals, rec);
     PixelValue out;
     switch (ctx_.render.projection) {
         case Projection::Composite: out = composite(ray, intervals, rec); break;

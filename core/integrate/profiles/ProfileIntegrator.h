@@ -33,7 +33,17 @@ namespace volref {
 
 class ShellGrid;
 class Seed001Kernel;
+class Camera;
 struct BoundsSpec;
+struct SliceLattice;
+
+// What placement "slices" places its surfaces from (Slices.h): the frame's camera and the geometry's
+// bounding box in the volume's space.
+struct SliceFrame {
+    const Camera* camera = nullptr;
+    const CameraSpec* spec = nullptr;
+    glm::dvec3 box_lo{0.0}, box_hi{0.0};
+};
 
 // What every mirror profile needs of the scene (fixed step, front-to-back order, its own termination,
 // a grid it reads, post-classification by value alone); throws volref::Error naming render.profile.
@@ -46,11 +56,13 @@ class ProfileIntegrator final : public OneLoopIntegrator<ProfileIntegrator> {
 public:
     // Throws volref::Error naming render.profile for what the profile cannot render.
     // `bounds`: the volume's bounds (seed 001's kernel builds its triangles from them; may be null otherwise).
+    // `slice_frame`: placement "slices" (required there).
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
-                      const BoundsSpec* bounds = nullptr);
+                      const BoundsSpec* bounds = nullptr, const SliceFrame* slice_frame = nullptr);
     ~ProfileIntegrator() override;
     // render.profile_options.texture_band (issue 17): PixelValue::error is the texture band (band()).
-    bool writes_error() const override { return band_; }
+    // render.profile_options.framebuffer_band (issue 54): the frame buffer's band.
+    bool writes_error() const override { return band_ || framebuffer_band_; }
     // cuda-curvilinear's float32 kernel (issue 28): the rays seed 001's loop cannot finish.
     bool writes_fault() const override { return kernel_ != nullptr; }
     std::string fault_reason(const Ray& ray) const override;
@@ -126,6 +138,24 @@ private:
     std::unique_ptr<Seed001Kernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell (issue 28)
     template <class Rec>
     PixelValue seed_kernel(const Ray& ray, Rec& rec) const;
+
+    // --- placement "slices" (issue 54; ProfileSlices.cpp, Slices.h, FrameBuffer.h) -------------------
+    struct Fragment {
+        double s = 0.0;        // the texture's filtered value (post) or the trilinear s (pre-unweighted)
+        glm::dvec3 color{0.0};  // the classification's colour (not premultiplied)
+        double opacity = 0.0;  // its opacity (uncorrected)
+        double alpha = 0.0;    // the fragment's alpha
+    };
+    void prepare_slices(const Volume& volume, const SliceFrame& frame);
+    double slice_texel(std::int64_t i, std::int64_t j, std::int64_t k) const;  // s_i in the texture's format
+    glm::dvec4 slice_lookup(double s) const;  // (c, a) at the texture's value s
+    Fragment slice_fragment(const glm::dvec3& x, std::size_t level, double d) const;
+    template <class Rec>
+    PixelValue slices(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    std::unique_ptr<SliceLattice> lattice_;
+    double window_lo_ = 0.0, window_width_ = 1.0;  // the texture window [lo, lo + width]
+    std::vector<glm::dvec4> slice_table_;          // the table's entries (c, a) over the window, stored
+    bool framebuffer_band_ = false;
 };
 
 }  // namespace volref

@@ -1,0 +1,194 @@
+// A slicer's frame buffer (issue 54; conventions section 9, "Slice-order renderers"): one pixel's
+// (C, A), cleared to (0, 0, 0, 0), into which each slice fragment (c, a) (colour not premultiplied,
+// alpha) is blended and stored in the buffer's format. The accumulator of placement "slices"
+// (ProfileIntegrator::composite_slices), and of `volref explain composite`'s 8-bit blend.
+//   src-alpha:      C <- c a + C (1 - a);   A <- a a + A (1 - a)  (blend_alpha src-alpha) | a + A (1 - a) (one)
+//   premultiplied:  C <- (a c) + C (1 - a); A <- a + A (1 - a)
+//   under (front to back, premultiplied): C <- C + (1 - A) a c; A <- A + (1 - A) a
+//   max (GL_MAX):   C <- max(C, c);          A <- max(A, a)
+// rgba8 blends integer codes q in [0, 255]: a fragment's channel x becomes q = R(255 clamp(x, 0, 1)); a
+// blend with source code q_s and factor f_s, destination Q_d and factor f_d (factors as codes: q_a,
+// 255 - q_a, 255) stores R((q_s f_s + Q_d f_d) / 255) (products "exact") or
+// min(255, R(q_s f_s / 255) + R(Q_d f_d / 255)) (products "rounded", Mesa's llvmpipe); R is floor(x + 1/2)
+// (rounding "nearest") or floor(x) ("truncate"). rgba32f computes in float32 (each product, the factor
+// 1 - a and the sum rounded to nearest even) and stores float32; rgba16f the same, stored as binary16.
+// double: no rounding.
+//
+// The band (`framebuffer_band`): per channel the interval [lo, hi] of what any rounding variant stores,
+// carried blend by blend: rgba8 over {nearest, truncate} x {exact, rounded products} and both roundings
+// of the fragment's conversion, float buffers the stored value moved one unit in the last place either
+// way; every variant is non-decreasing in the stored colour (and non-increasing in the stored alpha under
+// "under"), so the low end is the lowest variant at the low end and the high end the highest at the high.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "core/scene/Scene.h"
+
+namespace volref {
+
+namespace framebuffer {
+
+// x rounded to the nearest binary16 (ties to even; subnormals below 2^-14; past 65504: infinity).
+inline double to_half(double x) {
+    if (x == 0.0 || !std::isfinite(x)) return x;
+    int e = 0;
+    std::frexp(x, &e);  // |x| = f 2^e, f in [1/2, 1)
+    const int shift = std::min(11 - e, 24);  // 11 significant bits, or the subnormals' 2^-24 steps
+    const double r = std::ldexp(std::nearbyint(std::ldexp(x, shift)), -shift);
+    return std::fabs(r) > 65504.0 ? std::copysign(INFINITY, r) : r;
+}
+
+inline double to_float(double x) { return double(static_cast<float>(x)); }
+
+}  // namespace framebuffer
+
+class SliceFrameBuffer {
+public:
+    using Format = ProfileRules::FrameBuffer;
+    using Rounding = ProfileRules::Rounding;
+    using Products = ProfileRules::BlendProducts;
+    using Blend = ProfileRules::Blend;
+    using BlendAlpha = ProfileRules::BlendAlpha;
+
+    SliceFrameBuffer(Format f, Rounding r, Products p, Blend b, BlendAlpha ba, bool under, bool band)
+        : format_(f), rounding_(r), products_(p), blend_(b), blend_alpha_(ba), under_(under), band_(band) {}
+
+    // One fragment: colour c (not premultiplied), alpha a.
+    void blend(const glm::dvec3& c, double a) {
+        const double src[4] = {c.r, c.g, c.b, a};
+        if (format_ == Format::Rgba8) {
+            blend8(src, a);
+            return;
+        }
+        std::array<double, 4> next;
+        for (int ch = 0; ch < 4; ++ch) next[std::size_t(ch)] = blend_float(ch, src, a, v_[std::size_t(ch)], v_[3]);
+        if (band_) {
+            for (int ch = 0; ch < 4; ++ch) {
+                const double l = blend_float(ch, src, a, lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3]);
+                const double h = blend_float(ch, src, a, hi_[std::size_t(ch)], under_ ? lo_[3] : hi_[3]);
+                lo_[std::size_t(ch)] = std::min(l, next[std::size_t(ch)]) - ulp(l);
+                hi_[std::size_t(ch)] = std::max(h, next[std::size_t(ch)]) + ulp(h);
+            }
+        }
+        v_ = next;
+    }
+
+    // The pixel as the buffer holds it (rgba8: codes / 255).
+    glm::dvec4 pixel() const { return scale(v_); }
+    // max over R, G, B, A of max(hi - pixel, pixel - lo) (0 without the band).
+    double band() const {
+        if (!band_) return 0.0;
+        const glm::dvec4 p = pixel(), l = scale(lo_), h = scale(hi_);
+        double b = 0.0;
+        for (int ch = 0; ch < 4; ++ch) b = std::max({b, h[ch] - p[ch], p[ch] - l[ch]});
+        return b;
+    }
+    glm::dvec4 low() const { return scale(lo_); }
+    glm::dvec4 high() const { return scale(hi_); }
+
+private:
+    glm::dvec4 scale(const std::array<double, 4>& v) const {
+        const double k = format_ == Format::Rgba8 ? 255.0 : 1.0;  // code / 255, correctly rounded
+        return glm::dvec4(v[0] / k, v[1] / k, v[2] / k, v[3] / k);
+    }
+
+    double store(double x) const {
+        switch (format_) {
+            case Format::Rgba32f: return framebuffer::to_float(x);
+            case Format::Rgba16f: return framebuffer::to_half(x);
+            default: return x;
+        }
+    }
+    double ulp(double x) const {
+        const double m = std::max(std::fabs(x), 0x1p-24);
+        switch (format_) {
+            case Format::Rgba32f: return std::ldexp(1.0, std::ilogb(m) - 23);
+            case Format::Rgba16f: return std::ldexp(1.0, std::max(std::ilogb(m) - 10, -24));
+            default: return 0.0;
+        }
+    }
+
+    // A float buffer's blend of channel ch over the stored value dst (dst_alpha: the stored alpha).
+    double blend_float(int ch, const double* src, double a, double dst, double dst_alpha) const {
+        const bool f32 = format_ != Format::Double;
+        auto r = [&](double x) { return f32 ? framebuffer::to_float(x) : x; };
+        const double s = r(src[ch]), sa = r(a);
+        if (blend_ == Blend::Max) return store(std::max(dst, s));
+        const bool alpha = ch == 3;
+        if (under_) {  // C + (1 - A) (a c): the source premultiplied in the shader
+            const double source = alpha ? sa : r(sa * s);
+            return store(r(dst + r(r(1.0 - dst_alpha) * source)));
+        }
+        double source = 0.0;
+        if (blend_ == Blend::Premultiplied) source = alpha ? sa : r(r(sa * s));
+        else source = alpha && blend_alpha_ == BlendAlpha::One ? sa : r(s * sa);
+        return store(r(source + r(dst * r(1.0 - sa))));
+    }
+
+    double round8(double x, Rounding r) const { return std::clamp(r == Rounding::Nearest ? std::floor(x + 0.5) : std::floor(x), 0.0, 255.0); }
+    double code(double x, Rounding r) const { return round8(255.0 * std::clamp(x, 0.0, 1.0), r); }
+
+    // One 8-bit blend of channel ch by one variant: source code qs, the stored dst and dst alpha codes.
+    double blend8_variant(int ch, const double* src, double qa, double dst, double dst_alpha, Rounding conv, Rounding r,
+                          Products p) const {
+        const bool alpha = ch == 3;
+        double qs = 0.0, fs = 0.0, fd = 0.0;
+        if (blend_ == Blend::Max) return std::max(dst, code(src[ch], conv));
+        if (under_) {
+            qs = alpha ? qa : code(src[3] * src[ch], conv);
+            fs = 255.0 - dst_alpha;
+            fd = 255.0;
+        } else if (blend_ == Blend::Premultiplied) {
+            qs = alpha ? qa : code(src[3] * src[ch], conv);
+            fs = 255.0;
+            fd = 255.0 - qa;
+        } else {
+            qs = alpha ? qa : code(src[ch], conv);
+            fs = alpha && blend_alpha_ == BlendAlpha::One ? 255.0 : qa;
+            fd = 255.0 - qa;
+        }
+        if (p == Products::Exact) return round8((qs * fs + dst * fd) / 255.0, r);
+        return std::min(255.0, round8(qs * fs / 255.0, r) + round8(dst * fd / 255.0, r));
+    }
+
+    void blend8(const double* src, double a) {
+        std::array<double, 4> next;
+        const double qa = code(a, rounding_);
+        for (int ch = 0; ch < 4; ++ch)
+            next[std::size_t(ch)] = blend8_variant(ch, src, qa, v_[std::size_t(ch)], v_[3], rounding_, rounding_, products_);
+        if (band_) {
+            std::array<double, 4> lo = lo_, hi = hi_;
+            for (int ch = 0; ch < 4; ++ch) {
+                double l = next[std::size_t(ch)], h = l;
+                for (Rounding conv : {Rounding::Nearest, Rounding::Truncate})
+                    for (Rounding r : {Rounding::Nearest, Rounding::Truncate})
+                        for (Products p : {Products::Exact, Products::Rounded}) {
+                            const double qa_v = code(a, conv);
+                            l = std::min(l, blend8_variant(ch, src, qa_v, lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3], conv, r, p));
+                            h = std::max(h, blend8_variant(ch, src, qa_v, hi_[std::size_t(ch)], under_ ? lo_[3] : hi_[3], conv, r, p));
+                        }
+                lo[std::size_t(ch)] = l;
+                hi[std::size_t(ch)] = h;
+            }
+            lo_ = lo;
+            hi_ = hi;
+        }
+        v_ = next;
+    }
+
+    Format format_;
+    Rounding rounding_;
+    Products products_;
+    Blend blend_;
+    BlendAlpha blend_alpha_;
+    bool under_, band_;
+    std::array<double, 4> v_{0.0, 0.0, 0.0, 0.0};
+    std::array<double, 4> lo_{0.0, 0.0, 0.0, 0.0}, hi_{0.0, 0.0, 0.0, 0.0};
+};
+
+}  // namespace volref

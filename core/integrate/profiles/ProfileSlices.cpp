@@ -1,0 +1,218 @@
+// ProfileIntegrator's placement "slices" (issue 54; conventions section 9, "Slice-order renderers"): a
+// slicer's pixel as the sequence of frame-buffer blends of the fragments its centre ray crosses. The
+// surfaces are Slices.h's, the frame buffer FrameBuffer.h's; this file is what one fragment computes
+// (the texture's texels and filter, the table or the transfer function, the alpha) and the loop.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+#include "core/integrate/profiles/FrameBuffer.h"
+#include "core/integrate/profiles/ProfileIntegrator.h"
+#include "core/integrate/profiles/Slices.h"
+#include "transfer/OpacityCorrection.h"
+#include "transfer/TransferFunction.h"
+
+namespace volref {
+
+namespace {
+
+double quantise(double x, double levels) { return std::floor(levels * std::clamp(x, 0.0, 1.0) + 0.5) / levels; }
+
+// The transfer function's rows as data values: the first and last of the colour and opacity rows.
+bool transfer_rows(const TransferFunction& tf, double& lo, double& hi) {
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
+    const auto [wlo, whi] = tf.window();
+    auto value = [&](double x) { return tf.normalized() ? wlo + x * (whi - wlo) : x; };
+    for (const std::vector<double>* xs : {&tf.color_function().xs(), &tf.opacity_function().xs()})
+        for (double x : *xs) {
+            lo = std::min(lo, value(x));
+            hi = std::max(hi, value(x));
+        }
+    return lo < hi;
+}
+
+}  // namespace
+
+void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& frame) {
+    const ProfileRules& r = ctx_.render.profile_rules;
+    auto fail = [](const std::string& key, const std::string& why) { throw Error("render.profile." + key + ": " + why); };
+    const Projection proj = ctx_.render.projection;
+    if (proj != Projection::Composite && proj != Projection::Mip)
+        fail(r.placement ? "placement" : "base", "a slicer composites its slices (projection \"composite\") or takes their maximum (\"mip\" with blend \"max\")");
+    if (proj == Projection::Mip && p_.blend != Profile::Blend::Max) fail("blend", "the mip projection of a slicer is GL_MAX (blend \"max\")");
+    if (proj == Projection::Composite && p_.blend == Profile::Blend::Max) fail("blend", "\"max\" is the mip projection's (render.projection \"mip\")");
+    if (ctx_.pipeline.shaded() && proj == Projection::Composite) fail("placement", "\"slices\" does not shade (remove volume.shading)");
+    if (p_.slices.order == ProfileRules::Slices::Order::FrontToBack && p_.blend == Profile::Blend::SrcAlpha)
+        fail("slices", "front to back blends the premultiplied fragment under the frame buffer (blend \"premultiplied\")");
+    if (band_) throw Error("render.profile_options.texture_band: not derived for placement \"slices\" (framebuffer_band is its band)");
+    if (texture_unit_ != ProfileOptions::TextureUnit::Exact)
+        throw Error("render.profile.texture_unit: placement \"slices\" filters its texels exactly");
+    if (!ctx_.pipeline.cartesian_sampler() || !frame.camera) fail("placement", "\"slices\" needs a Cartesian grid (box or mesh bounds)");
+    if (p_.correction != Profile::Correction::None && p_.correction != Profile::Correction::Exact)
+        fail("correction", "a slice's alpha is the table's opacity (\"none\") or corrected for its spacing (\"exact\")");
+    // The window [lo, hi] of the texels.
+    window_lo_ = lo_;
+    window_width_ = width_;
+    if (p_.texture_window == Profile::TextureWindow::Given) {
+        window_lo_ = p_.texture_window_given.x;
+        window_width_ = p_.texture_window_given.y - p_.texture_window_given.x;
+    } else if (p_.texture_window == Profile::TextureWindow::TransferRows) {
+        double lo = 0.0, hi = 0.0;
+        if (const TransferFunction* tf = ctx_.pipeline.stages().transfer_function; tf && transfer_rows(*tf, lo, hi)) {
+            window_lo_ = lo;
+            window_width_ = hi - lo;
+        }
+    }
+    if (!(window_width_ > 0.0)) window_width_ = 1.0;  // a constant volume: every texel 0
+    // The table: entries over the window, stored in the table's format.
+    if (p_.table_entries > 1) {
+        const int n = p_.table_entries;
+        slice_table_.resize(std::size_t(n));
+        for (int j = 0; j < n; ++j) {
+            const Classified k = ctx_.pipeline.classifier().classify(window_lo_ + double(j) * window_width_ / double(n - 1), 0.0);
+            glm::dvec4 e(k.color, std::clamp(k.opacity, 0.0, 1.0));
+            if (p_.table_format == Profile::TableFormat::Unorm8)
+                for (int c = 0; c < 4; ++c) e[c] = quantise(e[c], 255.0);
+            slice_table_[std::size_t(j)] = e;
+        }
+    }
+    const double step_scale = ctx_.step / ctx_.render.step;  // world units per unit of render.step_units
+    lattice_ = std::make_unique<SliceLattice>(make_slice_lattice(p_, *frame.camera, *frame.spec, frame.box_lo, frame.box_hi,
+                                                                 volume.origin, volume.spacing, volume.dims, ctx_.step, step_scale));
+    framebuffer_band_ = ctx_.render.profile_options.framebuffer_band;
+}
+
+// A texel as the texture holds it: s = clamp((v - lo) / (hi - lo), 0, 1) in the texture's format.
+double ProfileIntegrator::slice_texel(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    const double s = std::clamp((texels_->at(i, j, k) - window_lo_) / window_width_, 0.0, 1.0);
+    switch (p_.texel_format) {
+        case Profile::TexelFormat::Unorm8: return quantise(s, 255.0);
+        case Profile::TexelFormat::Unorm16: return quantise(s, 65535.0);
+        case Profile::TexelFormat::Float: break;
+    }
+    return double(static_cast<float>(s));
+}
+
+// (c, a) at the texture's value s: the table by its lookup, or the transfer function at lo + s (hi - lo).
+glm::dvec4 ProfileIntegrator::slice_lookup(double s) const {
+    if (slice_table_.empty()) {
+        const Classified k = ctx_.pipeline.classifier().classify(window_lo_ + s * window_width_, 0.0);
+        return glm::dvec4(k.color, std::clamp(k.opacity, 0.0, 1.0));
+    }
+    const int n = int(slice_table_.size());
+    if (p_.table_lookup == Profile::TableLookup::Nearest) {  // OpenGL's colour-table index round(s (N - 1))
+        const int j = std::clamp(int(std::floor(s * double(n - 1) + 0.5)), 0, n - 1);
+        return slice_table_[std::size_t(j)];
+    }
+    const double pos = p_.table_lookup == Profile::TableLookup::Linear ? s * double(n - 1)
+                                                                       : std::clamp(s * double(n) - 0.5, 0.0, double(n - 1));
+    const int i = std::clamp(int(std::floor(pos)), 0, n - 2);
+    const double w = std::clamp(pos - double(i), 0.0, 1.0);
+    return slice_table_[std::size_t(i)] + w * (slice_table_[std::size_t(i) + 1] - slice_table_[std::size_t(i)]);
+}
+
+// One fragment at x (on level `level`), standing for the length d along its ray. The texture's filter:
+// the continuous index u = (x - origin) / spacing clamped to [0, n - 1] (section 2), cell i0 =
+// min(floor(u), n - 2), w = u - i0; 2D textures: u on the slicing axis is the level's own layer, w = 0.
+ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& x, std::size_t level, double d) const {
+    const Volume& v = *texels_;
+    glm::dvec3 u = (x - v.origin) / v.spacing;
+    std::array<std::int64_t, 3> i0{}, i1{};
+    glm::dvec3 w(0.0);
+    const bool layers = p_.texture == Profile::Texture::Texture2d;
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t n = v.dims[std::size_t(a)];
+        if (layers && a == lattice_->axis) {
+            const std::int64_t layer = lattice_->normal[a] > 0.0 ? n - 1 - std::int64_t(level) : std::int64_t(level);
+            i0[std::size_t(a)] = i1[std::size_t(a)] = layer;
+            continue;
+        }
+        const double c = std::clamp(u[a], 0.0, double(n - 1));
+        i0[std::size_t(a)] = n > 1 ? std::min(std::int64_t(std::floor(c)), n - 2) : 0;
+        i1[std::size_t(a)] = n > 1 ? i0[std::size_t(a)] + 1 : 0;
+        w[a] = n > 1 ? c - double(i0[std::size_t(a)]) : 0.0;
+    }
+    // Corners in Levoy's order of x fastest: c = x + 2 y + 4 z; trilinear as x, then y, then z.
+    auto corner = [&](int c) {
+        return std::array<std::int64_t, 3>{(c & 1) ? i1[0] : i0[0], (c & 2) ? i1[1] : i0[1], (c & 4) ? i1[2] : i0[2]};
+    };
+    auto lerp3 = [&](auto value) {
+        using T = decltype(value(0));
+        T x00 = value(0) + w.x * (value(1) - value(0)), x10 = value(2) + w.x * (value(3) - value(2));
+        T x01 = value(4) + w.x * (value(5) - value(4)), x11 = value(6) + w.x * (value(7) - value(6));
+        T y0 = x00 + w.y * (x10 - x00), y1 = x01 + w.y * (x11 - x01);
+        return T(y0 + w.z * (y1 - y0));
+    };
+    Fragment f;
+    glm::dvec4 ca;
+    if (p_.classify == Profile::SliceClassify::PreUnweighted) {  // each texel looked up, then (c, a) filtered
+        std::array<glm::dvec4, 8> e;
+        std::array<double, 8> s;
+        for (int c = 0; c < 8; ++c) {
+            const auto k = corner(c);
+            s[std::size_t(c)] = slice_texel(k[0], k[1], k[2]);
+            e[std::size_t(c)] = slice_lookup(s[std::size_t(c)]);
+        }
+        ca = lerp3([&](int c) { return e[std::size_t(c)]; });
+        f.s = lerp3([&](int c) { return s[std::size_t(c)]; });
+    } else {
+        std::array<double, 8> s;
+        for (int c = 0; c < 8; ++c) {
+            const auto k = corner(c);
+            s[std::size_t(c)] = slice_texel(k[0], k[1], k[2]);
+        }
+        f.s = lerp3([&](int c) { return s[std::size_t(c)]; });
+        ca = slice_lookup(f.s);
+    }
+    f.color = glm::dvec3(ca);
+    f.opacity = std::clamp(ca.a, 0.0, 1.0);
+    f.alpha = p_.correction == Profile::Correction::Exact
+                  ? opacity_for_length(f.opacity, d, ctx_.pipeline.classifier().unit_distance())
+                  : f.opacity;
+    return f;
+}
+
+template <class Rec>
+PixelValue ProfileIntegrator::slices(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+    const bool under = p_.slices.order == ProfileRules::Slices::Order::FrontToBack;
+    SliceFrameBuffer fb(p_.framebuffer, p_.framebuffer_rounding, p_.blend_products, p_.blend, p_.blend_alpha, under,
+                        framebuffer_band_);
+    lattice_->for_each_crossing(ray, intervals, [&](double t, double d, std::size_t k) {
+        const glm::dvec3 x = ray.at(t);
+        const Fragment f = slice_fragment(x, k, d);
+        fb.blend(f.color, f.alpha);
+        if constexpr (Rec::kOn) {
+            SampleRecord r{};
+            rec.begin(r, t - 0.5 * d, t + 0.5 * d);
+            r.t = t;
+            r.length = d;
+            r.sample.position = x;
+            r.sample.value = window_lo_ + f.s * window_width_;
+            r.sample.classified = true;
+            r.sample.classified_color = f.color;
+            r.sample.color = f.color;
+            r.sample.opacity = f.opacity;
+            r.composited = true;
+            r.alpha = f.alpha;
+            r.surface = std::int64_t(k);
+            r.accumulated = fb.pixel();
+            rec.recorder.record(r);
+        }
+        return true;
+    });
+    PixelValue out;
+    out.rgba = fb.pixel();
+    out.error = fb.band();
+    return out;
+}
+
+template PixelValue ProfileIntegrator::slices<NoRecording>(const Ray&, const std::vector<Interval>&, NoRecording&) const;
+template PixelValue ProfileIntegrator::slices<Recording>(const Ray&, const std::vector<Interval>&, Recording&) const;
+
+}  // namespace volref

@@ -195,6 +195,30 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     const bool shaded = composite && scene.volume().shading.has_value();
     const bool box = scene.volume().bounds.type == BoundsSpec::Type::Box && !scene.volume().bounds.min && !scene.volume().bounds.max;
     std::vector<std::vector<json>> d;
+    // A slicer (placement "slices", issue 54): its surfaces, fragments and frame buffer; the rules of
+    // "slices" are tried one key at a time ("slices.KEY", merged into the object by with_rules).
+    if (!r.reference_integrators() && r.profile != ProfileId::Fast &&
+        resolve_profile(r).placement == Profile::Placement::Slices) {
+        const bool perspective = scene.camera.type != CameraSpec::Type::Orthographic;
+        std::vector<json> orientation{{{"slices.orientation", "viewport"}}, {{"slices.orientation", "axis"}}};
+        if (perspective) orientation.push_back({{"slices.orientation", "spherical"}});
+        d.push_back(orientation);
+        if (scene.camera.near) d.push_back({{{"slices.range", "object"}}, {{"slices.range", "view_volume"}}});
+        d.push_back({{{"slices.first", "bound"}}, {{"slices.first", "half"}}});
+        d.push_back({{{"slices.spacing", r.step / 2.0}}, {{"slices.spacing", r.step}}, {{"slices.spacing", 2.0 * r.step}},
+                     {{"slices.count", 128}}, {{"slices.count", 256}}});
+        d.push_back({{{"framebuffer", "rgba8"}}, {{"framebuffer", "rgba16f"}}, {{"framebuffer", "rgba32f"}}, {{"framebuffer", "double"}}});
+        d.push_back({{{"correction", "none"}}, {{"correction", "exact"}}});
+        d.push_back({{{"framebuffer_rounding", "nearest"}}, {{"framebuffer_rounding", "truncate"}}});
+        d.push_back({{{"blend_products", "exact"}}, {{"blend_products", "rounded"}}});
+        d.push_back({{{"blend_alpha", "src-alpha"}}, {{"blend_alpha", "one"}}});
+        d.push_back({{{"table_lookup", "nearest"}}, {{"table_lookup", "linear"}}, {{"table_lookup", "texture"}}});
+        d.push_back({{{"texture_format", "unorm8"}}, {{"texture_format", "unorm16"}}, {{"texture_format", "float"}}});
+        d.push_back({{{"table_format", "unorm8"}}, {{"table_format", "float"}}});
+        d.push_back({{{"classify", "post"}}, {{"classify", "pre-unweighted"}}});
+        d.push_back({{{"texture", "3d"}}, {{"texture", "2d"}}});
+        return d;
+    }
     // (from-entry with each step count: step_count alone cannot be set over midpoints)
     d.push_back({{{"placement", "midpoints"}},
                  {{"placement", "from-entry"}, {"first", 0.0}},
@@ -227,7 +251,17 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
 
 Scene with_rules(const Scene& scene, const json& rules) {
     json merged = profile_rules_object(scene.render.profile_rules);
-    for (auto it = rules.begin(); it != rules.end(); ++it) merged[it.key()] = it.value();
+    for (auto it = rules.begin(); it != rules.end(); ++it) {
+        if (it.key().rfind("slices.", 0) == 0) {  // one key of the slicer's "slices" object, over the scene's
+            if (!merged.contains("slices")) merged["slices"] = profile_rules_json(resolve_profile(scene.render)).at("slices");
+            const std::string key = it.key().substr(7);
+            if (key == "spacing" || key == "count" || key == "period")
+                for (const char* other : {"spacing", "count", "period"}) merged["slices"].erase(other);
+            merged["slices"][key] = it.value();
+            continue;
+        }
+        merged[it.key()] = it.value();
+    }
     // A placement other than from-entry has no first sample's offset; midpoints no step count.
     if (rules.contains("placement")) {
         if (merged["placement"] != "from-entry") merged.erase("first");

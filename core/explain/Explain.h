@@ -40,6 +40,18 @@ struct CompositeSample {
 Explanation composite(const std::vector<CompositeSample>& samples, CompositeOrder order, double unit_distance,
                       double step);
 
+// composite --framebuffer (issue 54): the samples (listed front first) blended by a slicer's frame buffer,
+// from the far end (or front to back, under, with `order`), each blend's source, factors, unrounded
+// result and stored value (FrameBuffer.h), and the band of every rounding variant.
+struct FrameBufferRules {
+    ProfileRules::FrameBuffer format = ProfileRules::FrameBuffer::Rgba8;
+    ProfileRules::Rounding rounding = ProfileRules::Rounding::Nearest;
+    ProfileRules::BlendProducts products = ProfileRules::BlendProducts::Exact;
+    ProfileRules::Blend blend = ProfileRules::Blend::SrcAlpha;
+    ProfileRules::BlendAlpha blend_alpha = ProfileRules::BlendAlpha::SrcAlpha;
+};
+Explanation composite_framebuffer(const std::vector<CompositeSample>& samples, CompositeOrder order, const FrameBufferRules& rules);
+
 // opacity-correction: a over l, segment length d.
 Explanation opacity_correction(double a, double unit_distance, double length);
 

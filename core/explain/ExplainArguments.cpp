@@ -188,7 +188,8 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         return trilinear(c, vec3("--point", o.one("--point")));
     }
     if (t == "composite") {
-        const Options o(t, args, {"--samples", "--order", "--unit-distance", "--step"});
+        const Options o(t, args, {"--samples", "--order", "--unit-distance", "--step", "--framebuffer", "--blend", "--blend-alpha",
+                                  "--rounding", "--products"});
         std::vector<CompositeSample> samples;
         for (const std::string& s : o.all("--samples")) {
             const auto v = parse_list("--samples", s, 4, 4, "samples r,g,b,a");
@@ -202,6 +203,26 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
             if (!named) throw Error("--order: expected " + scene_names::listing(scene_names::kOrders) + ", got \"" + s + "\"");
             order = *named;
         }
+        if (o.has("--framebuffer")) {  // issue 54: a slicer's blends, each stored in the frame buffer's format
+            auto choice = [&](const std::string& key, const auto& table, auto fallback) {
+                if (!o.has(key)) return fallback;
+                const std::string v = o.one(key);
+                const auto named = scene_names::value_of(table, v);
+                if (!named) throw Error(key + ": expected " + scene_names::listing(table) + ", got \"" + v + "\"");
+                return *named;
+            };
+            FrameBufferRules f;
+            f.format = choice("--framebuffer", scene_names::kFrameBuffers, f.format);
+            f.blend = choice("--blend", scene_names::kBlends, f.blend);
+            f.blend_alpha = choice("--blend-alpha", scene_names::kBlendAlphas, f.blend_alpha);
+            f.rounding = choice("--rounding", scene_names::kRoundings, f.rounding);
+            f.products = choice("--products", scene_names::kBlendProducts, f.products);
+            if (!o.has("--order")) order = CompositeOrder::BackToFront;
+            if (o.has("--unit-distance") || o.has("--step")) throw Error("--framebuffer: the samples' alphas are blended as given (no --unit-distance or --step)");
+            return composite_framebuffer(samples, order, f);
+        }
+        for (const char* k : {"--blend", "--blend-alpha", "--rounding", "--products"})
+            if (o.has(k)) throw Error(std::string(k) + ": applies with --framebuffer");
         return composite(samples, order, number_or(o, "--unit-distance", 1.0), number_or(o, "--step", 1.0));
     }
     if (t == "opacity-correction") {

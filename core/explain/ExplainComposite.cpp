@@ -10,6 +10,8 @@
 #include "core/explain/Explain.h"
 #include "core/integrate/fixed/CompositeIntegrator.h"
 #include "core/integrate/march/SamplePipeline.h"
+#include "core/integrate/profiles/FrameBuffer.h"
+#include "core/scene/SceneNames.h"
 #include "transfer/OpacityCorrection.h"
 
 namespace volref::explain {
@@ -110,6 +112,57 @@ Explanation composite(const std::vector<CompositeSample>& samples, CompositeOrde
     double m = 0.0;
     for (int c = 0; c < 4; ++c) m = std::max(m, std::fabs(f[c] - k[c]));
     add(both, "max |difference|", m);
+    return e;
+}
+
+Explanation composite_framebuffer(const std::vector<CompositeSample>& samples, CompositeOrder order, const FrameBufferRules& f) {
+    namespace names = scene_names;
+    if (samples.empty()) throw Error("--samples: at least one sample r,g,b,a is needed");
+    for (const CompositeSample& s : samples) {
+        if (!(s.opacity >= 0.0 && s.opacity <= 1.0)) throw Error("--samples: an opacity a must be in [0, 1]");
+        for (int c = 0; c < 3; ++c)
+            if (!(s.color[c] >= 0.0 && s.color[c] <= 1.0)) throw Error("--samples: with --framebuffer, colours r, g, b are in [0, 1]");
+    }
+    const bool under = order == CompositeOrder::FrontToBack;
+    if (under && f.blend != ProfileRules::Blend::Premultiplied)
+        throw Error("--order: front to back blends under the frame buffer, with --blend premultiplied");
+    Explanation e;
+    e.topic = "composite";
+    Section& in = e.section("inputs");
+    add(in, "samples", double(samples.size()), "listed front first: sample 1 is nearest the eye");
+    in.notes.push_back(std::string("frame buffer ") + names::name_of(names::kFrameBuffers, f.format) + ", blend " +
+                       names::name_of(names::kBlends, f.blend) + ", blend_alpha " + names::name_of(names::kBlendAlphas, f.blend_alpha) +
+                       ", rounding " + names::name_of(names::kRoundings, f.rounding) + ", products " +
+                       names::name_of(names::kBlendProducts, f.products) + " (core/integrate/profiles/FrameBuffer.h)");
+    SliceFrameBuffer fb(f.format, f.rounding, f.products, f.blend, f.blend_alpha, under, true);
+    const bool eight = f.format == ProfileRules::FrameBuffer::Rgba8;
+    const double k = eight ? 255.0 : 1.0;  // rgba8: the table lists codes
+    Section& t = e.section(std::string(under ? "front to back (under): C <- C + (1 - A) a c, A <- A + (1 - A) a"
+                                             : "back to front, from the far end: C <- src + C (1 - a)") +
+                           (eight ? "; codes q = R(255 x)" : ""));
+    t.columns = {"sample", "r", "g", "b", "a", "exact_r", "exact_g", "exact_b", "exact_a", "C_r", "C_g", "C_b", "A", "lo_r", "hi_r", "lo_a", "hi_a"};
+    for (std::size_t j = 0; j < samples.size(); ++j) {
+        const std::size_t i = under ? j : samples.size() - 1 - j;
+        const CompositeSample& s = samples[i];
+        fb.blend(s.color, s.opacity);
+        const glm::dvec4 x = fb.last_exact() * k, c = fb.pixel() * k, lo = fb.low() * k, hi = fb.high() * k;
+        t.rows.push_back({double(i + 1), s.color.r, s.color.g, s.color.b, s.opacity, x.r, x.g, x.b, x.a, c.r, c.g, c.b, c.a, lo.r,
+                          hi.r, lo.a, hi.a});
+    }
+    if (eight) {
+        t.notes.push_back("a blend of source code q_s, factor f_s, stored Q and factor f_d: exact = (q_s f_s + Q f_d) / 255 (codes), "
+                          "stored R(exact), or R(q_s f_s / 255) + R(Q f_d / 255) with rounded products; R(x) = floor(x + 1/2) or floor(x)");
+        t.notes.push_back("src-alpha: colour q_s = R(255 c), f_s = q_a, f_d = 255 - q_a; alpha f_s = q_a (src-alpha) or 255 (one); "
+                          "premultiplied: q_s = R(255 a c), f_s = 255");
+    } else {
+        t.notes.push_back("exact: the blend in double from the stored value; C: as the buffer stores it (float32 arithmetic, stored "
+                          "float32 or binary16)");
+    }
+    t.notes.push_back("lo, hi: the band, what any rounding variant stores (FrameBuffer.h)");
+    Section& r = e.section("pixel");
+    const glm::dvec4 p = fb.pixel();
+    add(r, "pixel", {p.r, p.g, p.b, p.a}, eight ? "(C, A) = codes / 255, as the frame buffer holds them" : "(C, A) as stored");
+    add(r, "band", fb.band(), "max over R, G, B, A of the distance to the band's ends");
     return e;
 }
 

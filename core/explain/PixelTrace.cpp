@@ -1,5 +1,7 @@
 #include "core/explain/PixelTrace.h"
 
+#include "core/integrate/profiles/Profile.h"
+
 #include <algorithm>
 #include <charconv>
 #include <functional>
@@ -114,6 +116,8 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.shaded = v.shader != nullptr && is_composite(t.projection);
     t.lights = t.shaded ? v.shader->lights().size() : 0;
     t.skipping = v.macrocells != nullptr && is_composite(t.projection);  // the traced mip / minip loop does not skip
+    t.slices = !r.reference_integrators() && r.profile != ProfileId::Fast &&
+               resolve_profile(r).placement == Profile::Placement::Slices;
     Collector collector(scene, t.samples);
     t.pixel = scene.trace_pixel(x, y, collector);
     for (TracedSample& s : t.samples) {  // issue 29: the rows' interval and step from its entry
@@ -209,6 +213,11 @@ std::vector<Column> columns(const PixelTrace& t) {
     } else {
         add("running", [=](const TracedSample& s) { return num(s.record.running); });
     }
+    if (t.slices) {  // issue 54: the surface each fragment lies on, and its blend before the frame buffer stored it
+        add("surface", [](const TracedSample& s) { return std::to_string(s.record.surface); });
+        for (int a = 0; a < 4; ++a)
+            add(std::string("blend_") + "rgba"[a], [=](const TracedSample& s) { return num(s.record.blend_exact[a]); });
+    }
     for (int a = 0; a < 4; ++a)
         add(std::string("acc_") + "rgba"[a], [=](const TracedSample& s) { return num(s.record.accumulated[a]); });
     return c;
@@ -298,6 +307,10 @@ std::string trace_json(const PixelTrace& t, int indent) {
             o["transmittance_after"] = jnum(r.transmittance_after);
         } else {
             o["running"] = jnum(r.running);
+        }
+        if (t.slices) {
+            o["surface"] = r.surface;
+            o["blend"] = jvec(r.blend_exact);
         }
         o["accumulated"] = jvec(r.accumulated);
         samples.push_back(std::move(o));

@@ -55,6 +55,7 @@ struct PixelTrace {
     bool shaded = false;
     std::size_t lights = 0;
     bool skipping = false;       // empty-space skipping was on (skipped segments are not listed)
+    bool slices = false;         // placement "slices": each sample's surface and its blend's rounding are listed
     std::vector<TracedSample> samples;
     PixelValue pixel;            // what the integrator returned
     std::string fault;           // issue 28: why the mirrored program does not finish this ray (empty: it does)

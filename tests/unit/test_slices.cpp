@@ -15,6 +15,8 @@
 #include "TestScenes.h"
 #include "core/Error.h"
 #include "core/camera/Camera.h"
+#include "core/compare/ConventionSearch.h"
+#include "core/explain/Explain.h"
 #include "core/integrate/profiles/FrameBuffer.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/integrate/profiles/Slices.h"
@@ -426,4 +428,52 @@ TEST(Slices, ViewVolumeRangeAndDepthClip) {
     // object range, clipped: levels 25, 24, ..., 10; kept 20 .. 12: 9 planes.
     const glm::dvec4 q = pixel(with(s, {{"framebuffer", "double"}, {"table_format", "float"}, {"texture_format", "float"}, {"blend_alpha", "one"}}));
     EXPECT_NEAR(q.a, 1.0 - std::pow(0.9, 9), 1e-14);
+}
+
+// explain composite --framebuffer: each row's stored codes are the hand recurrence's, the exact column
+// (q_s f_s + Q f_d) / 255 before the rounding.
+TEST(Slices, ExplainWorksAnEightBitBlend) {
+    const std::vector<explain::CompositeSample> samples{{{1.0, 0.5, 0.0}, 0.4}, {{0.2, 1.0, 1.0}, 0.1}, {{1.0, 1.0, 1.0}, 0.75}};
+    const explain::Explanation e = explain::composite_framebuffer(samples, CompositeOrder::BackToFront, explain::FrameBufferRules{});
+    const explain::Section& t = e.sections.at(1);
+    ASSERT_EQ(t.rows.size(), 3u);
+    int c = 0, a = 0;
+    for (std::size_t j = 0; j < 3; ++j) {
+        const explain::CompositeSample& x = samples[2 - j];  // far first
+        const int qa = int(std::floor(255.0 * x.opacity + 0.5)), qc = int(std::floor(255.0 * x.color.r + 0.5));
+        EXPECT_DOUBLE_EQ(t.rows[j][5], (double(qc) * qa + double(c) * (255 - qa)) / 255.0);
+        c = blend8(qc, qa, c, 255 - qa, false, false);
+        a = blend8(qa, qa, a, 255 - qa, false, false);
+        EXPECT_EQ(t.rows[j][9], double(c));
+        EXPECT_EQ(t.rows[j][12], double(a));
+    }
+}
+
+// --fit --scene names a slicer's orientation, frame buffer and correction on an image volref rendered
+// with them (the real slicer's images: tests/gpu/slicing).
+TEST(Slices, ConventionSearchNamesTheSlicingRules) {
+    FieldSpec ml;
+    ml.kind = FieldSpec::Kind::MarschnerLobb;
+    ml.dims = {17, 17, 17};
+    Scene s = field_scene(ml);
+    s.volume().transfer.color = {{0, 0.1, 0.3, 0.9}, {1, 1, 0.8, 0.2}};
+    s.volume().transfer.opacity = {{0, 0}, {0.3, 0.0}, {1, 0.35}};
+    s.camera = perspective({34, -12, 30}, {8, 8, 8}, 30.0);
+    s.image.width = s.image.height = 20;
+    s.render.profile = ProfileId::Volumizer;
+    s.render.step = 0.75;
+    auto other = [&](const json& rules) {
+        compare::ComparedImage g;
+        const Image im = render_scene(with(s, rules), {0, false});
+        g.rgba = Image(im.width, im.height, {"R", "G", "B", "A"});
+        for (std::size_t p = 0; p < std::size_t(im.width * im.height); ++p)
+            for (std::size_t c = 0; c < 4; ++c) g.rgba.pixels[p * 4 + c] = im.pixels[p * im.channels.size() + c];
+        return g;
+    };
+    const compare::SearchResult r = compare::search_conventions(
+        other({{"slices", {{"orientation", "axis"}}}, {"framebuffer", "rgba32f"}, {"correction", "exact"}}), s);
+    EXPECT_TRUE(r.explained) << r.verdict;
+    EXPECT_EQ(r.best.rules.value("slices.orientation", ""), "axis") << r.best.rules.dump();
+    EXPECT_EQ(r.best.rules.value("framebuffer", ""), "rgba32f") << r.best.rules.dump();
+    EXPECT_EQ(r.best.rules.value("correction", ""), "exact") << r.best.rules.dump();
 }

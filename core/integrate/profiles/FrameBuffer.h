@@ -66,7 +66,10 @@ public:
             return;
         }
         std::array<double, 4> next;
-        for (int ch = 0; ch < 4; ++ch) next[std::size_t(ch)] = blend_float(ch, src, a, v_[std::size_t(ch)], v_[3]);
+        for (int ch = 0; ch < 4; ++ch) {
+            next[std::size_t(ch)] = blend_float(ch, src, a, v_[std::size_t(ch)], v_[3]);
+            exact_[std::size_t(ch)] = blend_float(ch, src, a, v_[std::size_t(ch)], v_[3], true);
+        }
         if (band_) {
             for (int ch = 0; ch < 4; ++ch) {
                 const double l = blend_float(ch, src, a, lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3]);
@@ -88,6 +91,9 @@ public:
         for (int ch = 0; ch < 4; ++ch) b = std::max({b, h[ch] - p[ch], p[ch] - l[ch]});
         return b;
     }
+    // The last blend's result before it was stored (rgba8: before the rounding, in codes / 255; float
+    // buffers: in double from the stored value): pixel() - last_exact() is that blend's rounding.
+    glm::dvec4 last_exact() const { return scale(exact_); }
     glm::dvec4 low() const { return scale(lo_); }
     glm::dvec4 high() const { return scale(hi_); }
 
@@ -114,9 +120,10 @@ private:
     }
 
     // A float buffer's blend of channel ch over the stored value dst (dst_alpha: the stored alpha).
-    double blend_float(int ch, const double* src, double a, double dst, double dst_alpha) const {
-        const bool f32 = format_ != Format::Double;
+    double blend_float(int ch, const double* src, double a, double dst, double dst_alpha, bool unrounded = false) const {
+        const bool f32 = format_ != Format::Double && !unrounded;
         auto r = [&](double x) { return f32 ? framebuffer::to_float(x) : x; };
+        auto store = [&](double x) { return unrounded ? x : this->store(x); };
         const double s = r(src[ch]), sa = r(a);
         if (blend_ == Blend::Max) return store(std::max(dst, s));
         const bool alpha = ch == 3;
@@ -135,7 +142,7 @@ private:
 
     // One 8-bit blend of channel ch by one variant: source code qs, the stored dst and dst alpha codes.
     double blend8_variant(int ch, const double* src, double qa, double dst, double dst_alpha, Rounding conv, Rounding r,
-                          Products p) const {
+                          Products p, bool unrounded = false) const {
         const bool alpha = ch == 3;
         double qs = 0.0, fs = 0.0, fd = 0.0;
         if (blend_ == Blend::Max) return std::max(dst, code(src[ch], conv));
@@ -152,6 +159,7 @@ private:
             fs = alpha && blend_alpha_ == BlendAlpha::One ? 255.0 : qa;
             fd = 255.0 - qa;
         }
+        if (unrounded) return (qs * fs + dst * fd) / 255.0;
         if (p == Products::Exact) return round8((qs * fs + dst * fd) / 255.0, r);
         return std::min(255.0, round8(qs * fs / 255.0, r) + round8(dst * fd / 255.0, r));
     }
@@ -159,8 +167,10 @@ private:
     void blend8(const double* src, double a) {
         std::array<double, 4> next;
         const double qa = code(a, rounding_);
-        for (int ch = 0; ch < 4; ++ch)
+        for (int ch = 0; ch < 4; ++ch) {
             next[std::size_t(ch)] = blend8_variant(ch, src, qa, v_[std::size_t(ch)], v_[3], rounding_, rounding_, products_);
+            exact_[std::size_t(ch)] = blend8_variant(ch, src, qa, v_[std::size_t(ch)], v_[3], rounding_, rounding_, products_, true);
+        }
         if (band_) {
             std::array<double, 4> lo = lo_, hi = hi_;
             for (int ch = 0; ch < 4; ++ch) {
@@ -187,7 +197,7 @@ private:
     Blend blend_;
     BlendAlpha blend_alpha_;
     bool under_, band_;
-    std::array<double, 4> v_{0.0, 0.0, 0.0, 0.0};
+    std::array<double, 4> v_{0.0, 0.0, 0.0, 0.0}, exact_{0.0, 0.0, 0.0, 0.0};
     std::array<double, 4> lo_{0.0, 0.0, 0.0, 0.0}, hi_{0.0, 0.0, 0.0, 0.0};
 };
 

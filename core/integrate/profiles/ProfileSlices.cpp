@@ -202,6 +202,7 @@ PixelValue ProfileIntegrator::slices(const Ray& ray, const std::vector<Interval>
             r.alpha = f.alpha;
             r.surface = std::int64_t(k);
             r.accumulated = fb.pixel();
+            r.blend_exact = fb.last_exact();
             rec.recorder.record(r);
         }
         return true;

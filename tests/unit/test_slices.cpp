@@ -477,3 +477,45 @@ TEST(Slices, ConventionSearchNamesTheSlicingRules) {
     EXPECT_EQ(r.best.rules.value("framebuffer", ""), "rgba32f") << r.best.rules.dump();
     EXPECT_EQ(r.best.rules.value("correction", ""), "exact") << r.best.rules.dump();
 }
+
+// for_each_crossing visits exactly the levels a loop over all of them keeps (it looks only at the levels
+// the chord can reach), in order, for every orientation, on random rays.
+TEST(Slices, CrossingsEqualABruteForceLoop) {
+    const glm::dvec3 lo(0.0), hi(20.0, 12.0, 16.0);
+    std::uint64_t seed = 12345;
+    auto uniform = [&]() {
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        return double(seed >> 11) * 0x1p-53;
+    };
+    for (const char* orientation : {"viewport", "axis", "spherical"})
+        for (const char* order : {"back-to-front", "front-to-back"}) {
+            const CameraSpec spec = perspective({31, -17, 29}, {10, 6, 8}, 50.0);
+            const SliceLattice L = lattice({{"placement", "slices"}, {"slices", {{"orientation", orientation}, {"spacing", 0.37}, {"order", order}}}},
+                                           spec, lo, hi, 0.37);
+            const Camera cam(spec, 64, 64, lo, hi);
+            std::size_t total = 0;
+            for (int i = 0; i < 200; ++i) {
+                const Ray r = cam.ray(64.0 * uniform(), 64.0 * uniform());
+                const double t0 = 20.0 + 20.0 * uniform();
+                const std::vector<Interval> iv{{t0, t0 + 3.0 * uniform()}, {t0 + 4.0, t0 + 4.0 + 10.0 * uniform()}};
+                std::vector<std::size_t> seen, expected;
+                L.for_each_crossing(r, iv, [&](double, double, std::size_t k) {
+                    seen.push_back(k);
+                    return true;
+                });
+                for (std::size_t j = 0; j < L.levels.size(); ++j) {
+                    const std::size_t k = std::string(order) == "back-to-front" ? j : L.levels.size() - 1 - j;
+                    double t = 0.0, d = 0.0;
+                    if (!L.crossing(r, k, t, d) || t < 0.0) continue;
+                    for (const Interval& x : iv)
+                        if (t >= x.t0 && t <= x.t1) {
+                            expected.push_back(k);
+                            break;
+                        }
+                }
+                ASSERT_EQ(seen, expected) << orientation << " " << order << " ray " << i;
+                total += expected.size();
+            }
+            EXPECT_GT(total, 1000u) << orientation;
+        }
+}

@@ -9,10 +9,13 @@
 // Levels lambda_k, k = 0 .. n - 1, from the far bound; a crossing t_k stands for d_k = s / |dlambda/dt|,
 // s the levels' spacing (planes: s / |n . d|; shells from the eye: s).
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/camera/Ray.h"
@@ -78,9 +81,32 @@ void SliceLattice::for_each_crossing(const Ray& ray, const std::vector<Interval>
         }
         return true;
     };
+    // The levels the chord [max(lo, 0), hi] can cross (levels fall by `spacing` from levels[0]), widened
+    // by one each way; each is still tested exactly below.
     const std::size_t n = levels.size();
-    for (std::size_t j = 0; j < n; ++j) {
-        const std::size_t k = back_to_front ? j : n - 1 - j;
+    std::size_t k0 = 0, k1 = n;  // [k0, k1)
+    if (n > 1 && spacing > 0.0) {
+        const double ta = std::max(lo, 0.0), tb = hi;
+        double l_min = 0.0, l_max = 0.0;
+        if (orientation == Orientation::Spherical) {
+            const glm::dvec3 a = ray.at(ta) - eye, b = ray.at(tb) - eye;
+            const double dd = glm::dot(ray.direction, ray.direction);
+            const double tc = dd > 0.0 ? std::clamp(-glm::dot(ray.origin - eye, ray.direction) / dd, ta, tb) : ta;
+            l_min = glm::length(ray.at(tc) - eye);
+            l_max = std::max(glm::length(a), glm::length(b));
+        } else {
+            const double base = glm::dot(normal, ray.origin) + offset, rate = glm::dot(normal, ray.direction);
+            l_min = std::min(base + ta * rate, base + tb * rate);
+            l_max = std::max(base + ta * rate, base + tb * rate);
+        }
+        const double first = std::floor((levels[0] - l_max) / spacing) - 1.0, last = std::ceil((levels[0] - l_min) / spacing) + 2.0;
+        if (std::isfinite(first) && std::isfinite(last)) {
+            k0 = std::size_t(std::clamp(first, 0.0, double(n)));
+            k1 = std::size_t(std::clamp(last, 0.0, double(n)));
+        }
+    }
+    for (std::size_t j = k0; j < k1; ++j) {
+        const std::size_t k = back_to_front ? j : k0 + k1 - 1 - j;
         double t = 0.0, d = 0.0;
         if (!crossing(ray, k, t, d) || !inside(t)) continue;
         if (!fn(t, d, k)) return;

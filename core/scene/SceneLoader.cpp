@@ -1032,7 +1032,7 @@ BoundsSpec parse_shell(const std::string& json_text, const std::string& name) {
     const Json json = json_reader::parse_json(json_text, name);
     ObjectReader r(json, "", ctx);
     BoundsSpec b;
-    b.type = r.required_choice<T>("type", std::span<const json_reader::Choice<T>>(names::kBounds).subspan(2));  // the shells
+    b.type = r.required_choice<T>("type", std::span<const json_reader::Choice<T>>(names::kBounds).subspan(2, 2));  // the shells
     read_shell(r, b);
     return b;
 }

@@ -25,6 +25,7 @@ inline constexpr Choice<FieldSpec::Kind> kFields[] = {{"constant", FieldSpec::Ki
                                                       {"marschner-lobb", FieldSpec::Kind::MarschnerLobb},
                                                       {"gaussian", FieldSpec::Kind::Gaussian},
                                                       {"cells", FieldSpec::Kind::Cells}};
+// The two shells are entries 2 and 3 (parse_shell reads them alone).
 inline constexpr Choice<BoundsSpec::Type> kBounds[] = {{"box", BoundsSpec::Type::Box},
                                                        {"mesh", BoundsSpec::Type::Mesh},
                                                        {"cylindrical", BoundsSpec::Type::Cylindrical},

@@ -174,14 +174,18 @@ private:
         if (band_) {
             std::array<double, 4> lo = lo_, hi = hi_;
             for (int ch = 0; ch < 4; ++ch) {
+                // Of the stored values' variants the lowest is truncated products (floor p1 + floor p2 <=
+                // floor(p1 + p2) <= round(p1 + p2)) and the highest one rounding to nearest, with exact or
+                // rounded products; the fragment's conversion (nearest or truncated) is tried both ways.
                 double l = next[std::size_t(ch)], h = l;
-                for (Rounding conv : {Rounding::Nearest, Rounding::Truncate})
-                    for (Rounding r : {Rounding::Nearest, Rounding::Truncate})
-                        for (Products p : {Products::Exact, Products::Rounded}) {
-                            const double qa_v = code(a, conv);
-                            l = std::min(l, blend8_variant(ch, src, qa_v, lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3], conv, r, p));
-                            h = std::max(h, blend8_variant(ch, src, qa_v, hi_[std::size_t(ch)], under_ ? lo_[3] : hi_[3], conv, r, p));
-                        }
+                for (Rounding conv : {Rounding::Nearest, Rounding::Truncate}) {
+                    const double qa_v = code(a, conv);
+                    const double dlo = lo_[std::size_t(ch)], dhi = hi_[std::size_t(ch)];
+                    const double alo = under_ ? hi_[3] : lo_[3], ahi = under_ ? lo_[3] : hi_[3];
+                    l = std::min(l, blend8_variant(ch, src, qa_v, dlo, alo, conv, Rounding::Truncate, Products::Rounded));
+                    for (Products p : {Products::Exact, Products::Rounded})
+                        h = std::max(h, blend8_variant(ch, src, qa_v, dhi, ahi, conv, Rounding::Nearest, p));
+                }
                 lo[std::size_t(ch)] = l;
                 hi[std::size_t(ch)] = h;
             }

@@ -519,3 +519,25 @@ TEST(Slices, CrossingsEqualABruteForceLoop) {
             EXPECT_GT(total, 1000u) << orientation;
         }
 }
+
+// GL_MAX (the mip projection): per channel the largest fragment, not (a c, a) at the largest value: a
+// colour ramp falling as the opacity rises gives the colour of the nearest slice and the alpha of the
+// farthest. f = z on [0, 4], 5 planes at z = 4, 3, ..., 0 (far first from the eye looking up +z).
+TEST(Slices, MaxBlendIsPerChannel) {
+    Scene s = field_scene(linear_field({0, 0, 1, 0}, {5, 5, 5}));
+    s.volume().transfer.color = {{0, 1, 1, 1}, {4, 0, 0, 0}};
+    s.volume().transfer.opacity = {{0, 0}, {4, 1}};
+    s.camera = ortho_down_z(2.0, 2.0, 14.0, 1.0);
+    s.image.width = s.image.height = 1;
+    s.render.step = 1.0;
+    s.render.step_units = StepUnits::World;
+    s.render.projection = Projection::Mip;
+    s.render.profile = ProfileId::Volumizer;
+    const glm::dvec4 p = pixel(with(s, {{"blend", "max"}, {"texture_format", "float"}, {"table_format", "float"}, {"table_lookup", "linear"},
+                                        {"framebuffer", "double"}}));
+    EXPECT_NEAR(p.r, 1.0, 1e-15);  // the slice at z = 0: colour 1, opacity 0
+    EXPECT_NEAR(p.a, 1.0, 1e-15);  // the slice at z = 4: colour 0, opacity 1
+    const glm::dvec4 q = pixel(with(s, {{"blend", "max"}}));  // 8-bit: the same codes
+    EXPECT_EQ(q.r, 1.0);
+    EXPECT_EQ(q.a, 1.0);
+}

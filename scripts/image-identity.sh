@@ -42,7 +42,7 @@ write_cases() {  # $1: the cases file
             done
             echo "$n.firsthit|$s|$base render.projection=\"first-hit\" render.isovalue=0.5|"
             echo "$n.firsthit.adaptive|$s|$small $extra render.projection=\"first-hit\" render.isovalue=0.5 render.integrator=\"adaptive\"|"
-            for p in fast vtk-gpu vtk-cpu glsl-basic ospray cuda-curvilinear; do
+            for p in fast vtk-gpu vtk-cpu glsl-basic ospray cuda-curvilinear volumizer; do
                 echo "$n.$p|$s|$base render.profile=\"$p\"|"
                 for q in mip minip average xray; do
                     echo "$n.$p.$q|$s|$base render.profile=\"$p\" render.projection=\"$q\"|"

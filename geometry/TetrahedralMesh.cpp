@@ -313,7 +313,7 @@ void skip_field(Cursor& c) {
             c.to_next_line();
             c.block(n * t->size, "FIELD array " + io::quoted(name));
         } else {
-            for (std::uint64_t i = 0; i < n; ++i) (void)c.real("FIELD array " + io::quoted(name));
+            for (std::uint64_t i = 0; i < n; ++i) (void)c.word("FIELD array " + io::quoted(name) + "'s values");
         }
     }
 }
@@ -409,7 +409,7 @@ void read_cell_arrays(Cursor& c, std::uint64_t n_offsets, std::uint64_t n_connec
     while (cells.where.size() + 1 < cells.offsets.size()) cells.where.push_back(c.binary() ? 0 : keyword_line);
 }
 
-// Orients tetrahedron k of `mesh` positively; Error `where` + "... has no volume" when degenerate.
+// Orients tetrahedron k of `mesh` positively; Error `where` + `what` + "... is degenerate" when it has no volume.
 void orient_one(TetrahedralMesh& mesh, std::size_t k, const std::string& where, const std::string& what) {
     auto& t = mesh.tetrahedra[k];
     const glm::dvec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]], &d = mesh.vertices[t[3]];

@@ -17,8 +17,8 @@
 //
 // Every tetrahedron must have a volume: |det(b - a, c - a, d - a)| > kTetrahedronDegenerateRelative
 // l^3 (core/Conventions.h; l its longest edge). Orientation is a convention of the writer (VTK's
-// right-hand rule, Volumizer's cube has both), so either is accepted: each tetrahedron is oriented
-// positively (det > 0, points 2 and 3 swapped if not). Refused, each with one line naming the file and
+// right-hand rule gives det > 0; Volumizer's cubeIndices are all det < 0), so either is accepted,
+// mixed too: each tetrahedron is oriented positively (det > 0, points 2 and 3 swapped if not). Refused, each with one line naming the file and
 // the line (ASCII) or byte (BINARY) and the cell or point index: degenerate tetrahedra, point indices
 // out of range, coordinates that are not finite or beyond 1e100, cell types other than 10, cells
 // without 4 points, counts that do not match (CELL_TYPES against CELLS, the sizes of CELLS, OFFSETS

@@ -11,7 +11,7 @@ shift || true
 build=build-sanitize
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(fuzz_scene fuzz_nrrd fuzz_nifti fuzz_metaimage fuzz_vtk fuzz_vti fuzz_den fuzz_obj fuzz_ply)
+  targets=(fuzz_scene fuzz_nrrd fuzz_nifti fuzz_metaimage fuzz_vtk fuzz_vti fuzz_den fuzz_obj fuzz_ply fuzz_tetrahedra)
 fi
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT

@@ -145,4 +145,22 @@ put('fuzz_obj', 'nan-vertex.obj', 'v nan 0 0\n' + ''.join(f'v {x} {y} {z}\n' for
     ''.join(f'f {a + 1} {b + 1} {c + 1}\n' for a, b, c in cube_f))
 put('fuzz_obj', 'huge-index.obj', 'mtllib /dev/zero\n' + ''.join(f'v {x} {y} {z}\n' for x, y, z in cube_v) +
     'f 1 2 99999999999999999999\n')
+# Tetrahedra (volume.bounds type "tetrahedra"): the reference scenes' files (ASCII, both cell layouts),
+# Volumizer's cube as BINARY in both layouts, and a FIELD + METADATA block before the points.
+for n in ('tetra-box.vtk', 'tetra-icosphere.vtk', 'tetra-shell.vtk'):
+    with open(os.path.join(ROOT, 'reference_scenes', 'data', n), 'rb') as f:
+        put('fuzz_tetrahedra', n, f.read())
+cube_t = [(0, 2, 5, 7), (3, 2, 0, 7), (1, 2, 5, 0), (2, 7, 6, 5), (5, 4, 0, 7)]
+points = struct.pack('>24d', *[c for v in cube_v for c in v])
+put('fuzz_tetrahedra', 'cube-binary.vtk', b'# vtk DataFile Version 3.0\ncube\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 8 double\n' +
+    points + b'\nCELLS 5 25\n' + b''.join(struct.pack('>5i', 4, *t) for t in cube_t) + b'\nCELL_TYPES 5\n' +
+    struct.pack('>5i', *[10] * 5) + b'\n')
+put('fuzz_tetrahedra', 'cube-binary-51.vtk', b'# vtk DataFile Version 5.1\ncube\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 8 float\n' +
+    struct.pack('>24f', *[c for v in cube_v for c in v]) + b'\nCELLS 6 20\nOFFSETS vtktypeint64\n' +
+    struct.pack('>6q', *range(0, 24, 4)) + b'\nCONNECTIVITY vtktypeint32\n' + b''.join(struct.pack('>4i', *t) for t in cube_t) +
+    b'\nCELL_TYPES 5\n' + struct.pack('>5i', *[10] * 5) + b'\n')
+put('fuzz_tetrahedra', 'cube-field.vtk', '# vtk DataFile Version 2.0\ncube\nASCII\nDATASET UNSTRUCTURED_GRID\n'
+    'FIELD FieldData 1\nTIME 1 1 double\n0.5\nMETADATA\nINFORMATION 0\n\nPOINTS 8 double\n' +
+    ''.join(f'{x} {y} {z}\n' for x, y, z in cube_v) + 'CELLS 5 25\n' + ''.join(f'4 {a} {b} {c} {d}\n' for a, b, c, d in cube_t) +
+    'CELL_TYPES 5\n10 10 10 10 10\nCELL_DATA 5\nSCALARS r int 1\nLOOKUP_TABLE default\n1 2 3 4 5\n')
 print('seeds written to', CORPUS)

@@ -5,7 +5,7 @@ ASCII UNSTRUCTURED_GRID files in reference_scenes/data/: the shapes of OpenGL Vo
 
   tetra-box.vtk        Volumizer's cube of five tetrahedra: its vertex order (vtxData) and its
                        cubeIndices {0,2,5,7}, {3,2,0,7}, {1,2,5,0}, {2,7,6,5}, {5,4,0,7} as written
-                       (seed L1730-1738; both orientations occur), on the cube [10, 53]^3. Legacy
+                       (seed L1730-1738; all five negative under VTK's right-hand rule), on the cube [10, 53]^3. Legacy
                        layout (CELLS n size, "4 i j k l" records), version 2.0 as Gmsh and TetGen write.
   tetra-icosphere.vtk  a sphere as a tessellated icosahedron: the icosahedron subdivided once (each
                        face into 4, new vertices pushed out to the sphere: 42 vertices, 80 faces), one

@@ -3,6 +3,7 @@
 // surfaces are Slices.h's, the frame buffer FrameBuffer.h's; this file is what one fragment computes
 // (the texture's texels and filter, the table or the transfer function, the alpha) and the loop.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -27,8 +28,8 @@ double quantise(double x, double levels) { return std::floor(levels * std::clamp
 bool transfer_rows(const TransferFunction& tf, double& lo, double& hi) {
     lo = std::numeric_limits<double>::infinity();
     hi = -lo;
-    const auto [wlo, whi] = tf.window();
-    auto value = [&](double x) { return tf.normalized() ? wlo + x * (whi - wlo) : x; };
+    const std::array<double, 2> w = tf.window();
+    auto value = [&](double x) { return tf.normalized() ? w[0] + x * (w[1] - w[0]) : x; };
     for (const std::vector<double>* xs : {&tf.color_function().xs(), &tf.opacity_function().xs()})
         for (double x : *xs) {
             lo = std::min(lo, value(x));

@@ -292,7 +292,12 @@ struct ProfileRules {
     enum class SliceClassify { Post, PreUnweighted };
     enum class FrameBuffer { Double, Rgba32f, Rgba16f, Rgba8 };
     enum class Rounding { Nearest, Truncate };
-    enum class BlendProducts { Exact, Rounded };
+    // Llvmpipe: each product (t + (t >> 8) + 128) >> 8, t = q_s f_s (Mesa's llvmpipe, measured by
+    // tests/gpu/slicing/gl_probe: one less than round(t / 255) for 24 pairs of codes >= 152).
+    enum class BlendProducts { Exact, Rounded, Llvmpipe };
+    // Exact: trilinear in double of the stored texels; Fixed8: llvmpipe's 8-bit filter (unorm8 texels):
+    // weights of 1/256, each lerp v0 + ((w (v1 - v0) + 128) >> 8) in codes, x, then y, then z.
+    enum class TextureFilter { Exact, Fixed8 };
     enum class Blend { SrcAlpha, Premultiplied, Max };
     enum class BlendAlpha { SrcAlpha, One };
 
@@ -308,6 +313,7 @@ struct ProfileRules {
     std::optional<FrameBuffer> framebuffer;
     std::optional<Rounding> framebuffer_rounding;
     std::optional<BlendProducts> blend_products;
+    std::optional<TextureFilter> texture_filter;
     std::optional<Blend> blend;
     std::optional<BlendAlpha> blend_alpha;
     std::optional<double> first;  // from-entry: the first sample's distance from the entry, in steps

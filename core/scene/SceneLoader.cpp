@@ -832,6 +832,7 @@ void read_slice_rules(ObjectReader& r, ProfileRules& out) {
     out.blend_products = r.optional_choice<P::BlendProducts>("blend_products", names::kBlendProducts);
     out.blend = r.optional_choice<P::Blend>("blend", names::kBlends);
     out.blend_alpha = r.optional_choice<P::BlendAlpha>("blend_alpha", names::kBlendAlphas);
+    out.texture_filter = r.optional_choice<P::TextureFilter>("texture_filter", names::kTextureFilters);
 }
 
 ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
@@ -842,12 +843,12 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
         "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded",
         // the slicers' rules (issue 54)
         "slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
-        "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha"};  // jitter "off": nothing to apply
+        "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha", "texture_filter"};  // jitter "off": nothing to apply
     r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
              "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
              "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter", "slices", "texture",
              "texture_format", "texture_window", "table_lookup", "table_format", "classify", "framebuffer", "framebuffer_rounding",
-             "blend_products", "blend", "blend_alpha"});
+             "blend_products", "blend", "blend_alpha", "texture_filter"});
     P out;
     for (std::string_view k : kKeys)
         if (r.has(k)) out.keys.emplace_back(k);

@@ -147,7 +147,10 @@ inline constexpr Choice<Rules::FrameBuffer> kFrameBuffers[] = {{"double", Rules:
                                                               {"rgba8", Rules::FrameBuffer::Rgba8}};
 inline constexpr Choice<Rules::Rounding> kRoundings[] = {{"nearest", Rules::Rounding::Nearest}, {"truncate", Rules::Rounding::Truncate}};
 inline constexpr Choice<Rules::BlendProducts> kBlendProducts[] = {{"exact", Rules::BlendProducts::Exact},
-                                                                 {"rounded", Rules::BlendProducts::Rounded}};
+                                                                 {"rounded", Rules::BlendProducts::Rounded},
+                                                                 {"llvmpipe", Rules::BlendProducts::Llvmpipe}};
+inline constexpr Choice<Rules::TextureFilter> kTextureFilters[] = {{"exact", Rules::TextureFilter::Exact},
+                                                                  {"fixed8", Rules::TextureFilter::Fixed8}};
 inline constexpr Choice<Rules::Blend> kBlends[] = {{"src-alpha", Rules::Blend::SrcAlpha},
                                                   {"premultiplied", Rules::Blend::Premultiplied},
                                                   {"max", Rules::Blend::Max}};

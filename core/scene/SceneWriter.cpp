@@ -344,6 +344,7 @@ nlohmann::json profile_rules_object(const ProfileRules& r) {
     if (r.blend_products) j["blend_products"] = name_of(names::kBlendProducts, *r.blend_products);
     if (r.blend) j["blend"] = name_of(names::kBlends, *r.blend);
     if (r.blend_alpha) j["blend_alpha"] = name_of(names::kBlendAlphas, *r.blend_alpha);
+    if (r.texture_filter) j["texture_filter"] = name_of(names::kTextureFilters, *r.texture_filter);
     return j;
 }
 

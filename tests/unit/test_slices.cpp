@@ -541,3 +541,46 @@ TEST(Slices, MaxBlendIsPerChannel) {
     EXPECT_EQ(q.r, 1.0);
     EXPECT_EQ(q.a, 1.0);
 }
+
+// Mesa's llvmpipe (measured by tests/gpu/slicing/gl_probe on the real program): its 8-bit product
+// (t + (t >> 8) + 128) >> 8 is round(t / 255) but for 24 pairs of codes, all >= 152, one less.
+TEST(Slices, LlvmpipeProductsByHand) {
+    int differ = 0;
+    for (int a = 0; a < 256; ++a)
+        for (int b = 0; b < 256; ++b) {
+            const double p = framebuffer::llvmpipe_product(a, b), r = std::floor(a * b / 255.0 + 0.5);
+            if (p != r) {
+                ++differ;
+                EXPECT_EQ(p, r - 1.0);
+                EXPECT_GE(std::min(a, b), 152);
+            }
+        }
+    EXPECT_EQ(differ, 24);
+    EXPECT_EQ(framebuffer::llvmpipe_product(152, 229), 136.0);
+    // binary16 toward zero: 1/3 -> 0x3555 (below), 0.1 -> 0x2E66 (below), 1 + 3 2^-11 -> 1 + 2^-10.
+    EXPECT_EQ(framebuffer::to_half_toward_zero(1.0 / 3.0), 0.333251953125);
+    EXPECT_EQ(framebuffer::to_half_toward_zero(1.0 + 3 * 0x1p-11), 1.0 + 0x1p-10);
+    EXPECT_EQ(framebuffer::to_half_toward_zero(-(1.0 + 3 * 0x1p-11)), -(1.0 + 0x1p-10));
+}
+
+// texture_filter "fixed8": llvmpipe's 8-bit filter. Texels 0 and 255 on an axis of 2, read at index 0.3:
+// x = float(0.8 / 2), i = rint(256 * 2 x) - 128 = 205 - 128 = 77, s = (0 + ((77 * 255 + 128) >> 8)) / 255
+// = 77 / 255, where the exact filter gives 0.3.
+TEST(Slices, Fixed8FilterByHand) {
+    Scene s = field_scene(linear_field({1, 0, 0, 0}, {2, 2, 2}));  // f = x on [0, 1]^3
+    s.volume().transfer.color = {{0, 1, 1, 1}, {1, 1, 1, 1}};
+    s.volume().transfer.opacity = {{0, 0}, {1, 1}};
+    s.camera = ortho_down_z(0.3, 0.5, 10.0, 0.01);
+    s.image.width = s.image.height = 1;
+    s.render.step = 100.0;  // one plane at z = 0
+    s.render.step_units = StepUnits::World;
+    const json rules = {{"placement", "slices"}, {"correction", "none"}, {"framebuffer", "double"}, {"texture_format", "unorm8"},
+                        {"texture_window", {0, 1}}, {"blend_alpha", "one"}};
+    json fixed = rules;
+    fixed["texture_filter"] = "fixed8";
+    EXPECT_NEAR(pixel(with(s, rules)).a, 0.3, 1e-12);
+    EXPECT_EQ(pixel(with(s, fixed)).a, 77.0 / 255.0);
+    json bad = fixed;
+    bad["texture_format"] = "float";
+    EXPECT_NE(error_of(with(s, bad)).find("render.profile.texture_filter"), std::string::npos);
+}

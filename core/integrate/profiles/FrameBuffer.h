@@ -43,7 +43,24 @@ inline double to_half(double x) {
     return std::fabs(r) > 65504.0 ? std::copysign(INFINITY, r) : r;
 }
 
+// x rounded to binary16 toward zero (Mesa's llvmpipe stores RGBA16F so; tests/gpu/slicing/gl_probe).
+inline double to_half_toward_zero(double x) {
+    if (x == 0.0 || !std::isfinite(x)) return x;
+    int e = 0;
+    std::frexp(x, &e);
+    const int shift = std::min(11 - e, 24);
+    const double r = std::ldexp(std::trunc(std::ldexp(x, shift)), -shift);
+    return std::fabs(r) > 65504.0 ? std::copysign(65504.0, r) : r;
+}
+
 inline double to_float(double x) { return double(static_cast<float>(x)); }
+
+// llvmpipe's 8-bit product of codes a, b: (t + (t >> 8) + 128) >> 8 with t = a b (round(t / 255) but for
+// 24 pairs of codes >= 152, one less: 152 x 229 gives 136; tests/gpu/slicing/gl_probe checks it).
+inline double llvmpipe_product(double a, double b) {
+    const long t = long(a) * long(b);
+    return double((t + (t >> 8) + 128) >> 8);
+}
 
 }  // namespace framebuffer
 
@@ -106,7 +123,7 @@ private:
     double store(double x) const {
         switch (format_) {
             case Format::Rgba32f: return framebuffer::to_float(x);
-            case Format::Rgba16f: return framebuffer::to_half(x);
+            case Format::Rgba16f: return rounding_ == Rounding::Truncate ? framebuffer::to_half_toward_zero(x) : framebuffer::to_half(x);
             default: return x;
         }
     }
@@ -161,6 +178,7 @@ private:
         }
         if (unrounded) return (qs * fs + dst * fd) / 255.0;
         if (p == Products::Exact) return round8((qs * fs + dst * fd) / 255.0, r);
+        if (p == Products::Llvmpipe) return std::min(255.0, framebuffer::llvmpipe_product(qs, fs) + framebuffer::llvmpipe_product(dst, fd));
         return std::min(255.0, round8(qs * fs / 255.0, r) + round8(dst * fd / 255.0, r));
     }
 
@@ -175,15 +193,17 @@ private:
             std::array<double, 4> lo = lo_, hi = hi_;
             for (int ch = 0; ch < 4; ++ch) {
                 // Of the stored values' variants the lowest is truncated products (floor p1 + floor p2 <=
-                // floor(p1 + p2) <= round(p1 + p2)) and the highest one rounding to nearest, with exact or
-                // rounded products; the fragment's conversion (nearest or truncated) is tried both ways.
+                // floor(p1 + p2) <= round(p1 + p2)) or llvmpipe's (round - 1 on 24 pairs), the highest one
+                // rounding to nearest, with exact, rounded or llvmpipe's products; the fragment's conversion
+                // (nearest or truncated) is tried both ways.
                 double l = next[std::size_t(ch)], h = l;
                 for (Rounding conv : {Rounding::Nearest, Rounding::Truncate}) {
                     const double qa_v = code(a, conv);
                     const double dlo = lo_[std::size_t(ch)], dhi = hi_[std::size_t(ch)];
                     const double alo = under_ ? hi_[3] : lo_[3], ahi = under_ ? lo_[3] : hi_[3];
-                    l = std::min(l, blend8_variant(ch, src, qa_v, dlo, alo, conv, Rounding::Truncate, Products::Rounded));
-                    for (Products p : {Products::Exact, Products::Rounded})
+                    for (Products p : {Products::Rounded, Products::Llvmpipe})
+                        l = std::min(l, blend8_variant(ch, src, qa_v, dlo, alo, conv, Rounding::Truncate, p));
+                    for (Products p : {Products::Exact, Products::Rounded, Products::Llvmpipe})
                         h = std::max(h, blend8_variant(ch, src, qa_v, dhi, ahi, conv, Rounding::Nearest, p));
                 }
                 lo[std::size_t(ch)] = l;

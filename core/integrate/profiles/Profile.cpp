@@ -256,6 +256,7 @@ Profile resolve_profile(const RenderSpec& render) {
     if (r.blend_products) p.blend_products = *r.blend_products;
     if (r.blend) p.blend = *r.blend;
     if (r.blend_alpha) p.blend_alpha = *r.blend_alpha;
+    if (r.texture_filter) p.texture_filter = *r.texture_filter;
     return p;
 }
 
@@ -303,6 +304,7 @@ nlohmann::json profile_rules_json(const Profile& p) {
         r.blend_products = p.blend_products;
         r.blend = p.blend;
         r.blend_alpha = p.blend_alpha;
+        r.texture_filter = p.texture_filter;
     }
     j.update(profile_rules_object(r));
     j["jitter"] = "off";

@@ -166,6 +166,8 @@ struct Profile {
     Blend blend = Blend::SrcAlpha;
     using BlendAlpha = ProfileRules::BlendAlpha;
     BlendAlpha blend_alpha = BlendAlpha::SrcAlpha;
+    using TextureFilter = ProfileRules::TextureFilter;
+    TextureFilter texture_filter = TextureFilter::Exact;
 };
 
 // The preset a scene names (render.profile, or its "base").

@@ -153,7 +153,7 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
     if (r.first && p_.placement != Profile::Placement::FromEntry) fail("first", "the first sample's offset applies to placement \"from-entry\"");
     if (p_.placement != Profile::Placement::Slices) {  // the slicers' rules (issue 54)
         for (const char* k : {"slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
-                              "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha"})
+                              "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha", "texture_filter"})
             if (std::find(r.keys.begin(), r.keys.end(), k) != r.keys.end())
                 fail(k, "applies to placement \"slices\" (a slicer's rule)");
         if (render.profile_options.framebuffer_band)

@@ -24,6 +24,25 @@ namespace {
 
 double quantise(double x, double levels) { return std::floor(levels * std::clamp(x, 0.0, 1.0) + 0.5) / levels; }
 
+// llvmpipe's 8-bit filter (texture_filter "fixed8"; tests/gpu/slicing/gl_probe measures it): on an axis of
+// n texels the float32 coordinate x = (c + 1/2) / n becomes i = rint(x 256 n) - 128 (ties to even), texels
+// i >> 8 and i >> 8 + 1 (clamped to the edge) and the weight w = i & 255 in 1/256.
+struct Fixed8Axis {
+    std::int64_t t0 = 0, t1 = 0;
+    long w = 0;
+};
+Fixed8Axis fixed8_axis(double c, std::int64_t n) {
+    const float x = float((c + 0.5) / double(n));
+    const long i = long(std::nearbyint(double(x * float(256 * n)))) - 128;
+    Fixed8Axis a;
+    a.t0 = std::clamp<std::int64_t>(i >> 8, 0, n - 1);
+    a.t1 = std::clamp<std::int64_t>((i >> 8) + 1, 0, n - 1);
+    a.w = i & 255;
+    return a;
+}
+// One lerp of codes: v0 + ((w (v1 - v0) + 128) >> 8), the shift arithmetic (floor).
+long fixed8_lerp(long v0, long v1, long w) { return v0 + ((w * (v1 - v0) + 128) >> 8); }
+
 // The transfer function's rows as data values: the first and last of the colour and opacity rows.
 bool transfer_rows(const TransferFunction& tf, double& lo, double& hi) {
     lo = std::numeric_limits<double>::infinity();
@@ -55,6 +74,12 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact)
         throw Error("render.profile.texture_unit: placement \"slices\" filters its texels exactly");
     if (!ctx_.pipeline.cartesian_sampler() || !frame.camera) fail("placement", "\"slices\" needs a Cartesian grid (box or mesh bounds)");
+    if (p_.texture_filter == Profile::TextureFilter::Fixed8) {
+        if (p_.texel_format != Profile::TexelFormat::Unorm8) fail("texture_filter", "\"fixed8\" filters 8-bit texels (texture_format \"unorm8\")");
+        if (p_.classify != Profile::SliceClassify::Post) fail("texture_filter", "\"fixed8\" filters the value texture (classify \"post\")");
+        if (p_.table_entries > 1 && p_.table_lookup != Profile::TableLookup::Nearest && p_.table_format != Profile::TableFormat::Unorm8)
+            fail("texture_filter", "\"fixed8\" filters a linearly read table of 8-bit entries (table_format \"unorm8\")");
+    }
     if (p_.correction != Profile::Correction::None && p_.correction != Profile::Correction::Exact)
         fail("correction", "a slice's alpha is the table's opacity (\"none\") or corrected for its spacing (\"exact\")");
     // The window [lo, hi] of the texels.
@@ -113,6 +138,14 @@ glm::dvec4 ProfileIntegrator::slice_lookup(double s) const {
     }
     const double pos = p_.table_lookup == Profile::TableLookup::Linear ? s * double(n - 1)
                                                                        : std::clamp(s * double(n) - 0.5, 0.0, double(n - 1));
+    if (p_.texture_filter == Profile::TextureFilter::Fixed8) {  // the 1D table's texel position pos, 8-bit weights
+        const Fixed8Axis a = fixed8_axis(pos, n);
+        glm::dvec4 e;
+        for (int c = 0; c < 4; ++c)
+            e[c] = double(fixed8_lerp(std::lround(255.0 * slice_table_[std::size_t(a.t0)][c]),
+                                      std::lround(255.0 * slice_table_[std::size_t(a.t1)][c]), a.w)) / 255.0;
+        return e;
+    }
     const int i = std::clamp(int(std::floor(pos)), 0, n - 2);
     const double w = std::clamp(pos - double(i), 0.0, 1.0);
     return slice_table_[std::size_t(i)] + w * (slice_table_[std::size_t(i) + 1] - slice_table_[std::size_t(i)]);
@@ -152,7 +185,25 @@ ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& 
     };
     Fragment f;
     glm::dvec4 ca;
-    if (p_.classify == Profile::SliceClassify::PreUnweighted) {  // each texel looked up, then (c, a) filtered
+    if (p_.texture_filter == Profile::TextureFilter::Fixed8) {  // llvmpipe's 8-bit filter on the texels' codes
+        std::array<Fixed8Axis, 3> ax;
+        for (int a = 0; a < 3; ++a) {
+            const std::int64_t n = v.dims[std::size_t(a)];
+            if (layers && a == lattice_->axis) {
+                ax[std::size_t(a)] = Fixed8Axis{i0[std::size_t(a)], i0[std::size_t(a)], 0};
+                continue;
+            }
+            ax[std::size_t(a)] = fixed8_axis(std::clamp(u[a], 0.0, double(n - 1)), n);
+        }
+        auto q = [&](int c) {
+            return std::lround(255.0 * slice_texel((c & 1) ? ax[0].t1 : ax[0].t0, (c & 2) ? ax[1].t1 : ax[1].t0, (c & 4) ? ax[2].t1 : ax[2].t0));
+        };
+        const long x00 = fixed8_lerp(q(0), q(1), ax[0].w), x10 = fixed8_lerp(q(2), q(3), ax[0].w);
+        const long x01 = fixed8_lerp(q(4), q(5), ax[0].w), x11 = fixed8_lerp(q(6), q(7), ax[0].w);
+        const long y0 = fixed8_lerp(x00, x10, ax[1].w), y1 = fixed8_lerp(x01, x11, ax[1].w);
+        f.s = double(fixed8_lerp(y0, y1, ax[2].w)) / 255.0;
+        ca = slice_lookup(f.s);
+    } else if (p_.classify == Profile::SliceClassify::PreUnweighted) {  // each texel looked up, then (c, a) filtered
         std::array<glm::dvec4, 8> e;
         std::array<double, 8> s;
         for (int c = 0; c < 8; ++c) {

@@ -16,6 +16,7 @@
 #include "core/Error.h"
 #include "core/MemoryLimit.h"
 #include "core/io/ByteDecoding.h"
+#include "core/io/VtkLegacyReader.h"
 
 namespace volref {
 
@@ -183,29 +184,6 @@ private:
     bool binary_;
 };
 
-// Lines 1..3: returns the byte just after line 3 and whether the data are BINARY.
-std::pair<std::size_t, bool> read_preamble(std::string_view file, const std::string& where) {
-    std::size_t pos = 0;
-    std::string_view lines[3];
-    for (int n = 0; n < 3; ++n) {
-        const std::size_t eol = file.find('\n', pos);
-        if (eol == std::string_view::npos)
-            throw Error(where + ": truncated header: line " + std::to_string(n + 1) + " has no end");
-        std::string_view line = file.substr(pos, eol - pos);
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        lines[n] = line;
-        pos = eol + 1;
-    }
-    if (upper(lines[0]).rfind("# VTK DATAFILE VERSION", 0) != 0)
-        throw Error(where + ": not a VTK legacy file: line 1 is " + io::quoted(lines[0]) +
-                    ", expected '# vtk DataFile Version x.y'");
-    std::string_view mode = lines[2];
-    while (!mode.empty() && is_space(mode.back())) mode.remove_suffix(1);
-    while (!mode.empty() && is_space(mode.front())) mode.remove_prefix(1);
-    const std::string m = upper(mode);
-    if (m != "ASCII" && m != "BINARY") throw Error(where + ": line 3: expected ASCII or BINARY, got " + io::quoted(lines[2]));
-    return {pos, m == "BINARY"};
-}
 
 // A BINARY number type of the file: its size and whether it is an integer, float or double.
 struct BinaryType {
@@ -441,7 +419,7 @@ double tetrahedron_det(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec
 
 TetrahedralMesh read_tetrahedra(const std::string& path) {
     const std::string file = io::read_file_bytes(path);  // a regular file within the memory limit
-    const auto [start, binary] = read_preamble(file, path);
+    const auto [start, binary] = read_vtk_legacy_preamble(file, path);
     Cursor c(file, start, 4, path, binary);
 
     const std::string_view dataset = c.word("DATASET");

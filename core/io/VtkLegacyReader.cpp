@@ -83,8 +83,29 @@ private:
     std::string where_;
 };
 
-// The lines 1..3 of the header: returns the byte just after line 3 and whether the data are BINARY.
-std::pair<std::size_t, bool> read_preamble(std::string_view file, const std::string& where) {
+
+ScalarType scalar_type(Words& words) {
+    const std::string_view w = words.next("the SCALARS data type");
+    const std::string t = upper(w);
+    if (t == "UNSIGNED_CHAR") return ScalarType::U8;
+    if (t == "CHAR") return ScalarType::I8;
+    if (t == "UNSIGNED_SHORT") return ScalarType::U16;
+    if (t == "SHORT") return ScalarType::I16;
+    if (t == "UNSIGNED_INT") return ScalarType::U32;
+    if (t == "INT") return ScalarType::I32;
+    if (t == "FLOAT") return ScalarType::F32;
+    if (t == "DOUBLE") return ScalarType::F64;
+    if (t == "BIT" || t == "LONG" || t == "UNSIGNED_LONG" || t == "VTKTYPEINT64" || t == "VTKTYPEUINT64" ||
+        t == "VTKIDTYPE")
+        words.fail("SCALARS: type " + io::quoted(w) +
+                   " is not supported (volref reads unsigned_char, char, unsigned_short, short, unsigned_int, "
+                   "int, float, double)");
+    words.fail("SCALARS: unknown type " + io::quoted(w));
+}
+
+}  // namespace
+
+std::pair<std::size_t, bool> read_vtk_legacy_preamble(std::string_view file, const std::string& where) {
     std::size_t pos = 0;
     std::string_view lines[3];
     for (int n = 0; n < 3; ++n) {
@@ -108,31 +129,10 @@ std::pair<std::size_t, bool> read_preamble(std::string_view file, const std::str
     return {pos, m == "BINARY"};
 }
 
-ScalarType scalar_type(Words& words) {
-    const std::string_view w = words.next("the SCALARS data type");
-    const std::string t = upper(w);
-    if (t == "UNSIGNED_CHAR") return ScalarType::U8;
-    if (t == "CHAR") return ScalarType::I8;
-    if (t == "UNSIGNED_SHORT") return ScalarType::U16;
-    if (t == "SHORT") return ScalarType::I16;
-    if (t == "UNSIGNED_INT") return ScalarType::U32;
-    if (t == "INT") return ScalarType::I32;
-    if (t == "FLOAT") return ScalarType::F32;
-    if (t == "DOUBLE") return ScalarType::F64;
-    if (t == "BIT" || t == "LONG" || t == "UNSIGNED_LONG" || t == "VTKTYPEINT64" || t == "VTKTYPEUINT64" ||
-        t == "VTKIDTYPE")
-        words.fail("SCALARS: type " + io::quoted(w) +
-                   " is not supported (volref reads unsigned_char, char, unsigned_short, short, unsigned_int, "
-                   "int, float, double)");
-    words.fail("SCALARS: unknown type " + io::quoted(w));
-}
-
-}  // namespace
-
 Volume read_vtk_legacy(const std::filesystem::path& path) {
     const std::string where = path.string();
     const std::string file = io::read_file_bytes(path);
-    const auto [start, binary] = read_preamble(file, where);
+    const auto [start, binary] = read_vtk_legacy_preamble(file, where);
     Words words(file, start, 4, where);
 
     const std::string_view dataset = words.next("DATASET");

@@ -12,12 +12,21 @@
 //   samples: ASCII numbers, or BINARY big-endian right after the LOOKUP_TABLE line's end
 // Keywords are not case-sensitive. docs/formats.md lists every error.
 #pragma once
+#include <cstddef>
 #include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
 
 #include "core/grid/Volume.h"
 
 namespace volref {
 
 Volume read_vtk_legacy(const std::filesystem::path& path);
+
+// Lines 1..3 of any VTK legacy file (the version line, the title, ASCII | BINARY): the byte just after
+// line 3 and whether the data are BINARY; throws volref::Error naming `where` and the line. Also read by
+// geometry/TetrahedralMesh (UNSTRUCTURED_GRID).
+std::pair<std::size_t, bool> read_vtk_legacy_preamble(std::string_view file, const std::string& where);
 
 }  // namespace volref

@@ -331,8 +331,8 @@ TEST(Slices, TwoDimensionalTexturesReadTheLayers) {
     EXPECT_NEAR(pixel(two).a, 1.0 - std::pow(0.9, 9), 1e-14);
 }
 
-// The band covers every rounding variant of the frame buffer: each variant's pixel lies within
-// [pixel - band, pixel + band] on every channel.
+// The band covers every rounding variant of the frame buffer and both 8-bit texture units (exact weights,
+// llvmpipe's fixed8): each variant's pixel lies within [pixel - band, pixel + band] on every channel.
 TEST(Slices, FrameBufferBandCoversTheVariants) {
     FieldSpec ml;
     ml.kind = FieldSpec::Kind::MarschnerLobb;
@@ -349,9 +349,11 @@ TEST(Slices, FrameBufferBandCoversTheVariants) {
     const Image base = render_scene(banded, {1, false});
     ASSERT_EQ(base.channel_count(), 5u);
     double largest = 0.0;
+    for (const char* filter : {"exact", "fixed8"})
     for (const char* rounding : {"nearest", "truncate"})
-        for (const char* products : {"exact", "rounded"}) {
-            const Image v = render_scene(with(s, {{"base", "volumizer"}, {"framebuffer_rounding", rounding}, {"blend_products", products}}), {1, false});
+        for (const char* products : {"exact", "rounded", "llvmpipe"}) {
+            const Image v = render_scene(with(s, {{"base", "volumizer"}, {"framebuffer_rounding", rounding}, {"blend_products", products},
+                                                  {"texture_filter", filter}}), {1, false});
             for (int y = 0; y < 24; ++y)
                 for (int x = 0; x < 24; ++x) {
                     const double band = base.at(x, y, 4);

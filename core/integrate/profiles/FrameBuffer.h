@@ -75,11 +75,14 @@ public:
     SliceFrameBuffer(Format f, Rounding r, Products p, Blend b, BlendAlpha ba, bool under, bool band)
         : format_(f), rounding_(r), products_(p), blend_(b), blend_alpha_(ba), under_(under), band_(band) {}
 
-    // One fragment: colour c (not premultiplied), alpha a.
-    void blend(const glm::dvec3& c, double a) {
+    // One fragment: colour c (not premultiplied), alpha a. `other`: the same fragment as another texture
+    // unit computes it (the band: 8-bit texels filtered exactly and by llvmpipe's fixed8 filter); the
+    // band's ends are taken over both.
+    void blend(const glm::dvec3& c, double a, const glm::dvec4* other = nullptr) {
         const double src[4] = {c.r, c.g, c.b, a};
+        const double alt[4] = {other ? other->r : c.r, other ? other->g : c.g, other ? other->b : c.b, other ? other->a : a};
         if (format_ == Format::Rgba8) {
-            blend8(src, a);
+            blend8(src, a, alt);
             return;
         }
         std::array<double, 4> next;
@@ -88,12 +91,18 @@ public:
             exact_[std::size_t(ch)] = blend_float(ch, src, a, v_[std::size_t(ch)], v_[3], true);
         }
         if (band_) {
+            std::array<double, 4> lo = lo_, hi = hi_;
             for (int ch = 0; ch < 4; ++ch) {
-                const double l = blend_float(ch, src, a, lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3]);
-                const double h = blend_float(ch, src, a, hi_[std::size_t(ch)], under_ ? lo_[3] : hi_[3]);
-                lo_[std::size_t(ch)] = std::min(l, next[std::size_t(ch)]) - ulp(l);
-                hi_[std::size_t(ch)] = std::max(h, next[std::size_t(ch)]) + ulp(h);
+                double l = next[std::size_t(ch)], h = l;
+                for (const double* f : {src, alt}) {
+                    l = std::min(l, blend_float(ch, f, f[3], lo_[std::size_t(ch)], under_ ? hi_[3] : lo_[3]));
+                    h = std::max(h, blend_float(ch, f, f[3], hi_[std::size_t(ch)], under_ ? lo_[3] : hi_[3]));
+                }
+                lo[std::size_t(ch)] = l - ulp(l);
+                hi[std::size_t(ch)] = h + ulp(h);
             }
+            lo_ = lo;
+            hi_ = hi;
         }
         v_ = next;
     }
@@ -182,7 +191,7 @@ private:
         return std::min(255.0, round8(qs * fs / 255.0, r) + round8(dst * fd / 255.0, r));
     }
 
-    void blend8(const double* src, double a) {
+    void blend8(const double* src, double a, const double* alt) {
         std::array<double, 4> next;
         const double qa = code(a, rounding_);
         for (int ch = 0; ch < 4; ++ch) {
@@ -197,14 +206,15 @@ private:
                 // rounding to nearest, with exact, rounded or llvmpipe's products; the fragment's conversion
                 // (nearest or truncated) is tried both ways.
                 double l = next[std::size_t(ch)], h = l;
+                for (const double* f : {src, alt})
                 for (Rounding conv : {Rounding::Nearest, Rounding::Truncate}) {
-                    const double qa_v = code(a, conv);
+                    const double qa_v = code(f[3], conv);
                     const double dlo = lo_[std::size_t(ch)], dhi = hi_[std::size_t(ch)];
                     const double alo = under_ ? hi_[3] : lo_[3], ahi = under_ ? lo_[3] : hi_[3];
                     for (Products p : {Products::Rounded, Products::Llvmpipe})
-                        l = std::min(l, blend8_variant(ch, src, qa_v, dlo, alo, conv, Rounding::Truncate, p));
+                        l = std::min(l, blend8_variant(ch, f, qa_v, dlo, alo, conv, Rounding::Truncate, p));
                     for (Products p : {Products::Exact, Products::Rounded, Products::Llvmpipe})
-                        h = std::max(h, blend8_variant(ch, src, qa_v, dhi, ahi, conv, Rounding::Nearest, p));
+                        h = std::max(h, blend8_variant(ch, f, qa_v, dhi, ahi, conv, Rounding::Nearest, p));
                 }
                 lo[std::size_t(ch)] = l;
                 hi[std::size_t(ch)] = h;

@@ -148,14 +148,16 @@ private:
     };
     void prepare_slices(const Volume& volume, const SliceFrame& frame);
     double slice_texel(std::int64_t i, std::int64_t j, std::int64_t k) const;  // s_i in the texture's format
-    glm::dvec4 slice_lookup(double s) const;  // (c, a) at the texture's value s
-    Fragment slice_fragment(const glm::dvec3& x, std::size_t level, double d) const;
+    glm::dvec4 slice_lookup(double s, bool fixed8) const;  // (c, a) at the texture's value s (fixed8: llvmpipe's 1D filter)
+    // `fixed8`: filter the texels by llvmpipe's 8-bit filter (the rule's, or the band's other unit).
+    Fragment slice_fragment(const glm::dvec3& x, std::size_t level, double d, bool fixed8) const;
     template <class Rec>
     PixelValue slices(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
     std::unique_ptr<SliceLattice> lattice_;
     double window_lo_ = 0.0, window_width_ = 1.0;  // the texture window [lo, lo + width]
     std::vector<glm::dvec4> slice_table_;          // the table's entries (c, a) over the window, stored
     bool framebuffer_band_ = false;
+    bool band_units_ = false;  // the band also takes each fragment from the other 8-bit texture unit
 };
 
 }  // namespace volref

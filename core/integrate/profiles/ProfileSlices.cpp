@@ -112,6 +112,9 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
     lattice_ = std::make_unique<SliceLattice>(make_slice_lattice(p_, *frame.camera, *frame.spec, frame.box_lo, frame.box_hi,
                                                                  volume.origin, volume.spacing, volume.dims, ctx_.step, step_scale));
     framebuffer_band_ = ctx_.render.profile_options.framebuffer_band;
+    // 8-bit texels: the band covers both units that filter them (exact weights, llvmpipe's fixed8).
+    band_units_ = framebuffer_band_ && p_.texel_format == Profile::TexelFormat::Unorm8 && p_.classify == Profile::SliceClassify::Post &&
+                  (slice_table_.empty() || p_.table_lookup == Profile::TableLookup::Nearest || p_.table_format == Profile::TableFormat::Unorm8);
 }
 
 // A texel as the texture holds it: s = clamp((v - lo) / (hi - lo), 0, 1) in the texture's format.
@@ -126,7 +129,7 @@ double ProfileIntegrator::slice_texel(std::int64_t i, std::int64_t j, std::int64
 }
 
 // (c, a) at the texture's value s: the table by its lookup, or the transfer function at lo + s (hi - lo).
-glm::dvec4 ProfileIntegrator::slice_lookup(double s) const {
+glm::dvec4 ProfileIntegrator::slice_lookup(double s, bool fixed8) const {
     if (slice_table_.empty()) {
         const Classified k = ctx_.pipeline.classifier().classify(window_lo_ + s * window_width_, 0.0);
         return glm::dvec4(k.color, std::clamp(k.opacity, 0.0, 1.0));
@@ -138,7 +141,7 @@ glm::dvec4 ProfileIntegrator::slice_lookup(double s) const {
     }
     const double pos = p_.table_lookup == Profile::TableLookup::Linear ? s * double(n - 1)
                                                                        : std::clamp(s * double(n) - 0.5, 0.0, double(n - 1));
-    if (p_.texture_filter == Profile::TextureFilter::Fixed8) {  // the 1D table's texel position pos, 8-bit weights
+    if (fixed8 && p_.table_format == Profile::TableFormat::Unorm8) {  // the 1D table's texel position pos, 8-bit weights
         const Fixed8Axis a = fixed8_axis(pos, n);
         glm::dvec4 e;
         for (int c = 0; c < 4; ++c)
@@ -154,7 +157,7 @@ glm::dvec4 ProfileIntegrator::slice_lookup(double s) const {
 // One fragment at x (on level `level`), standing for the length d along its ray. The texture's filter:
 // the continuous index u = (x - origin) / spacing clamped to [0, n - 1] (section 2), cell i0 =
 // min(floor(u), n - 2), w = u - i0; 2D textures: u on the slicing axis is the level's own layer, w = 0.
-ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& x, std::size_t level, double d) const {
+ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& x, std::size_t level, double d, bool fixed8) const {
     const Volume& v = *texels_;
     glm::dvec3 u = (x - v.origin) / v.spacing;
     std::array<std::int64_t, 3> i0{}, i1{};
@@ -185,7 +188,7 @@ ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& 
     };
     Fragment f;
     glm::dvec4 ca;
-    if (p_.texture_filter == Profile::TextureFilter::Fixed8) {  // llvmpipe's 8-bit filter on the texels' codes
+    if (fixed8) {  // llvmpipe's 8-bit filter on the texels' codes
         std::array<Fixed8Axis, 3> ax;
         for (int a = 0; a < 3; ++a) {
             const std::int64_t n = v.dims[std::size_t(a)];
@@ -202,14 +205,14 @@ ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& 
         const long x01 = fixed8_lerp(q(4), q(5), ax[0].w), x11 = fixed8_lerp(q(6), q(7), ax[0].w);
         const long y0 = fixed8_lerp(x00, x10, ax[1].w), y1 = fixed8_lerp(x01, x11, ax[1].w);
         f.s = double(fixed8_lerp(y0, y1, ax[2].w)) / 255.0;
-        ca = slice_lookup(f.s);
+        ca = slice_lookup(f.s, fixed8);
     } else if (p_.classify == Profile::SliceClassify::PreUnweighted) {  // each texel looked up, then (c, a) filtered
         std::array<glm::dvec4, 8> e;
         std::array<double, 8> s;
         for (int c = 0; c < 8; ++c) {
             const auto k = corner(c);
             s[std::size_t(c)] = slice_texel(k[0], k[1], k[2]);
-            e[std::size_t(c)] = slice_lookup(s[std::size_t(c)]);
+            e[std::size_t(c)] = slice_lookup(s[std::size_t(c)], false);
         }
         ca = lerp3([&](int c) { return e[std::size_t(c)]; });
         f.s = lerp3([&](int c) { return s[std::size_t(c)]; });
@@ -220,7 +223,7 @@ ProfileIntegrator::Fragment ProfileIntegrator::slice_fragment(const glm::dvec3& 
             s[std::size_t(c)] = slice_texel(k[0], k[1], k[2]);
         }
         f.s = lerp3([&](int c) { return s[std::size_t(c)]; });
-        ca = slice_lookup(f.s);
+        ca = slice_lookup(f.s, fixed8);
     }
     f.color = glm::dvec3(ca);
     f.opacity = std::clamp(ca.a, 0.0, 1.0);
@@ -237,8 +240,15 @@ PixelValue ProfileIntegrator::slices(const Ray& ray, const std::vector<Interval>
                         framebuffer_band_);
     lattice_->for_each_crossing(ray, intervals, [&](double t, double d, std::size_t k) {
         const glm::dvec3 x = ray.at(t);
-        const Fragment f = slice_fragment(x, k, d);
-        fb.blend(f.color, f.alpha);
+        const bool fixed8 = p_.texture_filter == Profile::TextureFilter::Fixed8;
+        const Fragment f = slice_fragment(x, k, d, fixed8);
+        if (band_units_) {  // the band: the fragment as the other 8-bit unit filters it too
+            const Fragment g = slice_fragment(x, k, d, !fixed8);
+            const glm::dvec4 other(g.color, g.alpha);
+            fb.blend(f.color, f.alpha, &other);
+        } else {
+            fb.blend(f.color, f.alpha);
+        }
         if constexpr (Rec::kOn) {
             SampleRecord r{};
             rec.begin(r, t - 0.5 * d, t + 0.5 * d);

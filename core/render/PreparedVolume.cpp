@@ -305,6 +305,10 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     // The bounding geometry (in the volume's own space), and the box the default camera frames.
     glm::dvec3 lo, hi;
     const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules (issue 29)
+    if (vs.bounds.type == BoundsSpec::Type::Tetrahedra && vs.bounds.overlap == BoundsSpec::Overlap::Count &&
+        (scene.render.reference_integrators() || scene.render.profile == ProfileId::Fast || resolved.placement != Profile::Placement::Slices))
+        throw Error(key + ".bounds.overlap: \"count\" (each tetrahedron drawn on its own) is a slicer's: it applies to "
+                          "render.profile placement \"slices\" (ray casters take the union)");
     // A rule set to another value than its preset's that this scene never reads is said, not dropped.
     if (const ProfileRules& rules = scene.render.profile_rules; !rules.empty()) {
         const nlohmann::json base = profile_rules_json(profile(scene.render.profile)), mine = profile_rules_json(resolved);
@@ -369,10 +373,15 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         // PreparedScene's, which frames this volume's box) and the geometry's box.
         std::optional<Camera> camera;
         SliceFrame frame;
+        std::optional<TriangleMesh> overlap;
         if (p.placement == Profile::Placement::Slices) {
             if (transform) throw Error("volume.transform: placement \"slices\" places its surfaces in the volume's own space (remove the transform)");
             camera.emplace(scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
             frame = SliceFrame{&*camera, &scene.camera, lo, hi};
+            if (vs.bounds.type == BoundsSpec::Type::Tetrahedra && vs.bounds.overlap == BoundsSpec::Overlap::Count) {
+                overlap.emplace(read_tetrahedral_bounds(vs.bounds.mesh.string()));
+                frame.overlap = &*overlap;
+            }
         }
         integrator = std::make_unique<ProfileIntegrator>(*context, p, volume, &vs.bounds, camera ? &frame : nullptr);  // the preset or custom rules
     }

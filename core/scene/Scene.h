@@ -107,9 +107,9 @@ enum class Interpolation { Nearest, Trilinear, TricubicBSpline, TricubicCatmullR
 struct BoundsSpec {
     enum class Type { Box, Mesh, Cylindrical, Spherical, Tetrahedra };
     // Tetrahedra: how overlapping tetrahedra count. Union: a point is inside once, however many cover
-    // it. "count" (OpenGL Volumizer drawing each tetrahedron, so overlaps count twice) is recognised by
-    // the loader and refused as not implemented yet (docs/scene-format.md).
-    enum class Overlap { Union };
+    // it. Count (OpenGL Volumizer slicing each tetrahedron on its own, so a point m tetrahedra cover is
+    // drawn m times): placement "slices" only, each fragment blended m times (conventions section 9).
+    enum class Overlap { Union, Count };
     Type type = Type::Box;
     std::optional<glm::dvec3> min, max;  // box: absent = the volume's domain
     std::filesystem::path mesh;          // mesh: a closed triangle mesh (.obj, .ply); tetrahedra: a VTK

@@ -385,7 +385,7 @@ BoundsSpec read_bounds(const Json& v, const std::string& path, const Context& ct
         case T::Tetrahedra:
             r.allow({"type", "file", "overlap"}, "for bounds type \"tetrahedra\"");
             b.mesh = resolve_file(r.required("file"), r.path("file"), ctx, base_dir);
-            b.overlap = r.choice<BoundsSpec::Overlap>("overlap", BoundsSpec::Overlap::Union, names::kOverlaps, {"count"});
+            b.overlap = r.choice<BoundsSpec::Overlap>("overlap", BoundsSpec::Overlap::Union, names::kOverlaps);
             return b;
         case T::Cylindrical:
         case T::Spherical:

@@ -32,7 +32,7 @@ inline constexpr Choice<BoundsSpec::Type> kBounds[] = {{"box", BoundsSpec::Type:
                                                        {"spherical", BoundsSpec::Type::Spherical},
                                                        {"tetrahedra", BoundsSpec::Type::Tetrahedra}};
 // volume.bounds.overlap (tetrahedra); "count" is planned (SceneLoader: not implemented yet).
-inline constexpr Choice<BoundsSpec::Overlap> kOverlaps[] = {{"union", BoundsSpec::Overlap::Union}};
+inline constexpr Choice<BoundsSpec::Overlap> kOverlaps[] = {{"union", BoundsSpec::Overlap::Union}, {"count", BoundsSpec::Overlap::Count}};
 // A spherical shell's "axes": the data's axis order (SphericalShell::axes holds these indices).
 inline constexpr Choice<int> kSphericalAxes[] = {{"longitude", 0}, {"latitude", 1}, {"radius", 2}};
 inline constexpr Choice<TransferSpec::Domain> kTransferDomains[] = {{"data", TransferSpec::Domain::Data},

@@ -35,6 +35,7 @@ class ShellGrid;
 class Seed001Kernel;
 class Camera;
 struct BoundsSpec;
+struct TriangleMesh;
 struct SliceLattice;
 
 // What placement "slices" places its surfaces from (Slices.h): the frame's camera and the geometry's
@@ -43,6 +44,9 @@ struct SliceFrame {
     const Camera* camera = nullptr;
     const CameraSpec* spec = nullptr;
     glm::dvec3 box_lo{0.0}, box_hi{0.0};
+    // Tetrahedra with overlap "count": the union's boundary, whose winding number at a fragment is the
+    // number of tetrahedra covering it (geometry/TetrahedralMesh.h); null otherwise.
+    const TriangleMesh* overlap = nullptr;
 };
 
 // What every mirror profile needs of the scene (fixed step, front-to-back order, its own termination,
@@ -157,7 +161,8 @@ private:
     double window_lo_ = 0.0, window_width_ = 1.0;  // the texture window [lo, lo + width]
     std::vector<glm::dvec4> slice_table_;          // the table's entries (c, a) over the window, stored
     bool framebuffer_band_ = false;
-    bool band_units_ = false;  // the band also takes each fragment from the other 8-bit texture unit
+    bool band_units_ = false;
+    std::shared_ptr<const TriangleMesh> overlap_;  // tetrahedra drawn each on its own (SliceFrame::overlap)  // the band also takes each fragment from the other 8-bit texture unit
 };
 
 }  // namespace volref

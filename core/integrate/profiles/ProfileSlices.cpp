@@ -15,6 +15,8 @@
 #include "core/integrate/profiles/FrameBuffer.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
 #include "core/integrate/profiles/Slices.h"
+#include "geometry/MeshIntervals.h"
+#include "geometry/TriangleMesh.h"
 #include "transfer/OpacityCorrection.h"
 #include "transfer/TransferFunction.h"
 
@@ -112,6 +114,7 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
     lattice_ = std::make_unique<SliceLattice>(make_slice_lattice(p_, *frame.camera, *frame.spec, frame.box_lo, frame.box_hi,
                                                                  volume.origin, volume.spacing, volume.dims, ctx_.step, step_scale));
     framebuffer_band_ = ctx_.render.profile_options.framebuffer_band;
+    if (frame.overlap) overlap_ = std::make_shared<const TriangleMesh>(*frame.overlap);
     // 8-bit texels: the band covers both units that filter them (exact weights, llvmpipe's fixed8).
     band_units_ = framebuffer_band_ && p_.texel_format == Profile::TexelFormat::Unorm8 && p_.classify == Profile::SliceClassify::Post &&
                   (slice_table_.empty() || p_.table_lookup == Profile::TableLookup::Nearest || p_.table_format == Profile::TableFormat::Unorm8);
@@ -238,7 +241,26 @@ PixelValue ProfileIntegrator::slices(const Ray& ray, const std::vector<Interval>
     const bool under = p_.slices.order == ProfileRules::Slices::Order::FrontToBack;
     SliceFrameBuffer fb(p_.framebuffer, p_.framebuffer_rounding, p_.blend_products, p_.blend, p_.blend_alpha, under,
                         framebuffer_band_);
+    // overlap "count": the boundary's crossings along the whole line; the winding number at t, the number
+    // of tetrahedra covering the fragment, is minus the windings of the crossings past t (0 beyond the last).
+    std::vector<std::pair<double, int>> windings;
+    if (overlap_) {
+        const RayTriangleFrame frame(ray);
+        for (const auto& tri : overlap_->triangles) {
+            double t = 0.0;
+            int w = 0;
+            if (frame.cross(overlap_->vertices[tri[0]], overlap_->vertices[tri[1]], overlap_->vertices[tri[2]], t, w)) windings.emplace_back(t, w);
+        }
+    }
+    auto covering = [&](double t) {
+        int m = 0;
+        for (const auto& [tc, w] : windings)
+            if (tc > t) m -= w;
+        return std::max(m, 1);  // a fragment inside the intervals is covered at least once
+    };
     lattice_->for_each_crossing(ray, intervals, [&](double t, double d, std::size_t k) {
+        const int times = overlap_ ? covering(t) : 1;
+        for (int copy = 0; copy < times; ++copy) {
         const glm::dvec3 x = ray.at(t);
         const bool fixed8 = p_.texture_filter == Profile::TextureFilter::Fixed8;
         const Fragment f = slice_fragment(x, k, d, fixed8);
@@ -266,6 +288,7 @@ PixelValue ProfileIntegrator::slices(const Ray& ray, const std::vector<Interval>
             r.accumulated = fb.pixel();
             r.blend_exact = fb.last_exact();
             rec.recorder.record(r);
+        }
         }
         return true;
     });

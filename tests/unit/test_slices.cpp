@@ -586,3 +586,17 @@ TEST(Slices, Fixed8FilterByHand) {
     bad["texture_format"] = "float";
     EXPECT_NE(error_of(with(s, bad)).find("render.profile.texture_filter"), std::string::npos);
 }
+
+// fixed8's table read takes llvmpipe's coordinate fl(k fl(1/255)) (gl_probe's texel8 check on the real
+// program): for k = 127 on 256 entries read "texture", 65536 fl(127 fl(1/255)) is the tie 32639.5, which
+// rounds to even: entry 127 with weight 0 (the correctly rounded 127 / 255 gives entry 126, weight 255).
+// Entries 126 and 127 are opacity 0 and 1: llvmpipe's pixel is 1, the other reading 254 / 255.
+TEST(Slices, Fixed8TableCoordinateIsLlvmpipes) {
+    Scene s = slab(0.0, 4);
+    s.volume().source.field = constant_field(127.0 / 255.0, {5, 5, 5});
+    s.volume().transfer.opacity = {{0, 0}, {126.0 / 255.0, 0}, {127.0 / 255.0, 1}, {1, 1}};
+    s.render.step = 100.0;  // one plane
+    const glm::dvec4 p = pixel(with(s, {{"base", "volumizer"}, {"texture_filter", "fixed8"}, {"table_lookup", "texture"},
+                                        {"texture_window", {0, 1}}, {"framebuffer", "double"}, {"blend_alpha", "one"}}));
+    EXPECT_EQ(p.a, 1.0);
+}

@@ -33,14 +33,23 @@ struct Fixed8Axis {
     std::int64_t t0 = 0, t1 = 0;
     long w = 0;
 };
-Fixed8Axis fixed8_axis(double c, std::int64_t n) {
-    const float x = float((c + 0.5) / double(n));
+Fixed8Axis fixed8_axis_at(float x, std::int64_t n) {  // x: the normalised float32 coordinate
     const long i = long(std::nearbyint(double(x * float(256 * n)))) - 128;
     Fixed8Axis a;
     a.t0 = std::clamp<std::int64_t>(i >> 8, 0, n - 1);
     a.t1 = std::clamp<std::int64_t>((i >> 8) + 1, 0, n - 1);
     a.w = i & 255;
     return a;
+}
+Fixed8Axis fixed8_axis(double c, std::int64_t n) { return fixed8_axis_at(float((c + 0.5) / double(n)), n); }
+// The 1D table's coordinate from a filtered code k, as llvmpipe hands it on: s = fl(k fl(1/255)) (not
+// the correctly rounded k / 255 for 126 codes; gl_probe's texel8 check); "texture": x = s; "linear":
+// x = fl(fl(fl(s (N - 1)) + 1/2) / N), the colour table's position s (N - 1) as a normalised coordinate.
+float fixed8_table_coordinate(double s, int n, bool linear) {
+    const float k = float(std::lround(255.0 * s));
+    const float sf = k * (1.0f / 255.0f);
+    if (!linear) return sf;
+    return (sf * float(n - 1) + 0.5f) / float(n);
 }
 // One lerp of codes: v0 + ((w (v1 - v0) + 128) >> 8), the shift arithmetic (floor).
 long fixed8_lerp(long v0, long v1, long w) { return v0 + ((w * (v1 - v0) + 128) >> 8); }
@@ -144,8 +153,8 @@ glm::dvec4 ProfileIntegrator::slice_lookup(double s, bool fixed8) const {
     }
     const double pos = p_.table_lookup == Profile::TableLookup::Linear ? s * double(n - 1)
                                                                        : std::clamp(s * double(n) - 0.5, 0.0, double(n - 1));
-    if (fixed8 && p_.table_format == Profile::TableFormat::Unorm8) {  // the 1D table's texel position pos, 8-bit weights
-        const Fixed8Axis a = fixed8_axis(pos, n);
+    if (fixed8 && p_.table_format == Profile::TableFormat::Unorm8) {  // the 1D table, 8-bit weights
+        const Fixed8Axis a = fixed8_axis_at(fixed8_table_coordinate(s, n, p_.table_lookup == Profile::TableLookup::Linear), n);
         glm::dvec4 e;
         for (int c = 0; c < 4; ++c)
             e[c] = double(fixed8_lerp(std::lround(255.0 * slice_table_[std::size_t(a.t0)][c]),

@@ -19,6 +19,8 @@
 //   filter    GL_LINEAR reads of 3D textures (GL_R8, GL_R16, GL_R32F), a 2D array (GL_R8) and 1D tables
 //             (GL_RGBA8, GL_RGBA32F) at random points: against exact weights of the stored values, and
 //             (8-bit formats) llvmpipe's 8.8 fixed-point filter (taps8 / lerp8 below)
+//   texel8    every code of an 8-bit texture as the shader reads it: against float(k / 255) and llvmpipe's
+//             fl(k fl(1/255)) (--filter fixed8 requires the latter: it addresses the 1D table)
 //   interp    a perspective polygon's interpolated world position at the pixel centres against the
 //             exact crossing of the pixel's ray (are attributes interpolated from snapped vertices? how far
 //             off are they?): an oblique square, and a slice of viewport-volumizer's box
@@ -506,6 +508,45 @@ bool probe_filter(const Gl& gl, bool& exact_holds, bool& fixed8_holds) {
     return true;
 }
 
+// --- texel8: an 8-bit texel as the shader sees it ---------------------------------------------------------
+// Every code k of a GL_R8 texture read by texelFetch and by GL_LINEAR at its centre, into RGBA32F: against
+// the correctly rounded float(k / 255) and llvmpipe's fl(k fl(1/255)) (what a fixed8 value becomes before
+// it addresses the 1D table; derive_tolerance.py's fixed8_fragments).
+bool probe_texel8(const Gl& gl, bool& holds) {
+    std::vector<std::uint8_t> codes(256);
+    for (int k = 0; k < 256; ++k) codes[std::size_t(k)] = std::uint8_t(k);
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_3D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, 256, 1, 1, 0, GL_RED, GL_UNSIGNED_BYTE, codes.data());
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    slicing::make_framebuffer(GL_RGBA32F, 256, 1);
+    const GLuint prog = slicing::link_program(
+        kQuadVs, "#version 330 core\nuniform sampler3D u_t; out vec4 o;\nvoid main() {\n"
+                 "  o = vec4(texelFetch(u_t, ivec3(int(gl_FragCoord.x), 0, 0), 0).r,\n"
+                 "           texture(u_t, vec3(gl_FragCoord.x / 256.0, 0.5, 0.5)).r, 0.0, 1.0);\n}\n");
+    glUseProgram(prog);
+    glUniform1i(glGetUniformLocation(prog, "u_t"), 0);
+    gl.draw();
+    const auto px = read_floats(256, 1);
+    long miss_rounded = 0, miss_llvmpipe = 0;
+    for (int k = 0; k < 256; ++k)
+        for (int c = 0; c < 2; ++c) {
+            const float got = px[std::size_t(k) * 4 + std::size_t(c)];
+            miss_rounded += got != float(k / 255.0);
+            miss_llvmpipe += got != float(k) * (1.0f / 255.0f);
+        }
+    std::printf("texel8: the 256 codes of GL_R8 (texelFetch and GL_LINEAR at the centre) as floats: unlike float(k / 255) "
+                "%ld, unlike fl(k fl(1/255)) %ld\n", miss_rounded, miss_llvmpipe);
+    holds = miss_llvmpipe == 0;
+    glDeleteProgram(prog);
+    glDeleteTextures(1, &t);
+    return true;
+}
+
 // --- interp: a plane's world position at the pixel centres ---------------------------------------------
 // An oblique square drawn under a perspective camera (eye E, forward f, fov 40, 128 x 128) with its world
 // position as the attribute: at each covered pixel the interpolated position against the exact crossing of
@@ -620,6 +661,8 @@ int run(int argc, char** argv) {
     bool half_truncates = false;
     probe_blendf(gl, floats, half_truncates);
     probe_filter(gl, exact, fixed8);
+    bool texel8 = false;
+    probe_texel8(gl, texel8);
     {
         const double E1[3] = {70.3, -41.7, 55.1}, T1[3] = {20.2, 21.9, 19.7}, n1[3] = {0.3, 0.5, 0.81};
         probe_interp("oblique square (half-size 60, fov 40)", E1, T1, n1, 60.0, 40.0);
@@ -628,12 +671,12 @@ int run(int argc, char** argv) {
     }
     std::printf("models: fragments to unorm8 as RNE(fl(x 255/256) 256): %s; rgba8 blends with llvmpipe's products: %s; "
                 "fragments converted before the blend: %s; float32 blends unfused, binary16 stored %s: %s; linear "
-                "filtering exact: %s; 8-bit filtering in 8.8 fixed point: %s\n",
+                "filtering exact: %s; 8-bit filtering in 8.8 fixed point: %s; 8-bit texels read as fl(k fl(1/255)): %s\n",
                 convert ? "hold" : "DO NOT hold", rounded ? "hold" : "DO NOT hold", converted ? "hold" : "DO NOT hold",
                 half_truncates ? "toward zero" : "nearest-even", floats ? "hold" : "DO NOT hold", exact ? "holds" : "does not hold",
-                fixed8 ? "holds" : "does not hold");
+                fixed8 ? "holds" : "does not hold", texel8 ? "hold" : "DO NOT hold");
     if (check) {
-        const bool filter_ok = filter.empty() || (filter == "exact" && exact) || (filter == "fixed8" && fixed8);
+        const bool filter_ok = filter.empty() || (filter == "exact" && exact) || (filter == "fixed8" && fixed8 && texel8);
         if (!filter.empty() && filter != "exact" && filter != "fixed8") gl_fail(2, "--filter: exact or fixed8");
         if (!(convert && rounded && converted && floats && filter_ok)) {
             std::fprintf(stderr, "gl_probe: a model the slicing tests' tolerances rely on does not hold (above)\n");

@@ -139,7 +139,7 @@ Slicing read_profile(const json& profile_in) {
     static const std::set<std::string> known = {"base", "placement", "slices", "texture", "texture_format", "texture_window",
                                                 "table", "table_lookup", "table_format", "classify", "correction",
                                                 "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha",
-                                                "jitter"};
+                                                "texture_filter", "jitter"};
     for (const auto& [k, v] : profile.items())
         if (!known.contains(k)) refuse("render.profile." + k + ": not a rule gl_slicer renders");
     using S = Slicing;
@@ -214,11 +214,15 @@ Slicing read_profile(const json& profile_in) {
         s.framebuffer = pick<S::Framebuffer>(profile["framebuffer"], "framebuffer",
                                              {{"rgba8", S::Framebuffer::Rgba8}, {"rgba16f", S::Framebuffer::Rgba16f},
                                               {"rgba32f", S::Framebuffer::Rgba32f}});
-    // How the frame buffer rounds is the GL implementation's (gl_probe measures it): accepted, not used.
+    // How the frame buffer rounds and multiplies, and how 8-bit textures are filtered, are the GL
+    // implementation's (gl_probe measures them; the filter is llvmpipe's fixed-point one unless
+    // GALLIVM_PERF=no_aos_sampling): accepted, not used.
     if (profile.contains("framebuffer_rounding"))
         pick<int>(profile["framebuffer_rounding"], "framebuffer_rounding", {{"nearest", 0}, {"truncate", 1}});
     if (profile.contains("blend_products"))
-        pick<int>(profile["blend_products"], "blend_products", {{"exact", 0}, {"rounded", 1}});
+        pick<int>(profile["blend_products"], "blend_products", {{"exact", 0}, {"rounded", 1}, {"llvmpipe", 2}});
+    if (profile.contains("texture_filter"))
+        pick<int>(profile["texture_filter"], "texture_filter", {{"exact", 0}, {"fixed8", 1}});
     if (profile.contains("jitter") && str(profile["jitter"], "jitter") != "off") refuse("render.profile.jitter: \"off\" only");
     if (profile.contains("blend"))
         s.blend = pick<S::Blend>(profile["blend"], "blend",
@@ -376,9 +380,9 @@ struct Transfer {
 
 double quantise(double x, double levels) { return std::round(std::clamp(x, 0.0, 1.0) * levels) / levels; }
 
-// The table's entries e_j = the transfer function at lo + j (hi - lo) / (N - 1) (evaluated in that order:
-// an entry whose unorm8 code is a tie, x = (k + 1/2) / 255, rounds by the last bit of that position),
-// stored per table_format.
+// The table's entries e_j = TF(lo + j (hi - lo) / (N - 1)), evaluated in that order (j (hi - lo), then / (N - 1),
+// then lo +, as the contract states and volref does: an entry whose unorm8 code is a tie, x = (k + 1/2) / 255,
+// rounds by the last bit of that position), stored per table_format.
 std::vector<std::array<double, 4>> make_table(const Transfer& tf, int N, bool unorm8) {
     std::vector<std::array<double, 4>> t(static_cast<std::size_t>(N));
     for (int j = 0; j < N; ++j) {
@@ -745,17 +749,9 @@ int run(int argc, char** argv) {
     const glm::dvec3 G = 1.0 / vol.spacing;  // diag(1 / spacing): world -> voxel units
     if (sl.orientation == Slicing::Orientation::Axis) {
         dvec3 w = view.f;
-        if (!view.ortho) {
-            // the unit vector from E to the centre of the range's box: the object's box, or for view_volume
-            // the box of the frustum's 8 corners
-            Box b = range_box;
-            if (sl.range == Slicing::Range::ViewVolume) {
-                const auto c = view.frustum_corners();
-                b = {c[0], c[0]};
-                for (const dvec3& p : c) b.lo = glm::min(b.lo, p), b.hi = glm::max(b.hi, p);
-            }
-            w = glm::normalize(0.5 * (b.lo + b.hi) - view.eye);
-        }
+        // perspective: the unit vector from E to the centre of the geometry's bounding box (volume.bounds'
+        // box, the domain by default) for both ranges (object and view_volume)
+        if (!view.ortho) w = glm::normalize(0.5 * (range_box.lo + range_box.hi) - view.eye);
         for (int a = 1; a < 3; ++a)
             if (std::fabs(w[a]) > std::fabs(w[axis])) axis = a;
         axis_sign = w[axis] > 0 ? 1.0 : -1.0;

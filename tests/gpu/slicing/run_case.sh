@@ -9,10 +9,13 @@
 # The images agree when no pixel is over BIG and at most M pixels are over SMALL (two `volref compare`
 # runs: --tolerance BIG must exit 0; --tolerance SMALL --json counts the pixels over).
 # Usage: run_case.sh GL_SLICER VOLREF SCENE.json OUTDIR [VARIANT]
-# With VARIANT (gl_slicer --define: SLICER_CORRECTED, SLICER_HALF, SLICER_FLOAT_FB, SLICER_LINEAR_TABLE,
-# SLICER_DATA_WINDOW, SLICER_NO_NEAR_FAR; or LLVMPIPE_FIXED8: gl_slicer as it is, with GALLIVM_PERF unset,
-# so llvmpipe filters 8-bit textures in its 8.8 fixed point) the program renders another convention and the
-# test passes only when the images do not agree: the comparison is tight enough to see it.
+# With VARIANT one of the two renders another convention and the test passes only when the images do not
+# agree: the comparison is tight enough to see it. VARIANT: SLICER_* (gl_slicer --define: SLICER_CORRECTED,
+# SLICER_HALF, SLICER_FLOAT_FB, SLICER_LINEAR_TABLE, SLICER_DATA_WINDOW, SLICER_NO_NEAR_FAR); LLVMPIPE_DEFAULT
+# (gl_slicer as it is, GALLIVM_PERF unset: llvmpipe's default 8-bit filter, 8.8 fixed point, on a scene whose
+# texture_filter is "exact"); LLVMPIPE_NO_AOS (gl_slicer with GALLIVM_PERF=no_aos_sampling: llvmpipe's exact
+# filter on a scene whose texture_filter is "fixed8"); VOLREF_EXACT_PRODUCTS (volref with
+# --set render.profile.blend_products=exact on a scene whose products are llvmpipe's).
 # Exit 0 = as expected; anything else fails (no GL context is a failure, never a skip).
 set -euo pipefail
 slicer=$1 volref=$2 scene=$3 out=$4 variant=${5:-}
@@ -21,12 +24,17 @@ here=$(cd "$(dirname "$0")" && pwd)
 read -r small count big < <(/usr/bin/python3 "$here/derive_tolerance.py" "$scene")
 echo "run_case.sh: $name: first-order tolerance $small, at most $count pixels past it, none past $big (derive_tolerance.py)"
 mkdir -p "$out"
-if [ "$variant" = LLVMPIPE_FIXED8 ]; then
-  env -u GALLIVM_PERF "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe
-else
-  "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe ${variant:+--define "$variant"}
-fi
-"$volref" render "$scene" -o "$out/$name-volref.exr"
+volref_set=()
+case "$variant" in
+  LLVMPIPE_DEFAULT) env -u GALLIVM_PERF "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe ;;
+  LLVMPIPE_NO_AOS) env GALLIVM_PERF=no_aos_sampling "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe ;;
+  VOLREF_EXACT_PRODUCTS)
+    "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe
+    volref_set=(--set render.profile.blend_products=exact) ;;
+  "" | SLICER_*) "$slicer" "$scene" "$out/$name-gl.exr" --require-renderer llvmpipe ${variant:+--define "$variant"} ;;
+  *) echo "run_case.sh: unknown variant $variant" >&2; exit 2 ;;
+esac
+"$volref" render "$scene" -o "$out/$name-volref.exr" "${volref_set[@]}"
 set +e
 "$volref" compare "$out/$name-gl.exr" "$out/$name-volref.exr" --tolerance "$big" --heatmap "$out/$name-diff.png"
 rc_big=$?

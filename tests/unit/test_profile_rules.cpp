@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ComparedRender.h"
 #include "TestScenes.h"
 #include "core/Error.h"
 #include "core/compare/ConventionSearch.h"
@@ -206,14 +207,7 @@ TEST(ConventionSearch, FindsTheRulesItWasGiven) {
     s.camera.fov_y = 40.0;
     s.image.width = 24;
     s.image.height = 20;
-    auto other = [&](const json& rules) {
-        compare::ComparedImage g;
-        const Image im = render_scene(with(s, rules), {0, false});
-        g.rgba = Image(im.width, im.height, {"R", "G", "B", "A"});
-        for (std::size_t p = 0; p < std::size_t(im.width * im.height); ++p)
-            for (std::size_t c = 0; c < 4; ++c) g.rgba.pixels[p * 4 + c] = im.pixels[p * im.channels.size() + c];
-        return g;
-    };
+    auto other = [&](const json& rules) { return compared_image(render_scene(with(s, rules), {0, false})); };
     const compare::SearchResult r = compare::search_conventions(other({{"placement", "from-entry"}, {"first", 0}, {"ray_box", "texel"}}), s);
     EXPECT_TRUE(r.explained) << r.verdict;
     EXPECT_EQ(r.best.rules["placement"], "from-entry");

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "ComparedRender.h"
 #include "TestScenes.h"
 #include "core/Error.h"
 #include "core/camera/Camera.h"
@@ -464,14 +465,7 @@ TEST(Slices, ConventionSearchNamesTheSlicingRules) {
     s.image.width = s.image.height = 20;
     s.render.profile = ProfileId::Volumizer;
     s.render.step = 0.75;
-    auto other = [&](const json& rules) {
-        compare::ComparedImage g;
-        const Image im = render_scene(with(s, rules), {0, false});
-        g.rgba = Image(im.width, im.height, {"R", "G", "B", "A"});
-        for (std::size_t p = 0; p < std::size_t(im.width * im.height); ++p)
-            for (std::size_t c = 0; c < 4; ++c) g.rgba.pixels[p * 4 + c] = im.pixels[p * im.channels.size() + c];
-        return g;
-    };
+    auto other = [&](const json& rules) { return compared_image(render_scene(with(s, rules), {0, false})); };
     const compare::SearchResult r = compare::search_conventions(
         other({{"slices", {{"orientation", "axis"}}}, {"framebuffer", "rgba32f"}, {"correction", "exact"}}), s);
     EXPECT_TRUE(r.explained) << r.verdict;

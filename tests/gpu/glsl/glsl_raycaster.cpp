@@ -13,10 +13,7 @@
 // read: the seed composites textureValue.rrr). Anything else is an error (exit 2).
 // Exit status: 0 written; 1 no GL context or a GL error (never a skip: a test that cannot get a
 // context fails); 2 a scene the program does not render.
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/glcorearb.h>
+#include "tests/gpu/gl_context.h"
 
 #include <cmath>
 #include <cstdio>
@@ -38,12 +35,10 @@
 
 namespace {
 
-struct Fail {
-    int code;
-    std::string what;
-};
+using gl_headless::check_gl;
+using gl_headless::GlFail;
 
-[[noreturn]] void fail(int code, const std::string& what) { throw Fail{code, what}; }
+[[noreturn]] void fail(int code, const std::string& what) { gl_headless::gl_fail(code, what); }
 
 std::string read_text(const char* path) {
     std::ifstream in(path);
@@ -51,66 +46,6 @@ std::string read_text(const char* path) {
     std::stringstream s;
     s << in.rdbuf();
     return s.str();
-}
-
-void check_gl(const char* where) {
-    if (const GLenum e = glGetError(); e != GL_NO_ERROR) fail(1, std::string("GL error ") + std::to_string(e) + " at " + where);
-}
-
-GLuint compile(GLenum type, const std::string& src) {
-    const GLuint s = glCreateShader(type);
-    const char* p = src.c_str();
-    glShaderSource(s, 1, &p, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[4096];
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        fail(1, std::string("shader compile: ") + log);
-    }
-    return s;
-}
-
-// A current OpenGL 3.3 core context without a surface: on Mesa's surfaceless platform (llvmpipe), or, with
-// --egl-device (a GPU machine: NVIDIA's driver has no surfaceless platform, issue 28), on the first EGL
-// device that initialises (EGL_EXT_platform_device).
-void make_context(const std::string& require_renderer, bool egl_device) {
-    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-    if (!get_platform_display) fail(1, "EGL: no eglGetPlatformDisplayEXT");
-    EGLDisplay dpy = EGL_NO_DISPLAY;
-    EGLint major = 0, minor = 0;
-    if (egl_device) {
-        auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-        EGLDeviceEXT devices[8];
-        EGLint count = 0;
-        if (!query_devices || !query_devices(8, devices, &count) || count < 1) fail(1, "EGL: no EGL device (EGL_EXT_device_enumeration)");
-        for (EGLint d = 0; d < count && dpy == EGL_NO_DISPLAY; ++d) {
-            dpy = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[d], nullptr);
-            if (dpy != EGL_NO_DISPLAY && !eglInitialize(dpy, &major, &minor)) dpy = EGL_NO_DISPLAY;
-        }
-        if (dpy == EGL_NO_DISPLAY) fail(1, "EGL: no EGL device initialises");
-    } else {
-        dpy = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        if (dpy == EGL_NO_DISPLAY) fail(1, "EGL: no surfaceless display (is libegl-mesa0 installed?)");
-        if (!eglInitialize(dpy, &major, &minor)) fail(1, "EGL: eglInitialize failed");
-    }
-    if (!eglBindAPI(EGL_OPENGL_API)) fail(1, "EGL: no OpenGL API");
-    // Mesa's surfaceless platform may offer no config for OpenGL: then EGL_KHR_no_config_context.
-    const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-    EGLConfig config = EGL_NO_CONFIG_KHR;
-    EGLint n = 0;
-    if (!eglChooseConfig(dpy, config_attribs, &config, 1, &n) || n < 1) config = EGL_NO_CONFIG_KHR;
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, ctx_attribs);
-    if (ctx == EGL_NO_CONTEXT) fail(1, "EGL: cannot create an OpenGL 3.3 core context");
-    if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) fail(1, "EGL: eglMakeCurrent without a surface failed");
-    const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    std::fprintf(stderr, "glsl_raycaster: GL_RENDERER %s, GL_VERSION %s\n", renderer ? renderer : "?", version ? version : "?");
-    if (!require_renderer.empty() && (!renderer || !std::strstr(renderer, require_renderer.c_str())))
-        fail(1, "GL_RENDERER is not " + require_renderer + " (the test's tolerance is derived for it)");
 }
 
 int run(int argc, char** argv) {
@@ -149,7 +84,7 @@ int run(int argc, char** argv) {
     const glm::dvec3 lo = vol.domain_min(), extent = vol.domain_max() - vol.domain_min();
     const int W = scene.image.width, H = scene.image.height;
 
-    make_context(require_renderer, egl_device);
+    gl_headless::make_context("glsl_raycaster", require_renderer, egl_device);
 
     // The volume: GL_R32F, linear, clamped to the edge.
     std::vector<float> voxels(std::size_t(vol.dims[0] * vol.dims[1] * vol.dims[2]));
@@ -185,10 +120,10 @@ int run(int argc, char** argv) {
                                "  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);\n"
                                "  gl_Position = vec4(p, 0.0, 1.0);\n}\n";
     const GLuint prog = glCreateProgram();
-    glAttachShader(prog, compile(GL_VERTEX_SHADER, vs_src));
+    glAttachShader(prog, gl_headless::compile_shader(GL_VERTEX_SHADER, vs_src));
     std::string frag = read_text(VOLREF_GLSL_SHADER);
     frag.insert(frag.find('\n') + 1, defines);
-    glAttachShader(prog, compile(GL_FRAGMENT_SHADER, frag));
+    glAttachShader(prog, gl_headless::compile_shader(GL_FRAGMENT_SHADER, frag));
     glLinkProgram(prog);
     GLint linked = 0;
     glGetProgramiv(prog, GL_LINK_STATUS, &linked);
@@ -276,7 +211,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return run(argc, argv);
-    } catch (const Fail& f) {
+    } catch (const GlFail& f) {
         std::fprintf(stderr, "glsl_raycaster: %s\n", f.what.c_str());
         return f.code;
     } catch (const std::exception& e) {

@@ -41,12 +41,12 @@
 #include <string>
 #include <vector>
 
-#include "gl_context.h"
+#include "tests/gpu/gl_context.h"
 
 namespace {
 
-using slicing::check_gl;
-using slicing::gl_fail;
+using gl_headless::check_gl;
+using gl_headless::gl_fail;
 
 const char* kQuadVs = "#version 330 core\nvoid main() {\n"
                       "  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);\n"
@@ -119,8 +119,8 @@ bool probe_convert(const Gl& gl, bool& convert_holds) {
             for (int c = 0; c < 4; ++c) in[(std::size_t(k) * W + std::size_t(j)) * 4 + std::size_t(c)] = x;
     }
     const GLuint tex = float_texture(in, W, H, GL_TEXTURE1);
-    slicing::make_framebuffer(GL_RGBA8, W, H);
-    const GLuint prog = slicing::link_program(kQuadVs, kCopyFs);
+    gl_headless::make_framebuffer(GL_RGBA8, W, H);
+    const GLuint prog = gl_headless::link_program(kQuadVs, kCopyFs);
     glUseProgram(prog);
     glUniform1i(glGetUniformLocation(prog, "u_in"), 1);
     gl.draw();
@@ -170,7 +170,7 @@ int mul8(int a, int f) {
 
 bool probe_blend8(const Gl& gl, bool& rounded_nearest_holds) {
     const int W = 4096, H = 4096;  // pixel p = y W + x: Q_dst = p & 255, q_a = (p >> 8) & 255, q_src = p >> 16
-    slicing::make_framebuffer(GL_RGBA8, W, H);
+    gl_headless::make_framebuffer(GL_RGBA8, W, H);
     // Pass 1 (no blend) writes Q_dst / 255 in R, G, B, A (G: q_src's complement 255 - Q, so both colour
     // channels are exercised); pass 2 blends the fragment (q_src / 255, (255 - q_src) / 255, q_a / 255, q_a / 255).
     const std::string fs_dst = "#version 330 core\nout vec4 o;\nvoid main() {\n"
@@ -181,7 +181,7 @@ bool probe_blend8(const Gl& gl, bool& rounded_nearest_holds) {
                                "  int p = int(gl_FragCoord.y) * 4096 + int(gl_FragCoord.x);\n"
                                "  float qa = float((p >> 8) & 255), qs = float(p >> 16);\n"
                                "  o = vec4(qs, 255.0 - qs, qa, qa) / 255.0;\n}\n";
-    const GLuint pd = slicing::link_program(kQuadVs, fs_dst), ps = slicing::link_program(kQuadVs, fs_src);
+    const GLuint pd = gl_headless::link_program(kQuadVs, fs_dst), ps = gl_headless::link_program(kQuadVs, fs_src);
     struct Mode {
         const char* name;
         int kind;  // 0 src-alpha (alpha src-alpha), 1 src-alpha with alpha ONE, 2 premultiplied, 3 under, 4 max
@@ -256,8 +256,8 @@ bool probe_blend8f(const Gl& gl, bool& converted_holds) {
     std::vector<float> dst(std::size_t(W) * H * 4), src(std::size_t(W) * H * 4);
     for (std::size_t i = 0; i < dst.size(); ++i) dst[i] = float(C(rng)) / 255.0f, src[i] = U(rng);
     const GLuint td = float_texture(dst, W, H, GL_TEXTURE1), ts = float_texture(src, W, H, GL_TEXTURE2);
-    slicing::make_framebuffer(GL_RGBA8, W, H);
-    const GLuint prog = slicing::link_program(kQuadVs, kCopyFs);
+    gl_headless::make_framebuffer(GL_RGBA8, W, H);
+    const GLuint prog = gl_headless::link_program(kQuadVs, kCopyFs);
     glUseProgram(prog);
     glUniform1i(glGetUniformLocation(prog, "u_in"), 1);
     gl.draw();
@@ -302,11 +302,11 @@ bool probe_blendf(const Gl& gl, bool& float_holds, bool& half_truncates) {
     std::vector<float> dst(std::size_t(W) * H * 4), src(std::size_t(W) * H * 4);
     for (std::size_t i = 0; i < dst.size(); ++i) dst[i] = U(rng), src[i] = U(rng);
     const GLuint td = float_texture(dst, W, H, GL_TEXTURE1), ts = float_texture(src, W, H, GL_TEXTURE2);
-    const GLuint prog = slicing::link_program(kQuadVs, kCopyFs);
+    const GLuint prog = gl_headless::link_program(kQuadVs, kCopyFs);
     float_holds = true;
     for (const GLenum fmt : {GL_RGBA32F, GL_RGBA16F}) {
         const bool half = fmt == GL_RGBA16F;
-        slicing::make_framebuffer(fmt, W, H);
+        gl_headless::make_framebuffer(fmt, W, H);
         glUseProgram(prog);
         glUniform1i(glGetUniformLocation(prog, "u_in"), 1);
         gl.draw();
@@ -394,7 +394,7 @@ bool probe_filter(const Gl& gl, bool& exact_holds, bool& fixed8_holds) {
     std::vector<float> coords(std::size_t(W) * H * 4);
     for (float& c : coords) c = U(rng);
     const GLuint tc = float_texture(coords, W, H, GL_TEXTURE1);
-    slicing::make_framebuffer(GL_RGBA32F, W, H);
+    gl_headless::make_framebuffer(GL_RGBA32F, W, H);
     struct Case {
         const char* name;
         GLenum target, internal, type;
@@ -439,7 +439,7 @@ bool probe_filter(const Gl& gl, bool& exact_holds, bool& fixed8_holds) {
         const std::string fs = std::string("#version 330 core\nuniform sampler2D u_in; uniform ") + sampler +
                                " u_t; out vec4 o;\nvoid main() {\n  vec4 p = texelFetch(u_in, ivec2(gl_FragCoord.xy), 0);\n"
                                "  o = vec4(" + read + ");\n}\n";
-        const GLuint prog = slicing::link_program(kQuadVs, fs);
+        const GLuint prog = gl_headless::link_program(kQuadVs, fs);
         glUseProgram(prog);
         glUniform1i(glGetUniformLocation(prog, "u_in"), 1);
         glUniform1i(glGetUniformLocation(prog, "u_t"), 0);
@@ -523,8 +523,8 @@ bool probe_texel8(const Gl& gl, bool& holds) {
     glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, 256, 1, 1, 0, GL_RED, GL_UNSIGNED_BYTE, codes.data());
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    slicing::make_framebuffer(GL_RGBA32F, 256, 1);
-    const GLuint prog = slicing::link_program(
+    gl_headless::make_framebuffer(GL_RGBA32F, 256, 1);
+    const GLuint prog = gl_headless::link_program(
         kQuadVs, "#version 330 core\nuniform sampler3D u_t; out vec4 o;\nvoid main() {\n"
                  "  o = vec4(texelFetch(u_t, ivec3(int(gl_FragCoord.x), 0, 0), 0).r,\n"
                  "           texture(u_t, vec3(gl_FragCoord.x / 256.0, 0.5, 0.5)).r, 0.0, 1.0);\n}\n");
@@ -593,12 +593,12 @@ bool probe_interp(const char* name, const double* E, const double* T, const doub
     const char* vs = "#version 330 core\nlayout(location = 0) in vec3 p; uniform mat4 u_m; out vec3 v_p;\n"
                      "void main() { v_p = p; gl_Position = u_m * vec4(p, 1.0); }\n";
     const char* fs = "#version 330 core\nin vec3 v_p; out vec4 o;\nvoid main() { o = vec4(v_p, 1.0); }\n";
-    const GLuint prog = slicing::link_program(vs, fs);
+    const GLuint prog = gl_headless::link_program(vs, fs);
     glUseProgram(prog);
     float Mf[16];
     for (int i = 0; i < 16; ++i) Mf[i] = float(M[i]);
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_m"), 1, GL_FALSE, Mf);
-    slicing::make_framebuffer(GL_RGBA32F, W, H);
+    gl_headless::make_framebuffer(GL_RGBA32F, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
     glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
@@ -651,7 +651,7 @@ int run(int argc, char** argv) {
         else if (a == "--filter" && i + 1 < argc) filter = argv[++i];
         else gl_fail(2, "usage: gl_probe [--require-renderer S] [--egl-device] [--check [--filter exact|fixed8]]");
     }
-    slicing::make_context("gl_probe", require_renderer, egl_device);
+    gl_headless::make_context("gl_probe", require_renderer, egl_device);
     Gl gl;
     glGenVertexArrays(1, &gl.vao);
     bool rounded = false, converted = false, floats = false, convert = false, exact = false, fixed8 = false;
@@ -691,7 +691,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return run(argc, argv);
-    } catch (const slicing::GlFail& f) {
+    } catch (const gl_headless::GlFail& f) {
         std::fprintf(stderr, "gl_probe: %s\n", f.what.c_str());
         return f.code;
     }

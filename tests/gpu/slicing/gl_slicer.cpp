@@ -46,14 +46,14 @@
 #include <nlohmann/json.hpp>
 
 #include "core/film/ImageWriter.h"
-#include "gl_context.h"
+#include "tests/gpu/gl_context.h"
 #include "volref_core.h"
 
 namespace {
 
 using nlohmann::json;
-using slicing::check_gl;
-using slicing::gl_fail;
+using gl_headless::check_gl;
+using gl_headless::gl_fail;
 
 // kSliceSlack of the contract: n = floor((b_far - b_near) / s - o + kSliceSlack) + 1 and
 // n = ceil(E / D - kSliceSlack).
@@ -809,7 +809,7 @@ int run(int argc, char** argv) {
                  sl.orientation == Slicing::Orientation::Axis ? (std::string(", axis ") + "xyz"[axis] + (axis_sign > 0 ? " +" : " -")).c_str() : "");
 
     // --- GL ------------------------------------------------------------------------------------------
-    slicing::make_context("gl_slicer", require_renderer, egl_device);
+    gl_headless::make_context("gl_slicer", require_renderer, egl_device);
 
     // The texels s_i = clamp((v - lo) / (hi - lo), 0, 1), stored per texture_format (unorm: round(q s) / q);
     // pre-unweighted: each voxel's (c, a) looked up from its stored s, as RGBA32F.
@@ -913,7 +913,7 @@ int run(int argc, char** argv) {
     const GLenum fb_format = sl.framebuffer == Slicing::Framebuffer::Rgba8     ? GL_RGBA8
                              : sl.framebuffer == Slicing::Framebuffer::Rgba16f ? GL_RGBA16F
                                                                                : GL_RGBA32F;
-    slicing::make_framebuffer(fb_format, W, H);
+    gl_headless::make_framebuffer(fb_format, W, H);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
 
@@ -926,7 +926,7 @@ int run(int argc, char** argv) {
     header += std::string("#define CORRECTION_EXACT ") + (sl.correction_exact ? "1" : "0") + "\n";
     header += std::string("#define SHELLS ") + (shells ? "1" : "0") + "\n";
     header += std::string("#define PREMULTIPLIED ") + (sl.blend == Slicing::Blend::Premultiplied ? "1" : "0") + "\n";
-    const GLuint prog = slicing::link_program(shells ? kShellVs : kPlaneVs, header + kFragment + (shells ? kShellMain : kPlaneMain));
+    const GLuint prog = gl_headless::link_program(shells ? kShellVs : kPlaneVs, header + kFragment + (shells ? kShellMain : kPlaneMain));
     glUseProgram(prog);
     auto loc = [&](const char* name) { return glGetUniformLocation(prog, name); };
     auto v3 = [&](const char* name, const dvec3& v) { glUniform3f(loc(name), float(v.x), float(v.y), float(v.z)); };
@@ -1066,7 +1066,7 @@ int run(int argc, char** argv) {
     // --fragments X,Y: each level's fragment at pixel (x, y) (row 0 at the top) alone, unblended, in
     // RGBA32F, far first: the shader's output (src-alpha and max: (c, a); premultiplied: (a c, a)).
     if (dump_x >= 0) {
-        slicing::make_framebuffer(GL_RGBA32F, W, H);
+        gl_headless::make_framebuffer(GL_RGBA32F, W, H);
         glDisable(GL_BLEND);
         for (std::size_t k = 0; k < lv.lambda.size(); ++k) {
             glClearColor(0, 0, 0, -1);  // alpha -1: no fragment
@@ -1093,7 +1093,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return run(argc, argv);
-    } catch (const slicing::GlFail& f) {
+    } catch (const gl_headless::GlFail& f) {
         std::fprintf(stderr, "gl_slicer: %s\n", f.what.c_str());
         return f.code;
     } catch (const std::exception& e) {

@@ -1,4 +1,5 @@
-// A headless OpenGL 3.3 core context through EGL, shared by gl_slicer and gl_probe: Mesa's surfaceless
+// A headless OpenGL 3.3 core context through EGL, shared by tests/gpu/glsl/glsl_raycaster and
+// tests/gpu/slicing's gl_slicer and gl_probe: Mesa's surfaceless
 // platform (llvmpipe; no X server, no window), or with `egl_device` the first EGL device that initialises
 // (a GPU machine: NVIDIA's driver has no surfaceless platform). Errors are thrown as GlFail; code 1 is
 // "no GL context or a GL error" (never a skip).
@@ -12,7 +13,7 @@
 #include <cstring>
 #include <string>
 
-namespace slicing {
+namespace gl_headless {
 
 struct GlFail {
     int code;
@@ -115,4 +116,4 @@ inline GLuint make_framebuffer(GLenum internal_format, int W, int H) {
     return fbo;
 }
 
-}  // namespace slicing
+}  // namespace gl_headless

@@ -102,36 +102,16 @@ int run(int argc, char** argv) {
         glTexParameteri(GL_TEXTURE_3D, w, GL_CLAMP_TO_EDGE);
     check_gl("volume texture");
 
-    // The target: GL_RGBA32F.
-    GLuint fbo = 0, rb = 0;
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glGenRenderbuffers(1, &rb);
-    glBindRenderbuffer(GL_RENDERBUFFER, rb);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, W, H);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail(1, "GL: RGBA32F framebuffer incomplete");
-    glViewport(0, 0, W, H);
-    glDisable(GL_BLEND);
-    glDisable(GL_DITHER);
+    // The target: GL_RGBA32F (blending, dithering, depth test and culling off).
+    gl_headless::make_framebuffer(GL_RGBA32F, W, H);
 
     // A full-screen triangle; the fragment shader casts the pixel's ray.
     const std::string vs_src = "#version 330 core\nvoid main() {\n"
                                "  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);\n"
                                "  gl_Position = vec4(p, 0.0, 1.0);\n}\n";
-    const GLuint prog = glCreateProgram();
-    glAttachShader(prog, gl_headless::compile_shader(GL_VERTEX_SHADER, vs_src));
     std::string frag = read_text(VOLREF_GLSL_SHADER);
     frag.insert(frag.find('\n') + 1, defines);
-    glAttachShader(prog, gl_headless::compile_shader(GL_FRAGMENT_SHADER, frag));
-    glLinkProgram(prog);
-    GLint linked = 0;
-    glGetProgramiv(prog, GL_LINK_STATUS, &linked);
-    if (!linked) {
-        char log[4096];
-        glGetProgramInfoLog(prog, sizeof log, nullptr, log);
-        fail(1, std::string("program link: ") + log);
-    }
+    const GLuint prog = gl_headless::link_program(vs_src, frag);
     glUseProgram(prog);
     auto loc = [&](const char* name) { return glGetUniformLocation(prog, name); };
     auto v3 = [&](const char* name, const glm::dvec3& v) { glUniform3f(loc(name), float(v.x), float(v.y), float(v.z)); };

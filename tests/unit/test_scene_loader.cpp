@@ -2,6 +2,8 @@
 // error (each naming the file and the JSON path), --set overrides, and files on disk.
 #include <gtest/gtest.h>
 
+#include "TempDir.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -79,26 +81,8 @@ void expect_vec(const glm::dvec3& v, double x, double y, double z) {
     EXPECT_DOUBLE_EQ(v.z, z);
 }
 
-// A temporary folder removed at the end of the test.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("volref_scene_test_" + std::to_string(::getpid()) + "_" +
-                testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    fs::path write(const std::string& name, const std::string& text) const {
-        const fs::path p = path / name;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p) << text;
-        return p;
-    }
+struct TempDir : test::TempDir {
+    TempDir() : test::TempDir("scene_test") {}
 };
 
 // ------------------------------------------------------------------------------------------------

@@ -3,6 +3,8 @@
 // against chords computed here by hand.
 #include <gtest/gtest.h>
 
+#include "TempDir.h"
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -475,24 +477,8 @@ TEST(Shells, QuadraticRootsWithoutCancellation) {
 // ------------------------------------------------------------------------------------------------
 // Triangle meshes
 
-// A temporary folder removed at the end of the test.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("volref_shapes_test_" + std::to_string(::getpid()) + "_" +
-                                            testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string write(const std::string& name, const std::string& text) const {
-        const fs::path p = path / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
+struct TempDir : test::TempDir {
+    TempDir() : test::TempDir("shapes_test") {}
 };
 
 std::string obj_text(const TriangleMesh& m, bool one_based = true) {

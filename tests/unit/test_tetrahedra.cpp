@@ -5,6 +5,8 @@
 // icosphere and the shell between two icospheres), the scene key and a render against box bounds.
 #include <gtest/gtest.h>
 
+#include "TempDir.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -39,23 +41,8 @@ using test::ortho_down_z;
 
 const fs::path kData = fs::path(VOLREF_SOURCE_DIR) / "reference_scenes" / "data";
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("volref_tetra_test_" + std::to_string(::getpid()) + "_" +
-                                            testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string write(const std::string& name, const std::string& text) const {
-        const fs::path p = path / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
+struct TempDir : test::TempDir {
+    TempDir() : test::TempDir("tetra_test") {}
 };
 
 template <class F>

@@ -25,6 +25,8 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   # issue 22, the vtk.js check (tests/gpu/web): Debian's Chromium (headless, SwiftShader WebGL2) and node
   chromium nodejs
+  # issue 55, the VolPack check (tests/volpack): VolPack 1.0b3's headers, static library and example programs
+  libvolpack1-dev
   # ---- issue 21, volref-mpi (cli/mpi/; built only when CMake finds MPI): OpenMPI's headers, libraries, mpirun ----
   libopenmpi-dev openmpi-bin
   # ---- end of issue 21 ----

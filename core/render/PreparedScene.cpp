@@ -1,6 +1,6 @@
 #include "core/render/PreparedScene.h"
 
-#include "core/integrate/profiles/VtkFixedPointRenderer.h"
+#include "core/integrate/profiles/ImageSpaceRenderer.h"
 
 #include <algorithm>
 #include <limits>
@@ -32,14 +32,16 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
         }
         multi = std::make_unique<MultiVolumeIntegrator>(std::move(members), scene.render, step);
     }
-    camera = std::make_unique<Camera>(scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
+    const ImageSpaceRenderer* own = volumes.front()->image_space.get();
+    const std::optional<CameraSpec> own_camera = own ? own->view_camera() : std::nullopt;
+    camera = std::make_unique<Camera>(own_camera ? *own_camera : scene.camera, scene.image.width, scene.image.height, view_lo, view_hi);
 }
 
 PreparedScene::~PreparedScene() = default;
 
 void PreparedScene::pixels(const int* x, const int* y, int count, PixelValue* out, bool simd, Scratch& scratch) const {
-    if (const vtkcpu::VtkFixedPointRenderer* r = image_space()) {
-        for (int i = 0; i < count; ++i) out[i] = PixelValue{r->display(x[i], y[i], nullptr)};
+    if (const ImageSpaceRenderer* r = image_space()) {
+        for (int i = 0; i < count; ++i) out[i] = r->pixel(x[i], y[i], nullptr);
         return;
     }
     Ray rays[kMaxPacketRays];
@@ -48,10 +50,10 @@ void PreparedScene::pixels(const int* x, const int* y, int count, PixelValue* ou
 }
 
 void PreparedScene::integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const {
-    if (const vtkcpu::VtkFixedPointRenderer* r = image_space()) {  // the window pixel each ray passes through
+    if (const ImageSpaceRenderer* r = image_space()) {  // the window pixel each ray passes through
         for (int i = 0; i < count; ++i) {
             const auto [x, y] = r->pixel_of(rays[i]);
-            out[i] = PixelValue{r->display(x, y, nullptr)};
+            out[i] = r->pixel(x, y, nullptr);
         }
         return;
     }
@@ -111,7 +113,7 @@ PixelValue PreparedScene::trace_pixel(int x, int y, SampleRecorder& recorder) co
     const PreparedVolume& v = traced_volume();
     if (v.image_space) {
         Recording rec{recorder};
-        return PixelValue{v.image_space->display(x, y, &rec)};
+        return v.image_space->pixel(x, y, &rec);
     }
     const Ray ray = pixel_ray(x, y);
     return v.integrator->integrate_traced(v.volume_ray(ray), intervals(ray), recorder);

@@ -14,6 +14,7 @@
 #include "core/camera/Camera.h"
 #include "core/integrate/Integrator.h"
 #include "core/integrate/mix/MultiVolumeIntegrator.h"
+#include "core/integrate/profiles/ImageSpaceRenderer.h"
 #include "core/integrate/march/SampleRecorder.h"
 #include "core/render/PreparedVolume.h"
 #include "core/render/Renderer.h"
@@ -38,9 +39,9 @@ struct PreparedScene {
     const PreparedVolume& volume() const { return *volumes.front(); }
     const Integrator& integrator() const { return *volumes.front()->integrator; }
     // The image-space renderer that draws the image instead of the integrators (vtk-cpu), or null.
-    const vtkcpu::VtkFixedPointRenderer* image_space() const { return volumes.front()->image_space.get(); }
+    const ImageSpaceRenderer* image_space() const { return volumes.front()->image_space.get(); }
     bool writes_depth() const { return !image_space() && integrator().writes_depth(); }
-    bool writes_error() const { return !image_space() && integrator().writes_error(); }
+    bool writes_error() const { return image_space() ? image_space()->writes_error() : integrator().writes_error(); }
     bool writes_fault() const { return !image_space() && volumes.size() == 1 && integrator().writes_fault(); }
 
     // Scratch space of one thread for integrate(): each volume's local rays and intervals.

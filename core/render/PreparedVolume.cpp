@@ -20,6 +20,7 @@
 #include "core/camera/Camera.h"
 #include "core/integrate/profiles/ProfileIntegrator.h"
 #include "core/integrate/profiles/VtkJsIntegrator.h"
+#include "core/integrate/profiles/VolPackRenderer.h"
 #include "core/integrate/profiles/VtkFixedPointRenderer.h"
 #include "core/io/VolumeReader.h"
 #include "core/scene/SceneNames.h"
@@ -196,6 +197,17 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
     if (vs.transform) transform.emplace(*vs.transform);
     const Volume& volume = model.volume();
+    if (scene.render.profile == ProfileId::VolPack) {
+        // VolPack's shear-warp (issue 55): VolPack's own classification and shading from
+        // render.profile_options (no transfer function, geometry or sample pipeline); the view is its own.
+        bytes = volume.values.bytes() + volume.values.size() * (sizeof(float) + 3);  // the voxels' opacity, code, gradient
+        check_memory(held_bytes + bytes, key + ": VolPack's classified voxels");
+        image_space = std::make_unique<VolPackRenderer>(volume, *scene.render.profile_options.volpack, scene.image.width,
+                                                        scene.image.height);
+        view_lo = volume.domain_min();
+        view_hi = volume.domain_max();
+        return;
+    }
     const FieldSampler& sampler = *model.sampler;
     classifier = make_classifier(vs, volume);
 

@@ -36,9 +36,7 @@
 
 namespace volref {
 
-namespace vtkcpu {
-class VtkFixedPointRenderer;
-}
+class ImageSpaceRenderer;
 
 // A ShellSampler as the pipeline's FieldSampler and GradientSource (world-space differences).
 class ShellField final : public FieldSampler, public GradientSource {
@@ -113,9 +111,10 @@ struct PreparedVolume {
     glm::dvec3 view_lo{0.0}, view_hi{0.0};          // the world box this volume adds to the default camera's view
     std::unique_ptr<IntegrationContext> context;
     std::unique_ptr<Integrator> integrator;  // null when an image-space renderer draws the image instead
-    // render.profile "vtk-cpu": VTK's fixed-point mapper, an image-space renderer (its own internal
-    // image and display; VtkFixedPointRenderer.h), called from the render step instead of `integrator`.
-    std::unique_ptr<vtkcpu::VtkFixedPointRenderer> image_space;
+    // render.profile "vtk-cpu" (VTK's fixed-point mapper, its own internal image and display;
+    // VtkFixedPointRenderer.h) and "volpack" (VolPack's shear-warp; VolPackRenderer.h): an image-space
+    // renderer (ImageSpaceRenderer.h), called from the render step instead of `integrator`.
+    std::unique_ptr<ImageSpaceRenderer> image_space;
     bool packets = true;  // false: the integrator's SIMD packet path does not apply (shading a transformed volume)
 
     // The ray this volume's geometry, pipeline and integrator take: the world ray, or its local ray.

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -186,7 +187,44 @@ enum class StepUnits { Voxel, World };
 enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/profiles/Profile.h, conventions section 9);
 // Fast is volref's own float SIMD variant of the reference (core/integrate/packet/FastProfile.h).
-enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs, Volumizer };
+enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs, Volumizer, VolPack };
+// render.profile "volpack" (issue 55; core/integrate/profiles/VolPackRenderer.h, docs/conventions.md "VolPack"):
+// VolPack 1.0b3's inputs as a VolPack program gives them, in render.profile_options.
+struct VolPackTable {
+    std::vector<float> entries;                    // the table as VolPack reads it (vpSetClassifierTable's floats)
+    std::vector<std::pair<int, float>> ramp;       // when given as {"ramp": ...}: vpRamp's points (SceneWriter)
+};
+struct VolPackLight {
+    glm::dvec3 direction{0.0, 0.0, 1.0};  // vpSetLight(VP_DIRECTION) while the model matrix is the identity
+    glm::dvec3 color{1.0};                 // vpSetLight(VP_COLOR), each in [0, 1]
+};
+struct VolPackSpec {
+    enum class Axis { X, Y, Z };
+    std::vector<std::pair<Axis, double>> rotate;  // vpRotate(axis, degrees) on VP_MODEL, in order
+    bool concat_left = false;                      // VP_CONCAT_MODE: VP_CONCAT_RIGHT (false, VolPack's default) or LEFT
+    std::array<double, 6> window{-0.5, 0.5, -0.5, 0.5, -0.5, 0.5};  // vpWindow(VP_PARALLEL, l, r, b, t, n, f)
+    VolPackTable scalar_table;                      // 256 opacities over the 8-bit scalar
+    std::optional<VolPackTable> gradient_table;     // 256 (222 read) over the gradient-magnitude field
+    bool shaded = false;                            // absent: every shade-table entry 255 (white, unlit)
+    glm::dvec3 ambient{0.1}, diffuse{0.4}, specular{0.5};  // vpSetMaterial (VP_MATERIAL0, VP_BOTH_SIDES); x 255 inside
+    double shininess = 10.0;
+    std::optional<std::vector<VolPackLight>> lights;  // absent: VolPack's default VP_LIGHT0
+    bool two_sided = false;                           // VP_LIGHT_BOTH_SIDES
+    double min_voxel_opacity = 0.0, max_ray_opacity = 1.0;
+    std::optional<std::array<double, 2>> depth_cue;   // vpSetDepthCueing(front, density); absent: off
+    int channels = 1;                                 // 1: luminance, 3: RGB
+    enum class Path { Classified, Raw };
+    Path path = Path::Classified;                     // vpRenderClassifiedVolume or vpRenderRawVolume
+    std::optional<Axis> axis;                         // VP_AXIS_OVERRIDE; absent: VolPack's choice
+    // Conventions changed one at a time (the check that each is seen; conventions "VolPack"):
+    enum class WarpWeights { Table, Exact };          // the 64-entry weight table, or the exact fractions
+    enum class NormalCode { Quantised, Exact };        // shade by the 13-bit code's normal, or the exact one
+    enum class CorrectionOrder { Voxel, Sample };      // correct each voxel's 8-bit opacity, or the resampled one
+    WarpWeights warp_weights = WarpWeights::Table;
+    NormalCode normal_code = NormalCode::Quantised;
+    CorrectionOrder correction_order = CorrectionOrder::Voxel;
+};
+
 // render.profile_options: the cuda-curvilinear renderer's own parameters (conventions section 9).
 struct ProfileOptions {
     double density = 1.0;         // the lerp weight is col.a * density
@@ -234,6 +272,8 @@ struct ProfileOptions {
     // fast (issue 31; transfer/PreIntegration.h): pre-integrated segments, the table's intervals per axis
     // (render.profile_options.preintegration); 0: off, samples at the segments' midpoints.
     int preintegration = 0;
+    // volpack (issue 55): VolPack's inputs (VolPackSpec above); set for render.profile "volpack" only.
+    std::optional<VolPackSpec> volpack;
 };
 
 // render.profile written as an object (issue 29): a preset (`base`) and the rules the scene sets over it.

@@ -852,8 +852,8 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     P out;
     for (std::string_view k : kKeys)
         if (r.has(k)) out.keys.emplace_back(k);
-    if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast))
-        r.fail(out.keys.front(), std::string("the \"") + std::string(base == ProfileId::VtkCpu ? "vtk-cpu" : base == ProfileId::VtkJs ? "vtk-js" : "fast") +
+    if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast || base == ProfileId::VolPack))
+        r.fail(out.keys.front(), std::string("the \"") + std::string(names::name_of(names::kProfiles, base)) +
                                      "\" profile is its own renderer, not a set of rules (use render.profile_options, or base \"reference\")");
     out.placement = r.optional_choice<P::Placement>("placement", names::kPlacements);
     out.first = r.optional_number("first", Range::closed(0.0, 1e6));
@@ -912,6 +912,146 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     return out;
 }
 
+// render.profile_options of "volpack" (issue 55): VolPack's inputs, each range VolPack's own (its
+// vpSet*, vpRamp and vpWindow error codes) or what its tables hold. A table is 256 numbers in [0, 1]
+// or {"ramp": [[x, y], ...]} filled as vpRamp fills it (x strictly increasing integers from 0 to the
+// field's maximum, so that every entry is set).
+VolPackTable read_volpack_table(const Json& v, const std::string& path, const Context& ctx, int max_index) {
+    VolPackTable t;
+    t.entries.assign(256, 0.0f);
+    if (v.is_object()) {
+        ObjectReader r(v, path, ctx);
+        r.allow({"ramp"});
+        const Json& ramp = r.required("ramp");
+        const std::string rp = r.path("ramp");
+        const std::size_t n = read_array_size(ramp, rp, ctx);
+        if (n < 2) ctx.fail(rp, "expected at least 2 points [x, y]");
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::string ip = index_path(rp, i);
+            const std::vector<double> xy = read_numbers(element(ramp, i), ip, ctx, 2);
+            const std::int64_t x = read_integer(element(element(ramp, i), 0), index_path(ip, 0), ctx, Range::closed(0, max_index));
+            const double y = read_number(element(element(ramp, i), 1), index_path(ip, 1), ctx, Range::closed(0.0, 1.0));
+            (void)xy;
+            if (i == 0 && x != 0) ctx.fail(index_path(ip, 0), "the first point's x must be 0 (vpRamp sets only the entries between its points)");
+            if (i > 0 && x <= t.ramp.back().first) ctx.fail(index_path(ip, 0), "x must increase strictly (vpRamp returns VPERROR_BAD_VALUE)");
+            t.ramp.emplace_back(int(x), float(y));
+        }
+        if (t.ramp.back().first != max_index)
+            ctx.fail(index_path(rp, n - 1), "the last point's x must be " + std::to_string(max_index) +
+                                                " (vpRamp sets only the entries between its points)");
+        // vpRamp (vp_util.c): the points' values, and between them y += dydx in double from the left point.
+        t.entries[std::size_t(t.ramp[0].first)] = t.ramp[0].second;
+        for (std::size_t i = 1; i < t.ramp.size(); ++i) {
+            const int lastx = t.ramp[i - 1].first, nextx = t.ramp[i].first;
+            const double lasty = t.ramp[i - 1].second, nexty = t.ramp[i].second;
+            const double dydx = (nexty - lasty) / double(nextx - lastx);
+            int x = lastx + 1;
+            for (double y = lasty + dydx; x < nextx; ++x, y += dydx) t.entries[std::size_t(x)] = float(y);
+            t.entries[std::size_t(x)] = float(nexty);
+        }
+        return t;
+    }
+    const std::vector<double> e = read_numbers(v, path, ctx, 256, Range::closed(0.0, 1.0));
+    for (std::size_t i = 0; i < 256; ++i) t.entries[i] = float(e[i]);
+    return t;
+}
+
+glm::dvec3 read_volpack_rgb(ObjectReader& r, std::string_view key, const glm::dvec3& fallback) {
+    const Json* v = r.find(key);
+    if (!v) return fallback;
+    if (v->is_number()) return glm::dvec3(read_number(*v, r.path(key), r.context(), Range::non_negative()));
+    return read_vec3(*v, r.path(key), r.context(), Range::non_negative());
+}
+
+VolPackSpec read_volpack_options(ObjectReader& po) {
+    using V = VolPackSpec;
+    const Context& ctx = po.context();
+    po.allow({"rotate", "concat", "window", "scalar_table", "gradient_table", "shading", "min_voxel_opacity",
+              "max_ray_opacity", "depth_cue", "channels", "path", "axis", "warp_weights", "normal_code",
+              "correction_order"});
+    V s;
+    static constexpr Choice<V::Axis> kAxes[] = {{"x", V::Axis::X}, {"y", V::Axis::Y}, {"z", V::Axis::Z}};
+    if (const Json* rot = po.find("rotate")) {
+        const std::string rp = po.path("rotate");
+        const std::size_t n = read_array_size(*rot, rp, ctx);
+        for (std::size_t i = 0; i < n; ++i) {
+            const Json& e = element(*rot, i);
+            const std::string ip = index_path(rp, i);
+            if (!e.is_array() || e.size() != 2)
+                ctx.fail(ip, "expected [axis, degrees] (axis \"x\", \"y\" or \"z\"), got " + describe(e));
+            const std::string a = read_string(e[0], index_path(ip, 0), ctx);
+            const V::Axis* axis = nullptr;
+            for (const auto& c : kAxes)
+                if (c.name == a) axis = &c.value;
+            if (!axis) ctx.fail(index_path(ip, 0), "expected \"x\", \"y\" or \"z\", got \"" + a + "\"");
+            s.rotate.emplace_back(*axis, read_number(e[1], index_path(ip, 1), ctx));
+        }
+    }
+    s.concat_left = po.choice<bool>("concat", false, {{"right", false}, {"left", true}});
+    if (const Json* w = po.find("window")) {
+        const std::string wp = po.path("window");
+        const std::vector<double> v = read_numbers(*w, wp, ctx, 6);
+        for (std::size_t i = 0; i < 6; ++i) s.window[i] = v[i];
+        // vpWindow: VPERROR_BAD_VALUE unless left < right, bottom < top, near < far.
+        if (!(v[0] < v[1])) ctx.fail(index_path(wp, 1), "right must exceed left (vpWindow)");
+        if (!(v[2] < v[3])) ctx.fail(index_path(wp, 3), "top must exceed bottom (vpWindow)");
+        if (!(v[4] < v[5])) ctx.fail(index_path(wp, 5), "far must exceed near (vpWindow)");
+    }
+    s.scalar_table = read_volpack_table(po.required("scalar_table"), po.path("scalar_table"), ctx, 255);
+    if (const Json* g = po.find("gradient_table")) s.gradient_table = read_volpack_table(*g, po.path("gradient_table"), ctx, 221);
+    if (const Json* sh = po.find("shading")) {
+        s.shaded = true;
+        ObjectReader sr(*sh, po.path("shading"), ctx);
+        sr.allow({"material", "lights", "two_sided"});
+        if (const Json* m = sr.find("material")) {
+            ObjectReader mr(*m, sr.path("material"), ctx);
+            mr.allow({"ambient", "diffuse", "specular", "shininess"});
+            s.ambient = read_volpack_rgb(mr, "ambient", s.ambient);
+            s.diffuse = read_volpack_rgb(mr, "diffuse", s.diffuse);
+            s.specular = read_volpack_rgb(mr, "specular", s.specular);
+            s.shininess = mr.number("shininess", s.shininess);
+        }
+        if (const Json* l = sr.find("lights")) {
+            const std::string lp = sr.path("lights");
+            const std::size_t n = read_array_size(*l, lp, ctx);
+            if (n > 6) ctx.fail(lp, "VolPack has 6 lights (VP_LIGHT0 .. VP_LIGHT5), got " + std::to_string(n));
+            std::vector<VolPackLight> lights;
+            for (std::size_t i = 0; i < n; ++i) {
+                ObjectReader lr(element(*l, i), index_path(lp, i), ctx);
+                lr.allow({"direction", "color"});
+                VolPackLight light;
+                light.direction = read_vec3(lr.required("direction"), lr.path("direction"), ctx);
+                if (glm::dot(light.direction, light.direction) < 1e-11)
+                    lr.fail("direction", "a zero vector (vpSetLight returns VPERROR_SINGULAR)");
+                light.color = lr.vec3("color", glm::dvec3(1.0), Range::closed(0.0, 1.0));
+                lights.push_back(light);
+            }
+            s.lights = std::move(lights);
+        }
+        s.two_sided = sr.boolean("two_sided", false);
+    }
+    s.min_voxel_opacity = po.number("min_voxel_opacity", 0.0, Range::closed(-1.0, 1.0));
+    s.max_ray_opacity = po.number("max_ray_opacity", 1.0, Range::left_open(0.0, 1.0));
+    if (const Json* d = po.find("depth_cue")) {
+        ObjectReader dr(*d, po.path("depth_cue"), ctx);
+        dr.allow({"front", "density"});
+        // vpSetDepthCueing: VPERROR_BAD_VALUE for front_factor <= 0.
+        s.depth_cue = std::array<double, 2>{dr.number("front", 1.0, Range::positive()), dr.number("density", 1.0)};
+    }
+    s.channels = int(po.integer("channels", 1, Range::closed(1, 3)));
+    if (s.channels == 2) po.fail("channels", "expected 1 (luminance) or 3 (RGB), got 2");
+    s.path = po.choice<V::Path>("path", V::Path::Classified, {{"classified", V::Path::Classified}, {"raw", V::Path::Raw}});
+    if (po.has("axis"))
+        s.axis = po.choice<V::Axis>("axis", V::Axis::Z, std::span<const Choice<V::Axis>>(kAxes));
+    s.warp_weights = po.choice<V::WarpWeights>("warp_weights", V::WarpWeights::Table,
+                                               {{"table", V::WarpWeights::Table}, {"exact", V::WarpWeights::Exact}});
+    s.normal_code = po.choice<V::NormalCode>("normal_code", V::NormalCode::Quantised,
+                                             {{"quantised", V::NormalCode::Quantised}, {"exact", V::NormalCode::Exact}});
+    s.correction_order = po.choice<V::CorrectionOrder>("correction_order", V::CorrectionOrder::Voxel,
+                                                       {{"voxel", V::CorrectionOrder::Voxel}, {"sample", V::CorrectionOrder::Sample}});
+    return s;
+}
+
 RenderSpec read_render(const Json& v, const std::string& path, const Context& ctx) {
     ObjectReader r(v, path, ctx);
     r.allow({"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance",
@@ -933,7 +1073,16 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
     } else {
         s.profile = read_profile_id(r, "profile");
     }
-    if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
+    if (s.profile == ProfileId::VolPack) {  // issue 55: VolPack's inputs; volref's own render keys do not apply
+        const Json* o = r.find("profile_options");
+        if (!o) r.fail("profile_options", "required by render.profile \"volpack\" (VolPack's inputs: scalar_table at least)");
+        ObjectReader po(*o, r.path("profile_options"), ctx);
+        s.profile_options.volpack = read_volpack_options(po);
+        for (std::string_view k : {"projection", "order", "step", "step_units", "isovalue", "early_termination", "integrator", "tolerance", "gain"})
+            if (r.has(k))
+                r.fail(k, "not used by render.profile \"volpack\" (VolPack composites front to back on its voxel slices; "
+                          "its thresholds are render.profile_options.min_voxel_opacity and max_ray_opacity)");
+    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction", "subpixel_bits"});
         s.profile_options.jitter = po.number("jitter", 1.0, Range::closed(0.01, 1.0));
@@ -1008,6 +1157,19 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);
     if (const Json* v = r.find("render")) scene.render = read_render(*v, r.path("render"), ctx);
+    if (scene.render.profile == ProfileId::VolPack) {  // issue 55: the scene names VolPack's inputs only
+        const char* why = "not used by render.profile \"volpack\" (VolPack's inputs are render.profile_options)";
+        if (scene.volumes.size() != 1) r.fail("volumes", "render.profile \"volpack\" renders one volume");
+        const Json* one = r.find("volume");
+        const Json& vol = one ? *one : element(*r.find("volumes"), 0);
+        for (const char* k : {"transfer", "classification", "shading", "gradient", "transform", "clip_planes", "crop",
+                              "bounds", "classify", "interpolation", "origin", "spacing"})
+            if (vol.contains(k)) ctx.fail(std::string("volume.") + k, why);
+        if (r.find("camera")) ctx.fail("camera", std::string(why) + ": the view is rotate and window");
+        if (r.find("lights")) ctx.fail("lights", std::string(why) + ": the lights are shading.lights");
+        if (scene.image.background != glm::dvec4(0.0))
+            ctx.fail("image.background", "VolPack has no background (its pixels are premultiplied over nothing): remove it");
+    }
     return scene;
 }
 

@@ -76,7 +76,8 @@ inline constexpr Choice<ProfileId> kProfiles[] = {{"reference", ProfileId::Refer
                                                   {"vtk-cpu", ProfileId::VtkCpu},
                                                   {"fast", ProfileId::Fast},
                                                   {"vtk-js", ProfileId::VtkJs},
-                                                  {"volumizer", ProfileId::Volumizer}};
+                                                  {"volumizer", ProfileId::Volumizer},
+                                                  {"volpack", ProfileId::VolPack}};
 // TextureUnit::Admissible has no name (tests only). "hardware": a deprecated alias of "h100".
 inline constexpr Choice<ProfileOptions::TextureUnit> kTextureUnits[] = {{"exact", ProfileOptions::TextureUnit::Exact},
                                                                        {"h100", ProfileOptions::TextureUnit::H100},

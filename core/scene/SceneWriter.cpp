@@ -248,7 +248,52 @@ json profile_options_json(const RenderSpec& r) {
     return j;
 }
 
+// render.profile_options of "volpack" (issue 55): every input, defaults included, as read_volpack_options reads them.
+json volpack_json(const VolPackSpec& v) {
+    static constexpr const char* kAxes[] = {"x", "y", "z"};
+    auto table = [](const VolPackTable& t) {
+        if (!t.ramp.empty()) {
+            json r = json::array();
+            for (const auto& [x, y] : t.ramp) r.push_back({x, double(y)});
+            return json{{"ramp", r}};
+        }
+        json e = json::array();
+        for (float f : t.entries) e.push_back(double(f));
+        return e;
+    };
+    json j;
+    j["rotate"] = json::array();
+    for (const auto& [axis, degrees] : v.rotate) j["rotate"].push_back({kAxes[int(axis)], degrees});
+    j["concat"] = v.concat_left ? "left" : "right";
+    j["window"] = v.window;
+    j["scalar_table"] = table(v.scalar_table);
+    if (v.gradient_table) j["gradient_table"] = table(*v.gradient_table);
+    if (v.shaded) {
+        json sh;
+        sh["material"] = {{"ambient", vec(v.ambient)}, {"diffuse", vec(v.diffuse)}, {"specular", vec(v.specular)},
+                          {"shininess", v.shininess}};
+        if (v.lights) {
+            sh["lights"] = json::array();
+            for (const VolPackLight& l : *v.lights) sh["lights"].push_back({{"direction", vec(l.direction)}, {"color", vec(l.color)}});
+        }
+        sh["two_sided"] = v.two_sided;
+        j["shading"] = sh;
+    }
+    j["min_voxel_opacity"] = v.min_voxel_opacity;
+    j["max_ray_opacity"] = v.max_ray_opacity;
+    if (v.depth_cue) j["depth_cue"] = {{"front", (*v.depth_cue)[0]}, {"density", (*v.depth_cue)[1]}};
+    j["channels"] = v.channels;
+    j["path"] = v.path == VolPackSpec::Path::Raw ? "raw" : "classified";
+    if (v.axis) j["axis"] = kAxes[int(*v.axis)];
+    if (v.warp_weights == VolPackSpec::WarpWeights::Exact) j["warp_weights"] = "exact";
+    if (v.normal_code == VolPackSpec::NormalCode::Exact) j["normal_code"] = "exact";
+    if (v.correction_order == VolPackSpec::CorrectionOrder::Sample) j["correction_order"] = "sample";
+    return j;
+}
+
 json render_json(const RenderSpec& r) {
+    if (r.profile == ProfileId::VolPack && r.profile_options.volpack)  // issue 55: VolPack's inputs only
+        return json{{"profile", "volpack"}, {"profile_options", volpack_json(*r.profile_options.volpack)}};
     json j;
     j["projection"] = name_of(names::kProjections, r.projection);
     j["order"] = name_of(names::kOrders, r.order);
@@ -273,6 +318,15 @@ json render_json(const RenderSpec& r) {
 
 json scene_json(const Scene& scene) {
     json j;
+    if (scene.render.profile == ProfileId::VolPack) {  // issue 55: the volume's file and VolPack's inputs
+        const VolumeSpec& v = scene.volumes.front();
+        j["volume"] = {{"source", source_json(v.source)}};
+        if (v.origin) j["volume"]["origin"] = vec(*v.origin);
+        if (v.spacing) j["volume"]["spacing"] = vec(*v.spacing);
+        j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
+        j["render"] = render_json(scene.render);
+        return j;
+    }
     if (scene.volumes.size() == 1) {
         j["volume"] = volume_json(scene.volumes.front());
     } else {

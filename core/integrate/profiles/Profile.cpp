@@ -53,6 +53,16 @@ Profile make_vtk_cpu() {
     return p;
 }
 
+// VolPack 1.0b3's shear-warp (issue 55): its own renderer (VolPackRenderer.h), its inputs
+// render.profile_options (docs/conventions.md, "VolPack").
+Profile make_volpack() {
+    Profile p;
+    p.id = ProfileId::VolPack;
+    p.name = "volpack";
+    p.renderer = Profile::Renderer::VolPack;
+    return p;
+}
+
 // A textbook GLSL ray caster (issue 7): samples from the entry point on, acc += (1 - acc.a) col.a col
 // with the transfer function's opacity used as the sample's alpha (no correction), stop at alpha >= 1,
 // central differences at +-0.1 in texture coordinates ([0, 1] over the volume's domain).
@@ -161,7 +171,7 @@ const Profile& profile(ProfileId id) {
     static const Profile reference = make_reference(), vtk_gpu = make_vtk_gpu(), vtk_cpu = make_vtk_cpu(),
                          glsl_basic = make_glsl_basic(),
                          ospray = make_ospray(), cuda_curvilinear = make_cuda_curvilinear(), vtk_js = make_vtk_js(),
-                         volumizer = make_volumizer();
+                         volumizer = make_volumizer(), volpack = make_volpack();
     switch (id) {
         case ProfileId::Reference: return reference;
         case ProfileId::VtkGpu: return vtk_gpu;
@@ -171,6 +181,7 @@ const Profile& profile(ProfileId id) {
         case ProfileId::CudaCurvilinear: return cuda_curvilinear;
         case ProfileId::VtkJs: return vtk_js;
         case ProfileId::Volumizer: return volumizer;
+        case ProfileId::VolPack: return volpack;
         case ProfileId::Fast: break;  // not a mirror profile: the reference's integrators (FastProfile.h)
     }
     throw Error("render.profile: unknown profile");
@@ -179,7 +190,8 @@ const Profile& profile(ProfileId id) {
 const std::vector<ProfileId>& preset_ids() {
     static const std::vector<ProfileId> ids{ProfileId::Reference, ProfileId::Fast,  ProfileId::VtkGpu,
                                             ProfileId::VtkCpu,    ProfileId::VtkJs, ProfileId::GlslBasic,
-                                            ProfileId::Ospray,    ProfileId::CudaCurvilinear, ProfileId::Volumizer};
+                                            ProfileId::Ospray,    ProfileId::CudaCurvilinear, ProfileId::Volumizer,
+                                            ProfileId::VolPack};
     return ids;
 }
 

@@ -26,7 +26,8 @@ struct Profile {
     // Which renderer reads the rest: a ray caster over the scene's rays (ProfileIntegrator), or VTK's
     // image-space fixed-point caster (VtkFixedPointRenderer.h: its own internal image, 15-bit fixed
     // point, texture display; the fields below are not read).
-    enum class Renderer { RayCaster, VtkFixedPoint, VtkJs };  // VtkJs: VtkJsIntegrator.h (issue 22)
+    // VtkJs: VtkJsIntegrator.h (issue 22); VolPack: VolPackRenderer.h (issue 55)
+    enum class Renderer { RayCaster, VtkFixedPoint, VtkJs, VolPack };
     Renderer renderer = Renderer::RayCaster;
 
     // The grids the renderer reads: Cartesian only (texture reads clamped to the domain), or beam-space

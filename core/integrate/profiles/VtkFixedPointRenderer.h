@@ -38,6 +38,7 @@
 
 #include "core/camera/Ray.h"
 #include "core/grid/Volume.h"
+#include "core/integrate/profiles/ImageSpaceRenderer.h"
 #include "core/integrate/march/SampleRecorder.h"
 #include "core/scene/Scene.h"
 
@@ -95,7 +96,7 @@ struct Pixel15 {
     std::array<unsigned short, 4> rgba{0, 0, 0, 0};
 };
 
-class VtkFixedPointRenderer {
+class VtkFixedPointRenderer final : public ImageSpaceRenderer {
 public:
     // Throws volref::Error naming the scene key vtk-cpu cannot mirror.
     VtkFixedPointRenderer(const Volume& volume, const Classifier& classifier, const Shader* shader, Projection projection,
@@ -105,8 +106,9 @@ public:
     // premultiplied RGBA in [0, 1). `rec` (optional) records the samples of each internal ray the
     // pixel blends, then one row holding the blend (its `accumulated` is the returned value).
     glm::dvec4 display(int x, int y, Recording* rec) const;
+    PixelValue pixel(int x, int y, Recording* rec) const override { return PixelValue{display(x, y, rec)}; }
     // The window pixel whose centre `ray` passes through (the camera's pixel_ray inverted).
-    std::array<int, 2> pixel_of(const Ray& ray) const;
+    std::array<int, 2> pixel_of(const Ray& ray) const override;
     // Internal pixel (i, j) (VTK's coordinates: from the image origin, row 0 at the bottom).
     Pixel15 cast(int i, int j, Recording* rec) const;
 

@@ -26,6 +26,10 @@ int run_explain(const ExplainArgs& in) {
         std::cout << out;
         return 0;
     }
+    if (e.topic == "volpack-scene") {  // the scene file itself (JSON either way)
+        std::cout << e.sections.at(0).notes.at(0) << "\n";
+        return 0;
+    }
     std::cout << (args.json ? explain::to_json(e) + "\n" : explain::to_text(e));
     return 0;
 }

@@ -7,6 +7,7 @@
 // domain, naming the argument.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -84,6 +85,17 @@ Explanation intersect_sphere(const Ray& ray, const SphericalShell& shell);
 // ray: pixel (x, y) of a prepared scene: the camera's ray, the intervals, every sample (the engine
 // of `volref trace`, PixelTrace.h) and the pixel.
 Explanation ray(const PreparedScene& scene, int x, int y);
+
+// volpack-warp (issue 55): output pixel (x, y) of a render.profile "volpack" scene through VolPack's 2D
+// warp: the view's factorisation, the pixel mapped back, the stepped fixed-point fractions, the weight
+// table's entry, the four intermediate pixels, the float sums and the truncated bytes.
+Explanation volpack_warp(const PreparedScene& scene, int x, int y);
+// volpack-voxel: voxel (x, y, z): its central differences, gradient byte and normal code, the tables,
+// the 8-bit opacity and its correction, the shade-table entry.
+Explanation volpack_voxel(const PreparedScene& scene, std::int64_t x, std::int64_t y, std::int64_t z);
+// volpack-scene: the continuous scene the VolPack scene discretises (volpack_continuous_scene), as the
+// scene file JSON (one note), composited by the reference at `step` voxels.
+Explanation volpack_scene(const PreparedScene& scene, double step);
 
 // texture-fetch (issue 27): one linearly filtered fetch of a 3D texture (a u16 volume read as unorm16,
 // an f32 volume as float) at a coordinate (unnormalised texels, texel i centred at i + 0.5, or normalised

@@ -28,7 +28,7 @@ namespace volref::explain {
 
 const char* topics() {
     return "trilinear, composite, opacity-correction, classify-isovalue, classify-boundary, shade, coords, intersect, ray, "
-           "texture-fetch";
+           "texture-fetch, volpack-warp, volpack-voxel, volpack-scene";
 }
 
 namespace {
@@ -362,6 +362,27 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         options.empty_space_skipping = !o.has("--no-skipping");
         const PreparedScene prepared(scene, options);
         return ray(prepared, p[0], p[1]);
+    }
+    if (t == "volpack-warp" || t == "volpack-voxel" || t == "volpack-scene") {  // issue 55
+        const Options o(t, args, t == "volpack-warp"    ? std::set<std::string>{"--scene", "--pixel", "--set"}
+                                 : t == "volpack-voxel" ? std::set<std::string>{"--scene", "--voxel", "--set"}
+                                                        : std::set<std::string>{"--scene", "--step", "--set"});
+        const Scene scene = scene_of(o);
+        if (scene.render.profile != ProfileId::VolPack) throw Error("--scene: not a render.profile \"volpack\" scene");
+        const PreparedScene prepared(scene, RenderOptions{});
+        if (t == "volpack-warp") {
+            const auto p = parse_pixel(o.one("--pixel"), scene.image.width, scene.image.height);
+            return volpack_warp(prepared, p[0], p[1]);
+        }
+        if (t == "volpack-voxel") {
+            const auto v = parse_list("--voxel", o.one("--voxel"), 3, 3, "3 integers X,Y,Z");
+            for (double c : v)
+                if (c != std::floor(c)) throw Error("--voxel: expected 3 integers X,Y,Z, got \"" + o.one("--voxel") + "\"");
+            return volpack_voxel(prepared, std::int64_t(v[0]), std::int64_t(v[1]), std::int64_t(v[2]));
+        }
+        const double step = number_or(o, "--step", 0.125);
+        if (!(step > 0.0)) throw Error("--step: must be > 0 (voxels)");
+        return volpack_scene(prepared, step);
     }
     if (t == "texture-fetch") {
         const Options o(t, args, {"--unit", "--volume", "--normalized", "--at", "--points"});

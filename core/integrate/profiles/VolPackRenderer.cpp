@@ -487,3 +487,66 @@ CameraSpec VolPackRenderer::camera() const {
 }
 
 }  // namespace volref
+
+namespace volref {
+
+Scene volpack_continuous_scene(const Scene& scene, const VolPackRenderer& renderer, double step) {
+    const VolPackSpec& v = renderer.spec();
+    const std::string key = "render.profile_options.";
+    if (v.depth_cue) throw Error(key + "depth_cue: VolPack's exponential depth cueing has no continuous form in volref");
+    Scene c;
+    c.file = scene.file;
+    c.image = scene.image;
+    VolumeSpec vol;
+    vol.source = scene.volumes.front().source;
+    vol.interpolation = Interpolation::Trilinear;
+    TransferSpec& t = vol.transfer;
+    t.domain = TransferSpec::Domain::Data;
+    for (int i = 0; i < 256; ++i) t.opacity.push_back({double(i), double(v.scalar_table.entries[std::size_t(i)])});
+    t.color = {{0.0, 1.0, 1.0, 1.0}};
+    t.opacity_unit_distance = 1.0;  // one voxel (VolPack's voxels are unit cubes)
+    if (v.gradient_table)
+        for (int g = 0; g <= kGradMax; ++g) t.gradient_opacity.push_back({double(g), double(v.gradient_table->entries[std::size_t(g)])});
+    if (v.shaded) {
+        const int C = v.channels;
+        for (const auto* m : {&v.ambient, &v.diffuse, &v.specular})
+            if (C == 3 && ((*m)[1] != (*m)[0] || (*m)[2] != (*m)[0]))
+                throw Error(key + "shading.material: channels that differ have no continuous form in volref (its ka, kd, ks are scalars)");
+        ShadingSpec sh;
+        sh.model = ShadingSpec::Model::BlinnPhong;
+        sh.ka = v.ambient[0];
+        sh.kd = v.diffuse[0];
+        sh.ks = v.specular[0];
+        sh.n = v.shininess;
+        sh.two_sided = v.two_sided;
+        vol.shading = sh;
+        // The lights in object space as vpShadeTable takes them (MODEL^-1 of the eye-space vector);
+        // volref's L points towards the light: the reverse.
+        const std::vector<VolPackLight> lights =
+            v.lights ? *v.lights : std::vector<VolPackLight>{VolPackLight{glm::dvec3(0.57735), glm::dvec3(1.0)}};
+        glm::dvec3 sum(0.0);
+        for (const VolPackLight& l : lights) sum += l.color;
+        if (lights.empty() || std::fabs(sum.x - 1.0) > 1e-12 || (C == 3 && (std::fabs(sum.y - 1.0) > 1e-12 || std::fabs(sum.z - 1.0) > 1e-12)))
+            throw Error(key + "shading.lights: VolPack adds the ambient term once and volref once per light: "
+                              "the continuous form needs light colours that sum to white");
+        for (const VolPackLight& l : lights) {
+            Vector4 e{l.direction.x, l.direction.y, l.direction.z, 1.0};
+            if (v.lights) normalize3(e.data());
+            if (!solve_system(renderer.view().model, {&e})) throw Error(key + "rotate: the model matrix is singular");
+            LightSpec ls;
+            ls.type = LightSpec::Type::Directional;
+            ls.direction = -glm::normalize(glm::dvec3(e[0], e[1], e[2]));
+            ls.color = l.color;
+            c.lights.push_back(ls);
+        }
+    }
+    c.volumes = {vol};
+    c.camera = renderer.camera();
+    c.render.projection = Projection::Composite;
+    c.render.profile = ProfileId::Reference;
+    c.render.step = step;
+    c.render.step_units = StepUnits::Voxel;
+    return c;
+}
+
+}  // namespace volref

@@ -111,4 +111,14 @@ private:
     double in_x_incr_ = 0.0, in_y_incr_ = 0.0, denom_ = 0.0;
 };
 
+// The continuous scene a VolPack scene discretises (`volref explain volpack-scene`; docs/conventions.md,
+// "VolPack", the continuous scene): the same volume and pixels (camera()), the scalar table as a
+// transfer function's opacity rows at the integer values (one voxel's opacity seen face on: opacity unit
+// distance one voxel), the gradient table as gradient_opacity rows over |grad f| = VolPack's field,
+// white colour, VolPack's one material and lights as Blinn-Phong (N . L = VolPack's n . l: volref's
+// light is the reverse of VolPack's object-space light vector), composited by the reference at `step`
+// voxels. Throws volref::Error naming the key that has no continuous form in volref (depth cueing, a
+// material whose channels are not one colour, lights whose colours do not sum to one white ambient).
+Scene volpack_continuous_scene(const Scene& scene, const VolPackRenderer& renderer, double step);
+
 }  // namespace volref

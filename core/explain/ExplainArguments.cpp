@@ -358,6 +358,8 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         const Scene scene = scene_of(o);
         const auto p = parse_pixel(o.one("--pixel"), scene.image.width, scene.image.height);
         if (is_first_hit(scene.render.projection)) throw Error("trace: first-hit is not supported yet");
+        if (scene.render.profile == ProfileId::VolPack)
+            throw Error("--scene: a volpack pixel is VolPack's warp of its intermediate image, not a ray: explain volpack-warp works it");
         RenderOptions options;
         options.empty_space_skipping = !o.has("--no-skipping");
         const PreparedScene prepared(scene, options);

@@ -99,6 +99,15 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.x = x;
     t.y = y;
     t.ray = scene.pixel_ray(x, y);
+    t.projection = r.projection;
+    t.order = r.order;
+    if (!v.classifier) {
+        // volpack (issue 55): VolPack's own renderer has no ray of volref's: the rows are the warp's taps
+        // (each an intermediate pixel, `alpha` its weight) and then the pixel (explain volpack-warp).
+        Collector collector(scene, t.samples);
+        t.pixel = scene.trace_pixel(x, y, collector);
+        return t;
+    }
     t.intervals = scene.intervals(t.ray);
     t.step = v.step;
     {  // issue 32: every sample is kept (and printed): counted against the memory limit before the march
@@ -110,8 +119,6 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
                          std::to_string(x) + ", " + std::to_string(y) + ") at render.step " + json_reader::format_number(t.step));
     }
     t.unit_distance = v.classifier->unit_distance();
-    t.projection = r.projection;
-    t.order = r.order;
     t.has_gradient = v.gradient != nullptr;
     t.shaded = v.shader != nullptr && is_composite(t.projection);
     t.lights = t.shaded ? v.shader->lights().size() : 0;

@@ -194,6 +194,9 @@ std::uint64_t count_sample_positions(const PreparedScene& prepared, const Scene&
 }  // namespace
 
 Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats* stats) {
+    if (options.error_estimate && scene.render.profile == ProfileId::VolPack)
+        throw Error("--error: step doubling halves render.step, and volpack has none (VolPack samples its voxel slices); "
+                    "its error channel is already written: where a byte may truncate either way");
     if (options.error_estimate && scene.render.integrator == IntegrationMethod::Fixed) {
         // Step doubling: the image at h, and its error estimate from the image at h / 2.
         RenderOptions single = options;

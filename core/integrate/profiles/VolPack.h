@@ -75,6 +75,10 @@ std::array<double, 3> code_normal(int code);
 // vpVolumeNormals / vpScanlineNormals over the 8-bit scalars: per voxel the 13-bit normal code and
 // the 8-bit gradient magnitude (rint(|Delta| / 2), Debian's library; 0 and code 0 on the volume's
 // boundary and for |Delta| < VP_EPS). `delta` (optional) receives the integer central differences.
+// The integer central differences of voxel (x, y, z) as vpScanlineNormals takes them; all 0 on the
+// volume's boundary (x at 0 or n - 1, or the scanline's y or z at 0 or n - 1).
+std::array<int, 3> central_differences(const std::uint8_t* scalars, const std::array<std::int64_t, 3>& dims,
+                                       std::int64_t x, std::int64_t y, std::int64_t z);
 struct VoxelNormals {
     std::vector<std::uint16_t> code;
     std::vector<std::uint8_t> gradient;

@@ -265,6 +265,13 @@ void VolPackRenderer::depth_cue() {
     const float depth_di = float(w.depth_di), depth_dj = float(w.depth_dj);
     const float slice_u = float(w.shear_i * slicenum + w.trans_i), slice_v = float(w.shear_j * slicenum + w.trans_j);
     const float left_depth = float(w.depth_000 + w.depth_dk * slicenum - double(slice_u * depth_di) - double(slice_v * depth_dj));
+    // The table's length as VolPack sizes it from the largest depth of the image (a fresh context's
+    // table is empty): a pixel past it is VolPack's VPBug abort ("depth too large").
+    const float W = float(w.intermediate_width), H = float(w.intermediate_height);
+    const float max_depth = depth_di > 0 ? (depth_dj > 0 ? left_depth + depth_di * W + depth_dj * H : left_depth + depth_di * W)
+                                         : (depth_dj > 0 ? left_depth + depth_dj * H : left_depth);
+    const int max_depth_int = int(max_depth * depth_quant);
+    const int table_len = max_depth_int >= 0 ? max_depth_int + 1 : 0;
     const float di_quant = depth_di * depth_quant, dj_quant = depth_dj * depth_quant;
     float left_quant = left_depth * depth_quant;
     const int C = spec_.channels;
@@ -275,6 +282,9 @@ void VolPackRenderer::depth_cue() {
             int d = int(pixel_quant);
             pixel_quant += di_quant;
             if (d < 0) d = 0;
+            if (d >= table_len)
+                throw Error("render.profile_options.depth_cue: VolPack stops on this view (VPDepthCueIntImage: \"depth too "
+                            "large\", a VPBug abort): the volume lies behind depth 0 of the window; move window's near and far");
             const float factor = float(front * std::exp(-density * (1.0 - d * kDepthCueQuantization)));
             IntermediatePixel& p = image_[std::size_t(j) * std::size_t(w.intermediate_width) + std::size_t(i)];
             for (int c = 0; c < C; ++c) p.color[c] *= factor;
@@ -435,8 +445,7 @@ VolPackRenderer::Voxel VolPackRenderer::voxel(std::int64_t x, std::int64_t y, st
     v.scalar = scalars_[i];
     v.gradient = normals_.gradient[i];
     v.code = normals_.code[i];
-    const VoxelNormals one = volume_normals(scalars_.data(), dims_, true);
-    for (int a = 0; a < 3; ++a) v.delta[std::size_t(a)] = one.delta[i][std::size_t(a)];
+    v.delta = central_differences(scalars_.data(), dims_, x, y, z);
     v.cls = classify_voxel(spec_, view_, v.scalar, v.gradient);
     v.normal = code_normal(v.code);
     for (int c = 0; c < spec_.channels; ++c) v.shade[c] = shade_table_[std::size_t(v.code) * std::size_t(spec_.channels) + std::size_t(c)];

@@ -1030,7 +1030,11 @@ VolPackSpec read_volpack_options(ObjectReader& po) {
         }
         s.two_sided = sr.boolean("two_sided", false);
     }
+    // vpSetd: VP_MIN_VOXEL_OPACITY in [0, 1] or exactly -1 (every voxel kept), else VPERROR_BAD_VALUE.
     s.min_voxel_opacity = po.number("min_voxel_opacity", 0.0, Range::closed(-1.0, 1.0));
+    if (s.min_voxel_opacity < 0.0 && s.min_voxel_opacity != -1.0)
+        po.fail("min_voxel_opacity", "expected a number in [0, 1] or -1 (vpSetd returns VPERROR_BAD_VALUE), got " +
+                                         format_number(s.min_voxel_opacity));
     s.max_ray_opacity = po.number("max_ray_opacity", 1.0, Range::left_open(0.0, 1.0));
     if (const Json* d = po.find("depth_cue")) {
         ObjectReader dr(*d, po.path("depth_cue"), ctx);
@@ -1164,7 +1168,7 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
         const Json& vol = one ? *one : element(*r.find("volumes"), 0);
         for (const char* k : {"transfer", "classification", "shading", "gradient", "transform", "clip_planes", "crop",
                               "bounds", "classify", "interpolation", "origin", "spacing"})
-            if (vol.contains(k)) ctx.fail(std::string("volume.") + k, why);
+            if (vol.contains(k)) ctx.fail(std::string(one ? "volume." : "volumes[0].") + k, why);
         if (r.find("camera")) ctx.fail("camera", std::string(why) + ": the view is rotate and window");
         if (r.find("lights")) ctx.fail("lights", std::string(why) + ": the lights are shading.lights");
         if (scene.image.background != glm::dvec4(0.0))

@@ -1043,6 +1043,8 @@ TEST(VolPack, BadInputsNameTheirKey) {
         {"max_ray_opacity 0", po + "max_ray_opacity", [&](json& j) { opt(j)["max_ray_opacity"] = 0; }},
         {"max_ray_opacity 1.5", po + "max_ray_opacity", [&](json& j) { opt(j)["max_ray_opacity"] = 1.5; }},
         {"min_voxel_opacity 2", po + "min_voxel_opacity", [&](json& j) { opt(j)["min_voxel_opacity"] = 2; }},
+        // vpSetd takes [0, 1] or exactly -1
+        {"min_voxel_opacity -0.5", po + "min_voxel_opacity", [&](json& j) { opt(j)["min_voxel_opacity"] = -0.5; }},
         {"depth cue front 0", po + "depth_cue.front", [&](json& j) { opt(j)["depth_cue"] = {{"front", 0}}; }},
         {"7 lights", po + "shading.lights",
          [&](json& j) { opt(j)["shading"] = {{"lights", json::array()}};
@@ -1077,6 +1079,15 @@ TEST(VolPack, BadInputsNameTheirKey) {
         {"rotated, axis z seen edge-on", po + "axis",
          [&](json& j) {
              opt(j)["rotate"] = json::parse(R"([["x", 90]])");  // eye z = c z - s y: the y axis is the view, z edge-on
+             opt(j)["axis"] = "z";
+         },
+         true},
+        // Nearly edge-on but past VolPack's test (it scales by the 2 x 2 viewport): the shear
+        // (k - 1) |tan| would make an intermediate image of about 10^9 x 3 pixels.
+        {"axis z nearly edge-on", po + "axis",
+         [&](json& j) {
+             j["image"] = {{"width", 2}, {"height", 2}};
+             opt(j)["rotate"] = json::parse(R"([["y", 89.9999999]])");
              opt(j)["axis"] = "z";
          },
          true},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/Error.h"
@@ -168,8 +169,18 @@ View factor_view(const VolPackSpec& spec, const std::array<std::int64_t, 3>& dim
     v.shear_i = (pvm[0][2] * pvm[1][1] - pvm[0][1] * pvm[1][2]) / denom;
     v.shear_j = (pvm[0][0] * pvm[1][2] - pvm[1][0] * pvm[0][2]) / denom;
     v.reverse_slice_order = !(pvm[2][0] * v.shear_i + pvm[2][1] * v.shear_j - pvm[2][2] > 0);
-    v.intermediate_width = v.icount + 1 + int(std::ceil((v.kcount - 1) * std::fabs(v.shear_i)));
-    v.intermediate_height = v.jcount + 1 + int(std::ceil((v.kcount - 1) * std::fabs(v.shear_j)));
+    // The intermediate image's size (held in int as VolPack holds it): a view nearly edge-on to the
+    // slices (an axis override) shears them past any memory; refused before the int overflows.
+    const double iw = v.icount + 1 + std::ceil((v.kcount - 1) * std::fabs(v.shear_i));
+    const double ih = v.jcount + 1 + std::ceil((v.kcount - 1) * std::fabs(v.shear_j));
+    if (!(iw * ih <= double(1 << 30))) {
+        char size[96];
+        std::snprintf(size, sizeof size, "%.4g x %.4g", iw, ih);
+        throw Error(std::string(spec.axis ? "render.profile_options.axis" : "render.profile_options.rotate") +
+                    ": the slices are seen nearly edge-on: VolPack's intermediate image would be " + size + " pixels");
+    }
+    v.intermediate_width = int(iw);
+    v.intermediate_height = int(ih);
     v.trans_i = v.shear_i >= 0.0 ? 1.0 : 1.0 - v.shear_i * (v.kcount - 1);
     v.trans_j = v.shear_j >= 0.0 ? 1.0 : 1.0 - v.shear_j * (v.kcount - 1);
     v.depth_di = pvm[2][0];

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/Error.h"
+#include "core/MemoryLimit.h"
 
 namespace volref {
 
@@ -149,6 +150,10 @@ VolPackRenderer::VolPackRenderer(const Volume& volume, const VolPackSpec& spec, 
         throw Error("volume.source: VolPack's scalar field is 8-bit (vpVolumeNormals and vpClassifyScalars read unsigned "
                     "char); this volume's voxels are not u8 (convert it, e.g. volref resample, or quantise it)");
     view_ = factor_view(spec_, dims_, width_, height_);
+    check_memory(std::size_t(view_.intermediate_width) * std::size_t(view_.intermediate_height) * sizeof(IntermediatePixel),
+                 std::string(spec_.axis ? "render.profile_options.axis" : "render.profile_options.rotate") +
+                     ": VolPack's intermediate image of " + std::to_string(view_.intermediate_width) + " x " +
+                     std::to_string(view_.intermediate_height) + " pixels");
     const std::size_t n = volume.values.size();
     scalars_.resize(n);
     for (std::size_t i = 0; i < n; ++i) scalars_[i] = std::uint8_t(volume.values[i]);

@@ -32,6 +32,7 @@ import numpy as np
 SCALAR_MAX = 255
 GRAD_MAX = 221  # VP_GRAD_MAX
 MAX_LIGHTS = 6  # VP_MAX_LIGHTS
+VP_EPS = 1.0e-11
 # volref-only variant rules: known, ignored here.
 VARIANT_KEYS = {"warp_weights", "normal_code", "correction_order", "framebuffer_band"}
 PROFILE_KEYS = {"rotate", "concat", "window", "scalar_table", "gradient_table", "shading", "min_voxel_opacity",
@@ -225,39 +226,84 @@ def volpack_args(scene_path, workdir, stem=None):
 def predicted_view(options, dims, width, height):
     """VolPack's principal axis and intermediate image size recomputed from the scene (the shear-warp
     factorisation of VolPack's vp_view.c, VPComputeViewTransform and FactorAffineView, re-derived):
-    ('x' | 'y' | 'z', width, height): vm = viewport . PROJECT . MODEL . prematrix (voxel index to the unit
-    cube centred at n / 2), the object axis whose image direction has the largest |z| (ties x, y, z), and
-    width = icount + 1 + ceil((kcount - 1) |shear_i|), height likewise. Rotations as vpRotate builds them (a rotation by
-    -degrees in the right-handed sense), composed M R (concat right) or R M (left)."""
-    def rotation(axis, degrees):
-        c, s = math.cos(degrees * math.pi / 180.0), math.sin(degrees * math.pi / 180.0)
-        m = np.eye(4)
+    ('x' | 'y' | 'z', width, height): vm = viewport . PROJECT . VIEW . MODEL . prematrix (voxel index to
+    the unit cube centred at n / 2), the object axis whose normalised image direction has the largest |z|
+    (ties x, y, z), and width = icount + 1 + ceil((kcount - 1) |shear_i|), height likewise. Rotations as
+    VPLoadRotation builds them (a rotation by -degrees in the right-handed sense), composed M R (concat
+    right) or R M (left). Every product, sum and quotient in double in VolPack's own order (MatrixMult:
+    p_ij = 0 + a_i0 b_0j + ... + a_i3 b_3j; vpNormalize3), not numpy's: a view at an exact multiple of
+    90 degrees leaves shears of 1e-16 whose ceil decides the size. VPERROR_SINGULAR: (axis, None, None)."""
+    def mult(a, b):  # MatrixMult (vp_linalg.c)
+        p = [[0.0] * 4 for _ in range(4)]
+        for i in range(4):
+            for j in range(4):
+                acc = 0.0
+                for k in range(4):
+                    acc += a[i][k] * b[k][j]
+                p[i][j] = acc
+        return p
+
+    def eye():
+        return [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
+
+    def rotation(axis, degrees):  # VPLoadRotation
+        radians = degrees * math.pi / 180.0
+        s, c = math.sin(radians), math.cos(radians)
+        m = eye()
         a, b = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
-        m[a, a], m[a, b], m[b, a], m[b, b] = c, s, -s, c
+        m[a][a], m[a][b], m[b][a], m[b][b] = c, s, -s, c
         return m
-    model = np.eye(4)
+
+    def window(l, r, b, t, n, f):  # vpWindow, VP_PARALLEL, on the identity (exact)
+        m = eye()
+        m[0][0], m[1][1], m[2][2] = 2.0 / (r - l), 2.0 / (t - b), 2.0 / (f - n)
+        m[0][3], m[1][3], m[2][3] = (l + r) / (l - r), (b + t) / (b - t), (n + f) / (n - f)
+        return m
+
+    model = eye()
+    left = options.get("concat", "right") == "left"
     for axis, degrees in options.get("rotate", []):
         r = rotation(axis, float(degrees))
-        model = r @ model if options.get("concat", "right") == "left" else model @ r
-    l, r_, b, t, n, f = options.get("window", [-0.5, 0.5, -0.5, 0.5, -0.5, 0.5])
-    project = np.eye(4)
-    project[0, 0], project[1, 1], project[2, 2] = 2 / (r_ - l), 2 / (t - b), 2 / (f - n)
-    project[0, 3], project[1, 3], project[2, 3] = (l + r_) / (l - r_), (b + t) / (b - t), (n + f) / (n - f)
-    scale = 1.0 / max(dims)
-    pre = np.diag([scale, scale, scale, 1.0])
-    pre[:3, 3] = [-d * scale * 0.5 for d in dims]
-    viewport = np.diag([0.5 * width, 0.5 * height, -0.5, 1.0])
-    viewport[:3, 3] = [0.5 * width, 0.5 * height, 0.5]
-    vm = viewport @ project @ model @ pre
-    zs = [abs(vm[2, a] / np.linalg.norm(vm[:3, a])) for a in range(3)]
-    x, y, z = zs
+        model = mult(r, model) if left else mult(model, r)
+    project = window(*(float(v) for v in options.get("window", [-0.5, 0.5, -0.5, 0.5, -0.5, 0.5])))
+    maxdim = max(dims)
+    scale = 1.0 / float(maxdim)
+    pre = eye()
+    pre[0][0] = pre[1][1] = pre[2][2] = scale
+    for a in range(3):
+        pre[a][3] = -dims[a] * scale * 0.5
+    viewport = eye()
+    viewport[0][0] = viewport[0][3] = 0.5 * width
+    viewport[1][1] = viewport[1][3] = 0.5 * height
+    viewport[2][2], viewport[2][3] = -0.5, 0.5
+    vm = mult(viewport, mult(project, mult(eye(), mult(model, pre))))
+
+    def aligned(a):  # vpMatrixVectorMult4 of a unit vector, vpNormalize3, |z|
+        v = [vm[i][a] for i in range(3)]  # 0 + m_i0 e_0 + ... + m_i3 e_3: m_ia exactly
+        magsqr = 0.0
+        for i in range(3):
+            magsqr += v[i] * v[i]
+        if abs(magsqr) < VP_EPS:
+            return 0.0
+        return abs(v[2] * (1.0 / math.sqrt(magsqr)))
+    x, y, z = (aligned(a) for a in range(3))
     best = ("x" if x >= z else "z") if x >= y else ("y" if y >= z else "z")
-    best = options.get("axis", "auto") if options.get("axis", "auto") != "auto" else best
+    override = options.get("axis", "auto")
+    if override != "auto":
+        if {"x": x, "y": y, "z": z}[override] < VP_EPS:
+            return (override, None, None)
+        best = override
     perm = {"x": (1, 2, 0), "y": (2, 0, 1), "z": (0, 1, 2)}[best]  # (i, j, k) object axes
-    pvm = vm[:, list(perm) + [3]]
-    denom = pvm[0, 0] * pvm[1, 1] - pvm[0, 1] * pvm[1, 0]
-    shear_i = (pvm[0, 2] * pvm[1, 1] - pvm[0, 1] * pvm[1, 2]) / denom
-    shear_j = (pvm[0, 0] * pvm[1, 2] - pvm[1, 0] * pvm[0, 2]) / denom
+    p = [[0.0] * 4 for _ in range(4)]
+    for row, axis in enumerate(perm):
+        p[axis][row] = 1.0
+    p[3][3] = 1.0
+    pvm = mult(vm, p)
+    denom = pvm[0][0] * pvm[1][1] - pvm[0][1] * pvm[1][0]
+    if abs(denom) < VP_EPS:
+        return (best, None, None)
+    shear_i = (pvm[0][2] * pvm[1][1] - pvm[0][1] * pvm[1][2]) / denom
+    shear_j = (pvm[0][0] * pvm[1][2] - pvm[1][0] * pvm[0][2]) / denom
     icount, jcount, kcount = (dims[a] for a in perm)
     return (best, icount + 1 + math.ceil((kcount - 1) * abs(shear_i)),
             jcount + 1 + math.ceil((kcount - 1) * abs(shear_j)))

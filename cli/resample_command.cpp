@@ -19,7 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 #include "core/Error.h"
 #include "core/sample/Resample.h"
 #include "core/io/NrrdWriter.h"

@@ -18,6 +18,10 @@ inline constexpr double kSegmentSlack = 1e-9;
 // that is an integer up to rounding from gaining or losing a level.
 inline constexpr double kSliceSlack = 1e-9;
 
+// Pre-integrated segments (render.profile_options.preintegration; transfer/PreIntegration.h): the table
+// has 2 to kPreIntegrationMaxIntervals intervals per axis.
+inline constexpr int kPreIntegrationMaxIntervals = 2048;
+
 // Intervals shorter than this (world units) are dropped: a ray grazing a box edge or face has a
 // chord of length 0 (or a rounding error of it) and contributes nothing.
 inline constexpr double kMinIntervalLength = 0.0;

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <vector>
 
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 #include "core/Error.h"
 
 namespace volref {

@@ -23,7 +23,7 @@
 // out of range, coordinates that are not finite or beyond 1e100, cell types other than 10, cells
 // without 4 points, counts that do not match (CELL_TYPES against CELLS, the sizes of CELLS, OFFSETS
 // against CONNECTIVITY), truncated data, a file with no tetrahedra, and a file larger than the memory
-// limit (core/io/InputFile.h check_whole_file, before it is read).
+// limit (core/InputFile.h check_whole_file, before it is read).
 //
 // The region (tetrahedra_boundary): the union of the tetrahedra. Its boundary is the set of faces
 // not cancelled by the same face of another tetrahedron in the opposite orientation: for a conforming

@@ -12,7 +12,7 @@
 
 #include "core/Conventions.h"
 #include "core/Lanes.h"
-#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/GaussKronrod.h"
 #include "transfer/TransferFunction.h"
 
 namespace volref {

@@ -31,9 +31,8 @@ class TransferFunction;
 
 // The opacity is clamped to 1 - 2^-20 so that the extinction -log1p(-a) / l stays finite (at most
 // 13.9 / l: one unit distance at the clamp lets 2^-20 through); the table has 2 to
-// kPreIntegrationMaxIntervals intervals per axis (render.profile_options.preintegration).
+// conventions::kPreIntegrationMaxIntervals intervals per axis (render.profile_options.preintegration).
 inline constexpr double kPreIntegrationMaxOpacity = 1.0 - 0x1p-20;
-inline constexpr int kPreIntegrationMaxIntervals = 2048;
 
 struct SegmentIntegral {
     double sigma_bar = 0.0;  // mean extinction over the segment (per unit length)

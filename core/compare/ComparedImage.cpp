@@ -6,7 +6,7 @@
 
 #include "core/Error.h"
 #include "core/film/ImageFileModule.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 
 namespace volref::compare {
 

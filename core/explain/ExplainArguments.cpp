@@ -15,7 +15,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 #include "core/explain/Explain.h"
 #include "core/explain/PixelTrace.h"
 #include "core/grid/Volume.h"

@@ -29,7 +29,7 @@
 #include "core/Cancellation.h"
 #include "core/Error.h"
 #include "core/grid/Volume.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 
 namespace volref::io {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/Error.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 #include "core/Conventions.h"
 #include "core/io/ByteDecoding.h"
 #include "core/io/DenReader.h"

@@ -19,10 +19,9 @@
 #include "core/Angles.h"
 #include "core/Conventions.h"
 #include "core/Error.h"
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 #include "core/scene/JsonReader.h"
 #include "core/scene/SceneNames.h"
-#include "transfer/PreIntegration.h"
 
 namespace volref {
 
@@ -1099,7 +1098,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"preintegration"});
         s.profile_options.preintegration =
-            int(po.integer("preintegration", 0, Range::closed(2, kPreIntegrationMaxIntervals)));
+            int(po.integer("preintegration", 0, Range::closed(2, conventions::kPreIntegrationMaxIntervals)));
     } else if (const Json* o = r.find("profile_options");
                o && (s.profile == ProfileId::Volumizer || s.profile_rules.placement == ProfileRules::Placement::Slices)) {  // issue 54
         ObjectReader po(*o, r.path("profile_options"), ctx);

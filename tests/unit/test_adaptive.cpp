@@ -14,7 +14,7 @@
 #include "TestScenes.h"
 #include "core/Cancellation.h"
 #include "core/Error.h"
-#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/GaussKronrod.h"
 #include "core/integrate/adaptive/CellCubic.h"
 #include "core/film/StepDoubling.h"
 #include "core/render/PreparedScene.h"

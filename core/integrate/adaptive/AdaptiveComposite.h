@@ -19,7 +19,7 @@
 #include "core/Cancellation.h"
 #include "core/Conventions.h"
 #include "core/integrate/Integrator.h"
-#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/GaussKronrod.h"
 #include "core/integrate/march/Accumulators.h"
 
 namespace volref {

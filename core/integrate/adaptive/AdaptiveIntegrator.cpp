@@ -13,7 +13,7 @@
 #include "core/integrate/adaptive/AdaptiveCellWalk.h"
 #include "core/integrate/adaptive/AdaptiveComposite.h"
 #include "core/integrate/adaptive/CellCubic.h"
-#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/GaussKronrod.h"
 #include "core/integrate/march/CompensatedSum.h"
 #include "geometry/ShellCoordinates.h"
 #include "core/integrate/march/Accumulators.h"

@@ -25,7 +25,7 @@
 // sigma(t) = -log1p(-a(t)) / l, T(t) = exp(-tau(t)), tau(t) = integral of sigma up to t,
 //   C = integral c(t) sigma(t) T(t) dt,   A = 1 - T(end) = -expm1(-tau_total).
 // A rule on [a, b] gives Delta tau = integral of sigma (K15) and E = integral c sigma exp(-(tau(t) - tau(a)))
-// (K15, with tau(t) - tau(a) at the nodes from the integration matrix, AdaptiveQuadrature.h), and the
+// (K15, with tau(t) - tau(a) at the nodes from the integration matrix, core/GaussKronrod.h), and the
 // same by G7. A candidate [a', b'] with rule P and halves L, R has the estimate
 //   e = |P - (L + R)| + |K15 - G7|_L + |K15 - G7|_R   (E of L + R = E_L + exp(-Delta tau_L) E_R),
 // for the emission (e_E, max over channels) and the optical depth (e_tau), times kAdaptiveWeakSafety

@@ -1,4 +1,4 @@
-#include "core/io/InputFile.h"
+#include "core/InputFile.h"
 
 #include <sys/stat.h>
 

@@ -1,4 +1,4 @@
-#include "core/integrate/adaptive/AdaptiveQuadrature.h"
+#include "core/GaussKronrod.h"
 
 #include <vector>
 

@@ -1,4 +1,4 @@
-// AdaptiveQuadrature: the Gauss-Kronrod G7/K15 pair on [-1, 1] and its integration matrices.
+// GaussKronrod: the Gauss-Kronrod G7/K15 pair on [-1, 1] and its integration matrices.
 //
 // K15 (15 nodes x_0 < ... < x_14, exact for polynomials of degree 22) contains the 7 Gauss-Legendre
 // nodes of G7 (exact to degree 13) at the odd indices 1, 3, ..., 13; |K15 - G7| estimates the error of

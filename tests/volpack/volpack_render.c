@@ -12,6 +12,7 @@
  *                            [--light DX DY DZ R G B]... [--no-lights] [--two-sided]]
  *                  [--min-voxel-opacity X] [--max-ray-opacity X] [--depth-cue FRONT DENSITY]
  *                  [--channels 1|3] [--path classified|raw] [--axis auto|x|y|z]
+ *                  [--time] [--repeat N]
  *
  * FILE (--volume): NX * NY * NZ bytes, x fastest. Table files: 256 numbers separated by white space
  * (the gradient table uses its first VP_GRAD_MAX + 1 = 222). A ramp is vpRamp's points, x integers
@@ -32,9 +33,19 @@
  * "volpack_render: view_axis=x|y|z intermediate=WxH" (vpGeti VP_VIEW_AXIS, VP_INTERMEDIATE_WIDTH/HEIGHT).
  * Every VolPack call is checked: an error prints one line naming the call and vpGetErrorString, exit 1;
  * usage errors exit 2.
+ *
+ * --repeat N (default 1; for benchmarks, bench/volpack/volpack_error.py) renders the frame N times: each
+ * time vpShadeTable (shaded only) and the render call (vpRenderClassifiedVolume; vpRenderRawVolume with
+ * --path raw) on a zeroed image, vpClassifyVolume once before the first render, so the first frame makes
+ * the calls of a single render in the same order; every frame's image must equal the first (exit 1 if
+ * not); the last is written. --time prints one more line on stderr, wall-clock seconds (CLOCK_MONOTONIC)
+ * around each call alone: "volpack_render: timing {"normals_s": vpVolumeNormals, "classify_s":
+ * vpClassifyVolume (0 on the raw path), "shade_s": [per frame], "frames_s": [the render call, per frame],
+ * "median_s": the median of frames_s}".
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <time.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -139,6 +150,17 @@ static void fill_ramp(const char *spec, float *table, int max_x, const char *wha
     CHECK(vpRamp(table, sizeof(float), n, xs, ys));
 }
 
+static double now_s(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 static int parse_axis(const char *s, const char *what) {
     if (!strcmp(s, "x")) return VP_X_AXIS;
     if (!strcmp(s, "y")) return VP_Y_AXIS;
@@ -192,10 +214,14 @@ int main(int argc, char **argv) {
     float scalar_table[TABLE_ENTRIES], gradient_table[TABLE_ENTRIES];
     float *shade_table;
     size_t shade_entries, voxel_count, n;
-    unsigned char *scalars, *image;
+    unsigned char *scalars, *image, *first_image = NULL;
     Voxel *voxels;
     vpContext *vpc;
     int i, k, view_axis, int_width, int_height, depth;
+    int timing = 0;
+    long repeat = 1, r;
+    double normals_s = 0.0, classify_s = 0.0, t0, *frames_s, *shade_s, *sorted_s;
+    size_t image_bytes;
 
     for (i = 1; i < argc; i++) {
         const char *arg = argv[i];
@@ -297,6 +323,12 @@ int main(int argc, char **argv) {
             NEED(1);
             ++i;
             axis_override = !strcmp(argv[i], "auto") ? VP_NO_AXIS : parse_axis(argv[i], "--axis");
+        } else if (!strcmp(arg, "--time")) {
+            timing = 1;
+        } else if (!strcmp(arg, "--repeat")) {
+            NEED(1);
+            repeat = parse_integer(argv[++i], arg);
+            if (repeat < 1 || repeat > 100000) usage_error("--repeat: expected 1..100000, got %ld", repeat);
         } else {
             usage_error("unknown argument \"%s\"", arg);
         }
@@ -327,7 +359,9 @@ int main(int argc, char **argv) {
     CHECK(vpSetVoxelField(vpc, GRADIENT_FIELD, sizeof(unsigned char), offsetof(Voxel, gradient), VP_GRAD_MAX));
     CHECK(vpSetRawVoxels(vpc, voxels, (int)(voxel_count * sizeof(Voxel)), sizeof(Voxel),
                          (int)(dims[0] * sizeof(Voxel)), (int)(dims[0] * dims[1] * sizeof(Voxel))));
+    t0 = now_s();
     CHECK(vpVolumeNormals(vpc, scalars, (int)voxel_count, DENSITY_FIELD, GRADIENT_FIELD, NORMAL_FIELD));
+    normals_s = now_s() - t0;
 
     /* Classification: param 0 = density (256 entries), param 1 = gradient magnitude (222 entries). */
     if (scalar_file)
@@ -387,27 +421,70 @@ int main(int argc, char **argv) {
     if (axis_override != VP_NO_AXIS) CHECK(vpSeti(vpc, VP_AXIS_OVERRIDE, axis_override));
 
     depth = channels == 1 ? 2 : 4;
-    image = calloc((size_t)width * (size_t)height, (size_t)depth);
-    if (!image) fail("out of memory");
+    image_bytes = (size_t)width * (size_t)height * (size_t)depth;
+    image = calloc(image_bytes, 1);
+    frames_s = calloc((size_t)repeat, sizeof(double));
+    shade_s = calloc((size_t)repeat, sizeof(double));
+    sorted_s = calloc((size_t)repeat, sizeof(double));
+    if (!image || !frames_s || !shade_s || !sorted_s) fail("out of memory");
     CHECK(vpSetImage(vpc, image, width, height, width * depth, channels == 1 ? VP_LUMINANCEA : VP_RGBA));
     if (have_max) CHECK(vpSetd(vpc, VP_MAX_RAY_OPACITY, max_opacity));
-    if (shaded) CHECK(vpShadeTable(vpc));
 
-    if (path_raw) {
-        CHECK(vpRenderRawVolume(vpc));
-    } else {
-        CHECK(vpClassifyVolume(vpc));
-        CHECK(vpRenderClassifiedVolume(vpc));
+    for (r = 0; r < repeat; r++) {
+        memset(image, 0, image_bytes);
+        if (shaded) {
+            t0 = now_s();
+            CHECK(vpShadeTable(vpc));
+            shade_s[r] = now_s() - t0;
+        }
+        if (path_raw) {
+            t0 = now_s();
+            CHECK(vpRenderRawVolume(vpc));
+            frames_s[r] = now_s() - t0;
+        } else {
+            if (r == 0) {
+                t0 = now_s();
+                CHECK(vpClassifyVolume(vpc));
+                classify_s = now_s() - t0;
+            }
+            t0 = now_s();
+            CHECK(vpRenderClassifiedVolume(vpc));
+            frames_s[r] = now_s() - t0;
+        }
+        if (repeat > 1) {
+            if (r == 0) {
+                first_image = malloc(image_bytes);
+                if (!first_image) fail("out of memory");
+                memcpy(first_image, image, image_bytes);
+            } else if (memcmp(first_image, image, image_bytes) != 0) {
+                fail("--repeat: frame %ld differs from the first", r + 1);
+            }
+        }
     }
     CHECK(vpGeti(vpc, VP_VIEW_AXIS, &view_axis));
     CHECK(vpGeti(vpc, VP_INTERMEDIATE_WIDTH, &int_width));
     CHECK(vpGeti(vpc, VP_INTERMEDIATE_HEIGHT, &int_height));
     fprintf(stderr, "%s: view_axis=%c intermediate=%dx%d\n", program,
             view_axis == VP_X_AXIS ? 'x' : view_axis == VP_Y_AXIS ? 'y' : 'z', int_width, int_height);
+    if (timing) {
+        memcpy(sorted_s, frames_s, (size_t)repeat * sizeof(double));
+        qsort(sorted_s, (size_t)repeat, sizeof(double), compare_doubles);
+        fprintf(stderr, "%s: timing {\"normals_s\": %.9f, \"classify_s\": %.9f, \"shade_s\": [", program, normals_s,
+                classify_s);
+        for (r = 0; r < repeat; r++) fprintf(stderr, "%s%.9f", r ? ", " : "", shade_s[r]);
+        fprintf(stderr, "], \"frames_s\": [");
+        for (r = 0; r < repeat; r++) fprintf(stderr, "%s%.9f", r ? ", " : "", frames_s[r]);
+        fprintf(stderr, "], \"median_s\": %.9f}\n",
+                repeat % 2 ? sorted_s[repeat / 2] : 0.5 * (sorted_s[repeat / 2 - 1] + sorted_s[repeat / 2]));
+    }
     write_pam(output_path, image, width, height, depth);
 
     vpDestroyContext(vpc);
     free(image);
+    free(first_image);
+    free(frames_s);
+    free(shade_s);
+    free(sorted_s);
     free(shade_table);
     free(voxels);
     free(scalars);

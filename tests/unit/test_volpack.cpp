@@ -22,6 +22,7 @@
 #include "core/grid/Volume.h"
 #include "core/integrate/profiles/VolPack.h"
 #include "core/integrate/profiles/VolPackRenderer.h"
+#include "core/render/PreparedScene.h"
 #include "core/render/Renderer.h"
 #include "core/scene/SceneLoader.h"
 #include "core/scene/SceneWriter.h"
@@ -1146,4 +1147,40 @@ TEST(VolPack, ThreadCountDoesNotChangeTheImage) {
             for (int x = 0; x < one.width; ++x) lit += one.at(x, y, 3) > 0.0;
         EXPECT_GT(lit, 100) << path;
     }
+}
+
+// The continuous scene of a VolPack scene (`explain volpack-scene`): its lights are VolPack's only (not
+// the default headlight), each towards -(M^-1 l): with no rotation, a light set along (0, 0, 2) is the
+// volref light towards (0, 0, -1); the tables become rows at the integer values; unshaded: no lights.
+TEST(VolPack, ContinuousSceneTakesVolPacksLightsAndTables) {
+    const test::TempDir dir("volpack");
+    write_u8_nrrd(dir, "v.nrrd", {4, 4, 4}, std::vector<std::uint8_t>(64, 100));
+    json j = minimal_scene();
+    j["render"]["profile_options"]["shading"] =
+        json::parse(R"({"material": {"ambient": 0.2, "diffuse": 0.5, "specular": 0.3, "shininess": 8},
+                        "lights": [{"direction": [0, 0, 2], "color": [1, 1, 1]}], "two_sided": true})");
+    const Scene s = parse_scene(j.dump(), dir.path, "scene.json");
+    const PreparedScene prepared(s, RenderOptions{});
+    const auto& r = dynamic_cast<const VolPackRenderer&>(*prepared.image_space());
+    const Scene c = volpack_continuous_scene(s, r, 0.125);
+    ASSERT_EQ(c.lights.size(), 1u);
+    EXPECT_EQ(c.lights[0].type, LightSpec::Type::Directional);
+    EXPECT_NEAR(c.lights[0].direction.x, 0.0, 1e-15);
+    EXPECT_NEAR(c.lights[0].direction.y, 0.0, 1e-15);
+    EXPECT_NEAR(c.lights[0].direction.z, -1.0, 1e-15);
+    ASSERT_TRUE(c.volumes.front().shading);
+    EXPECT_EQ(c.volumes.front().shading->ka, 0.2);
+    EXPECT_EQ(c.volumes.front().shading->kd, 0.5);
+    EXPECT_EQ(c.volumes.front().shading->ks, 0.3);
+    EXPECT_EQ(c.volumes.front().shading->n, 8.0);
+    EXPECT_TRUE(c.volumes.front().shading->two_sided);
+    ASSERT_EQ(c.volumes.front().transfer.opacity.size(), 256u);
+    EXPECT_EQ(c.volumes.front().transfer.opacity[51][0], 51.0);
+    EXPECT_NEAR(c.volumes.front().transfer.opacity[51][1], 51.0 / 255.0, 1e-7);
+    EXPECT_EQ(c.render.step, 0.125);
+    EXPECT_EQ(c.camera.type, CameraSpec::Type::Matrices);
+    json u = minimal_scene();
+    const Scene su = parse_scene(u.dump(), dir.path, "scene.json");
+    const PreparedScene pu(su, RenderOptions{});
+    EXPECT_TRUE(volpack_continuous_scene(su, dynamic_cast<const VolPackRenderer&>(*pu.image_space()), 0.5).lights.empty());
 }

@@ -509,6 +509,7 @@ Scene volpack_continuous_scene(const Scene& scene, const VolPackRenderer& render
     const std::string key = "render.profile_options.";
     if (v.depth_cue) throw Error(key + "depth_cue: VolPack's exponential depth cueing has no continuous form in volref");
     Scene c;
+    c.lights.clear();  // the lights are VolPack's (below), not the default headlight
     c.file = scene.file;
     c.image = scene.image;
     VolumeSpec vol;

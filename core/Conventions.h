@@ -12,7 +12,7 @@ namespace volref::conventions {
 // The slack absorbs a remainder shorter than kSegmentSlack * h that is only rounding of L / h
 // (e.g. L = 0.3, h = 0.1), instead of creating a sliver segment.
 inline constexpr double kSegmentSlack = 1e-9;
-// A slicer's level count (issue 54; core/integrate/profiles/Slices.cpp, conventions section 9,
+// A slicer's level count (core/integrate/profiles/Slices.cpp, conventions section 9,
 // "Slice-order renderers"): with spacing s over the range's extent E, n = floor(E / s - o + kSliceSlack) + 1
 // levels (o = 0 or 1/2, `first`); with a period, n = ceil(E / D - kSliceSlack). The slack keeps a ratio
 // that is an integer up to rounding from gaining or losing a level.
@@ -70,11 +70,11 @@ inline constexpr double kFastTransmittanceCutoff = 0x1p-10;
 // Images are cut into square tiles of this many pixels for the thread pool; results do not depend
 // on it (every pixel is computed independently). The side is halved, down to kMinTileSize (one 4 x 4
 // packet block), while the image has fewer than kTilesPerThread tiles per thread: tiles of very
-// different cost (the adaptive integrator's) then balance over many cores (issue 31, part 4;
-// bench/tile_balance: 128 x 128 adaptive, 64 tiles of 16 give 16 workers 13.0x, 256 of 8 15.5x).
-// 32 since session 24: on an Intel Xeon the fast profile's benchmark frame 2-3% faster than with 16 at one
+// different cost (the adaptive integrator's) then balance over many cores (bench/tile_balance:
+// 128 x 128 adaptive, 64 tiles of 16 give 16 workers 13.0x, 256 of 8 15.5x).
+// 32: on an Intel Xeon the fast profile's benchmark frame 2-3% faster than with 16 at one
 // thread and two (neighbouring blocks' voxels still in cache), the reference's the same (docs/performance.md,
-// "Tiles of 32 (session 24)"); on the EPYC 8 to 64 were within 2% (session 3).
+// "Tiles of 32"); on an AMD EPYC 8 to 64 were within 2% (docs/performance.md, "Tile size").
 inline constexpr int kTileSize = 32;
 inline constexpr int kMinTileSize = 4;
 inline constexpr int kTilesPerThread = 16;
@@ -89,13 +89,13 @@ inline constexpr double kAdaptiveDefaultTolerance = 1e-6;
 // (below, kAdaptiveWeakSafety: emission error plus the colour bound times the optical depth's error),
 // are split largest estimate first until T(a) sum e is at most
 //   tolerance * (b - a) / (total length of the ray's intervals)   (the budget is shared by length;
-// a test per sub-interval never holds beside an integrable singularity of sigma, issue 18),
+// a test per sub-interval never holds beside an integrable singularity of sigma),
 // a candidate whose e is at most kAdaptiveRoundoffRelative * |K15| (rounding, QUADPACK's test), or that
 // is kAdaptiveMaxDepth bisections deep, is not split again (the estimate is still reported: 2^-48 of a
 // piece is below any length the double t of a ray resolves for pieces up to 2^48 ulps long).
 inline constexpr int kAdaptiveMaxDepth = 48;
-// Work per ray is bounded (issue 18: an opacity reaching 1 on a cell face made the bisection run for
-// minutes and grow without bound): a ray evaluates at most kAdaptiveMaxRulesPerRay G7/K15 rules (15
+// Work per ray is bounded (an opacity reaching 1 on a cell face would otherwise make the bisection run
+// for minutes and grow without bound): a ray evaluates at most kAdaptiveMaxRulesPerRay G7/K15 rules (15
 // samples each). Once they are spent, every piece still open is accepted with the estimate it has
 // (the halves against their rule), so the pixel's error channel reports what was not resolved instead
 // of claiming the tolerance; the ray also stops refining once a cancel is requested (SIGINT/SIGTERM),
@@ -110,8 +110,8 @@ inline constexpr double kAdaptiveRoundoffRelative = 50.0 * 2.220446049250313e-16
 // (the ray ends there, T = 0 behind it) when its opacity is 1 at its midpoint and at
 // a + kAdaptiveOpaqueColourOffset (b - a) and b - kAdaptiveOpaqueColourOffset (b - a): between two
 // cuts the transfer function is linear in s, so that is opacity 1 on the whole piece, not at one point
-// (issue 18, case 1: a tent of opacity 1 at a value reached on a grid plane made every ray crossing
-// the plane opaque). A piece with kAdaptiveOpaqueMinDoubles or fewer doubles inside it is never opaque:
+// (with the midpoint alone, a tent of opacity 1 at a value reached on a grid plane would make every ray
+// crossing the plane opaque). A piece with kAdaptiveOpaqueMinDoubles or fewer doubles inside it is never opaque:
 // its ends are two cuts that coincide in exact arithmetic (a face and a row's root, found to rounding).
 inline constexpr double kAdaptiveMaxOpacity = 1.0 - 0x1p-53;
 inline constexpr int kAdaptiveOpaqueMinDoubles = 4;
@@ -158,7 +158,7 @@ inline constexpr int kStepDoublingNeighbourhood = 1;
 // stack of the code that walks the document).
 inline constexpr int kMaxJsonDepth = 256;
 
-// Issue 32 (docs/robustness.md, "Extreme numbers"): every number a JSON document gives volref, and every
+// Extreme numbers (docs/robustness.md): every number a JSON document gives volref, and every
 // spacing and origin a volume header gives, is 0 or has a magnitude in [kMinMagnitude, kMaxMagnitude].
 // Within it a product or quotient of two such numbers (a ray parameter, a length over a step, a squared
 // distance) stays a finite, normal double, so the arithmetic of a render is exact where it is all

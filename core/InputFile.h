@@ -1,4 +1,4 @@
-// InputFile: every file volref reads is checked here before it is opened (issue 32; docs/robustness.md,
+// InputFile: every file volref reads is checked here before it is opened (docs/robustness.md,
 // "Special files"). It must exist and, after symbolic links, be a regular file: a FIFO, a character or
 // block device, a socket or a directory is refused by its type, because reading one can block forever
 // (a FIFO without a writer), never end (/dev/zero) or mean nothing (a directory). A file read whole is

@@ -57,7 +57,7 @@ extern "C" int volref_image_files_write(const WriteRequest* rq, char* error, std
         if (rq->unassociated_alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
         if (rq->compression) spec.attribute("compression", rq->compression);
         // No clock in the file: OpenImageIO writes the current time (EXR capDate, TIFF DateTime) unless
-        // DateTime is set, so two renders of one scene would differ in their bytes (issue 18).
+        // DateTime is set, so two renders of one scene would differ in their bytes.
         spec.attribute("DateTime", "");
         if (!out->open(rq->path, spec) || !out->write_image(spec.format, rq->pixels) || !out->close())
             return fail("cannot write the image: " + first_line(out->geterror()), error, size);

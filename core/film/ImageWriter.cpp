@@ -96,7 +96,7 @@ void write_image(const Image& image, const fs::path& path, const glm::dvec4& bac
         }
     }
     rq.channel_names = names.data();
-    // (The module writes no clock into the file: the same render gives the same bytes, issue 18.)
+    // (The module writes no clock into the file: the same render gives the same bytes.)
     try {
         image_files::write(rq, path.string());
     } catch (...) {

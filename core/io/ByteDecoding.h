@@ -68,8 +68,8 @@ inline FileHandle open_for_reading(const std::filesystem::path& path) {
 
 // read_file_bytes (the whole contents of a file): InputFile.h.
 
-// The first `limit` bytes of the file at `path` (all of it when it is no longer); `whole` tells
-// whether that is the whole file.
+// The first `limit` bytes of the file at `path` (all of it when it is at most `limit` bytes long);
+// `whole` tells whether that is the whole file.
 inline std::string read_file_prefix(const std::filesystem::path& path, std::size_t limit, bool& whole) {
     FileHandle f = open_for_reading(path);
     std::string bytes(limit + 1, '\0');

@@ -102,7 +102,7 @@ public:
         return nullptr;
     }
     // The first of the synonyms `keys` present; each other one present must say the same (`same` compares
-    // two fields), or the header contradicts itself: an error naming both lines (issue 32).
+    // two fields), or the header contradicts itself: an error naming both lines.
     template <class Same>
     const Field* find_agreeing(std::initializer_list<const char*> keys, Same same) const {
         const Field* first = nullptr;

@@ -79,7 +79,7 @@ struct RawFields {
     std::array<std::int64_t, 8> dim{};
     int datatype = 0;
     // As stored (nifti_clib replaces a pixdim of 0 by 1 and a vox_offset below the header by its end;
-    // volref checks the values the file holds, issue 32).
+    // volref checks the values the file holds).
     std::array<double, 8> pixdim{};
     double vox_offset = 0.0, scl_slope = 0.0, scl_inter = 0.0;
     bool single_file = true;  // magic n+1 / n+2 (the image follows the header in the same file)

@@ -153,7 +153,7 @@ Sidecar read_sidecar(const std::filesystem::path& sidecar_path, const std::strin
         throw Error(std::string(e.what()) + " (the JSON sidecar describing " + data_where + ")");
     }
     // The scene's strict parser: a key given twice, a NUL byte, nesting beyond kMaxJsonDepth or a number
-    // beyond a double is an error naming it (issue 32), not the last value silently.
+    // beyond a double is an error naming it, not the last value silently.
     const json doc = json_reader::parse_json(text, where + ": invalid JSON");
     return parse_sidecar(doc, SidecarReader(where));
 }

@@ -79,7 +79,7 @@ Volume read_volume(const std::filesystem::path& path, const std::string& format)
     io::check_input_file(path, path.string());  // a FIFO or a device: refused by type, before its name is read
     const std::string chosen = volume_format(path, format);
     Volume v = read_by_format(path, chosen);
-    // issue 32: the grid a header describes lies within volref's number range (conventions::kMaxMagnitude),
+    // The grid a header describes lies within volref's number range (conventions::kMaxMagnitude),
     // like every number of a scene file, so that no ray parameter or position overflows.
     // the header fields that give them, by format, for the message
     const char* spacing_field = chosen == "nrrd" ? "space directions / spacings" : chosen == "metaimage" ? "ElementSpacing"

@@ -73,7 +73,7 @@ public:
     bool number_integer(number_integer_t v) override { return add(Json(v)) != nullptr; }
     bool number_unsigned(number_unsigned_t v) override { return add(Json(v)) != nullptr; }
     bool number_float(number_float_t v, const string_t& text) override {
-        // issue 32: 0 or a magnitude in [kMinMagnitude, kMaxMagnitude] (conventions.md, "Extreme numbers")
+        // 0 or a magnitude in [kMinMagnitude, kMaxMagnitude] (conventions.md, "Extreme numbers")
         if (v != 0.0 && !(std::fabs(v) <= conventions::kMaxMagnitude && std::fabs(v) >= conventions::kMinMagnitude))
             ctx_.fail(pending_path(), "the number " + text + " is beyond volref's range (0, or a magnitude in [1e-100, 1e100]: "
                                       "products of two such numbers stay finite doubles)");
@@ -225,7 +225,7 @@ std::string display_path(std::string_view path) {
 // ---- parsing ----
 
 namespace {
-// JSON is text: a NUL byte (and whatever follows it) is an error naming its byte (issue 32).
+// JSON is text: a NUL byte (and whatever follows it) is an error naming its byte.
 void refuse_nul(const std::string& text, const std::string& name) {
     if (const auto at = text.find('\0'); at != std::string::npos)
         throw Error(name + ": byte " + std::to_string(at) + ": a NUL byte (a JSON document is text)");

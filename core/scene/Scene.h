@@ -188,7 +188,7 @@ enum class IntegrationMethod { Fixed, Adaptive };
 // render.profile: whose discretisation to reproduce (core/integrate/profiles/Profile.h, conventions section 9);
 // Fast is volref's own float SIMD variant of the reference (core/integrate/packet/FastProfile.h).
 enum class ProfileId { Reference, VtkGpu, GlslBasic, Ospray, CudaCurvilinear, VtkCpu, Fast, VtkJs, Volumizer, VolPack };
-// render.profile "volpack" (issue 55; core/integrate/profiles/VolPackRenderer.h, docs/conventions.md "VolPack"):
+// render.profile "volpack" (core/integrate/profiles/VolPackRenderer.h, docs/conventions.md "VolPack"):
 // VolPack 1.0b3's inputs as a VolPack program gives them, in render.profile_options.
 struct VolPackTable {
     std::vector<float> entries;                    // the table as VolPack reads it (vpSetClassifierTable's floats)
@@ -231,18 +231,18 @@ struct ProfileOptions {
     double transfer_scale = 1.0;  // the table is read at s * transfer_scale
     double iso_threshold = 0.0;   // samples with s below it are skipped (s: value normalised over the data range)
     double brightness = 1.0;      // x-ray: the maximum of s times this
-    // vtk-js (issue 22; VtkJsIntegrator.h): the jitter fraction in [0.01, 1] (vtk.js: 0.01 + 0.99 seed);
+    // vtk-js (VtkJsIntegrator.h): the jitter fraction in [0.01, 1] (vtk.js: 0.01 + 0.99 seed);
     // fixed_normal drops vtk.js's diag(dims * spacing) normal scaling; flip_normal, ray_box_domain and
     // mip_correction false are conventions `volref compare --fit --scene` tries.
     double jitter = 1.0;
     bool fixed_normal = false, flip_normal = false, ray_box_domain = false, mip_correction = true;
-    // vtk-js (issue 28, part 5): the rasteriser's sub-pixel precision. vtk.js takes each pixel's ray from
+    // vtk-js: the rasteriser's sub-pixel precision. vtk.js takes each pixel's ray from
     // the varying interpolated over its proxy quad, whose corners the rasteriser snaps to 1 / 2^bits of a
     // pixel: 4 (the default) is SwiftShader's (vk::SUBPIXEL_PRECISION_BITS), what the check runs; 0: no
     // snapping, each ray through its pixel centre.
     int subpixel_bits = 4;
     double intensity = 1.0;       // glsl-basic: seed 002's K, the sample's alpha is K times the opacity
-    // vtk-gpu, glsl-basic, cuda-curvilinear (issues 17, 27; core/integrate/profiles/TextureUnit.h, conventions
+    // vtk-gpu, glsl-basic, cuda-curvilinear (core/integrate/profiles/TextureUnit.h, conventions
     // section 9, "The texture unit"): the profile's linearly filtered texture reads, exact (llvmpipe) or
     // the NVIDIA H100's rule bit for bit; texture_band: the render writes the "error" channel, a bound
     // on how far any texture unit of the rule's family can be from this render. Admissible: tests only
@@ -250,10 +250,10 @@ struct ProfileOptions {
     // the fetch's position (a Monte Carlo of the units the band covers).
     enum class TextureUnit { Exact, H100, Admissible };
     TextureUnit texture_unit = TextureUnit::Exact;
-    // cuda-curvilinear on shells (issue 28; Seed001Kernel.h): "float32" (the default) runs seed 001's kernel
+    // cuda-curvilinear on shells (Seed001Kernel.h): "float32" (the default) runs seed 001's kernel
     // as the program does, in float32 on the host's bounding triangles with its unsigned-short data (composite
-    // and x-ray; other projections keep the double-precision profile); "double": the earlier profile, in double
-    // on the exact shell.
+    // and x-ray; other projections keep the double-precision profile); "double": the double-precision
+    // profile on the exact shell.
     enum class Kernel { Float32, Double };
     Kernel kernel = Kernel::Float32;
     // cuda-curvilinear on shells: seed 001's tri-cubic option (its --tricubic, cubicInterpolate: the seed's
@@ -266,23 +266,23 @@ struct ProfileOptions {
     // data range to unsigned shorts (rounded to nearest) read as v / 65535 (render.profile_options.
     // texture_format "unorm16"), or the values themselves ("float", the default).
     bool data_unorm16 = false;
-    // placement "slices" (issue 54): the render writes the "error" channel, the interval of what every
+    // placement "slices": the render writes the "error" channel, the interval of what every
     // rounding variant of the frame buffer stores (conventions section 9, "Slice-order renderers").
     bool framebuffer_band = false;
-    // fast (issue 31; transfer/PreIntegration.h): pre-integrated segments, the table's intervals per axis
+    // fast (transfer/PreIntegration.h): pre-integrated segments, the table's intervals per axis
     // (render.profile_options.preintegration); 0: off, samples at the segments' midpoints.
     int preintegration = 0;
-    // volpack (issue 55): VolPack's inputs (VolPackSpec above); set for render.profile "volpack" only.
+    // volpack: VolPack's inputs (VolPackSpec above); set for render.profile "volpack" only.
     std::optional<VolPackSpec> volpack;
 };
 
-// render.profile written as an object (issue 29): a preset (`base`) and the rules the scene sets over it.
+// render.profile written as an object: a preset (`base`) and the rules the scene sets over it.
 // Each rule is one field of Profile (core/integrate/profiles/Profile.h, which has its formula;
 // docs/conventions.md section 9, "Profiles as data"); a rule the scene does not set is the base's.
 struct ProfileRules {
     // Where the samples of an interval [t0, t1] lie: segment midpoints (the reference), from the entry
     // t0 + (first + k) h, or from the exit t1 - k h.
-    // Slices: a slicer's sampling surfaces (issue 54; `slices` below, conventions section 9, "Slice-order
+    // Slices: a slicer's sampling surfaces (`slices` below, conventions section 9, "Slice-order
     // renderers").
     enum class Placement { Midpoints, FromEntry, FromExit, Slices };
     // From the entry or the exit: how many samples. ThroughExit: n = max(1, floor(L / h + 1 - first))

@@ -109,7 +109,7 @@ void apply_override(Json& root, const std::string& text, Context& scene_ctx) {
     for (const PathStep& step : steps) {
         if (!step.is_index) {
             if (at->is_null()) *at = Json::object();  // a missing intermediate object
-            // issue 29: a rule set over a preset given by name: "vtk-gpu" becomes {"base": "vtk-gpu"}
+            // a rule set over a preset given by name: "vtk-gpu" becomes {"base": "vtk-gpu"}
             if (path == "render.profile" && at->is_string()) *at = Json{{"base", *at}};
             if (!at->is_object())
                 ctx.fail(path, "expected an object to set \"" + step.key + "\" in, got " + describe(*at));
@@ -140,7 +140,7 @@ double max_abs(const glm::dvec3& v) { return std::max({std::fabs(v.x), std::fabs
 bool all_finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Relative paths are relative to the scene file's folder; stored absolute and lexically normal, a symbolic
-// link kept as written (its name gives the format, and messages name what the scene names; issue 32).
+// link kept as written (its name gives the format, and messages name what the scene names).
 fs::path resolve_file(const Json& v, const std::string& path, const Context& ctx, const fs::path& base_dir) {
     const std::string s = read_string(v, path, ctx);
     if (s.empty()) ctx.fail(path, "expected a file path, got \"\"");
@@ -785,9 +785,9 @@ ProfileId read_profile_id(Reader& r, std::string_view key) {
     return r.template choice<ProfileId>(key, ProfileId::Reference, names::kProfiles);
 }
 
-// render.profile as an object (issue 29): each rule of Profile.h by its key (scene-format.md,
+// render.profile as an object: each rule of Profile.h by its key (scene-format.md,
 // "render.profile"); the renderers that are not rule-driven (vtk-cpu, vtk-js, fast) take none.
-// The slicers' rules (issue 54; conventions section 9, "Slice-order renderers"): `slices` and what a
+// The slicers' rules (conventions section 9, "Slice-order renderers"): `slices` and what a
 // slice fragment and the frame buffer compute.
 void read_slice_rules(ObjectReader& r, ProfileRules& out) {
     using P = ProfileRules;
@@ -840,7 +840,7 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
         "placement", "first",      "step_count",  "ray_box",  "step_voxel", "correction",    "correction_floor",
         "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
         "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded",
-        // the slicers' rules (issue 54)
+        // the slicers' rules
         "slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
         "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha", "texture_filter"};  // jitter "off": nothing to apply
     r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
@@ -911,7 +911,7 @@ ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
     return out;
 }
 
-// render.profile_options of "volpack" (issue 55): VolPack's inputs, each range VolPack's own (its
+// render.profile_options of "volpack": VolPack's inputs, each range VolPack's own (its
 // vpSet*, vpRamp and vpWindow error codes) or what its tables hold. A table is 256 numbers in [0, 1]
 // or {"ramp": [[x, y], ...]} filled as vpRamp fills it (x strictly increasing integers from 0 to the
 // field's maximum, so that every entry is set).
@@ -1068,7 +1068,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
     s.early_termination = r.optional_number("early_termination", Range::left_open(0, 1));
     s.integrator = r.choice<IntegrationMethod>("integrator", IntegrationMethod::Fixed, names::kIntegrators);
     s.tolerance = r.number("tolerance", conventions::kAdaptiveDefaultTolerance, Range::positive());
-    // render.profile: a preset's name, or an object of rules over a preset (issue 29; read_profile_rules).
+    // render.profile: a preset's name, or an object of rules over a preset (read_profile_rules).
     if (const Json* p = r.find("profile"); p && p->is_object()) {
         ObjectReader pr(*p, r.path("profile"), ctx);
         s.profile = read_profile_id(pr, "base");
@@ -1076,7 +1076,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
     } else {
         s.profile = read_profile_id(r, "profile");
     }
-    if (s.profile == ProfileId::VolPack) {  // issue 55: VolPack's inputs; volref's own render keys do not apply
+    if (s.profile == ProfileId::VolPack) {  // VolPack's inputs; volref's own render keys do not apply
         const Json* o = r.find("profile_options");
         if (!o) r.fail("profile_options", "required by render.profile \"volpack\" (VolPack's inputs: scalar_table at least)");
         ObjectReader po(*o, r.path("profile_options"), ctx);
@@ -1085,7 +1085,7 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
             if (r.has(k))
                 r.fail(k, "not used by render.profile \"volpack\" (VolPack composites front to back on its voxel slices; "
                           "its thresholds are render.profile_options.min_voxel_opacity and max_ray_opacity)");
-    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {  // issue 22
+    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::VtkJs) {
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"jitter", "fixed_normal", "flip_normal", "ray_box", "mip_correction", "subpixel_bits"});
         s.profile_options.jitter = po.number("jitter", 1.0, Range::closed(0.01, 1.0));
@@ -1094,13 +1094,13 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.ray_box_domain = po.choice<bool>("ray_box", false, names::kVtkJsRayBoxes);
         s.profile_options.mip_correction = po.boolean("mip_correction", true);
         s.profile_options.subpixel_bits = int(po.integer("subpixel_bits", 4, Range::closed(0, 23)));
-    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::Fast) {  // issue 31
+    } else if (const Json* o = r.find("profile_options"); o && s.profile == ProfileId::Fast) {
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"preintegration"});
         s.profile_options.preintegration =
             int(po.integer("preintegration", 0, Range::closed(2, conventions::kPreIntegrationMaxIntervals)));
     } else if (const Json* o = r.find("profile_options");
-               o && (s.profile == ProfileId::Volumizer || s.profile_rules.placement == ProfileRules::Placement::Slices)) {  // issue 54
+               o && (s.profile == ProfileId::Volumizer || s.profile_rules.placement == ProfileRules::Placement::Slices)) {
         ObjectReader po(*o, r.path("profile_options"), ctx);
         po.allow({"framebuffer_band"});
         s.profile_options.framebuffer_band = po.boolean("framebuffer_band", false);
@@ -1111,23 +1111,23 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         if (s.profile == ProfileId::GlslBasic) po.allow({"intensity", "texture_unit", "texture_band"});
         else if (s.profile == ProfileId::VtkGpu) po.allow({"texture_unit", "texture_band"});
         else po.allow({"density", "transfer_scale", "iso_threshold", "brightness", "texture_unit", "texture_band", "texture_format", "kernel", "tricubic"});
-        // issue 17: the texture unit's weights (TextureUnit.h) and the band in the "error" channel
+        // the texture unit's weights (TextureUnit.h) and the band in the "error" channel
         using TU = ProfileOptions::TextureUnit;
         s.profile_options.texture_unit = po.choice<TU>("texture_unit", TU::Exact, names::kTextureUnits);
         if (po.has("texture_unit") && po.string("texture_unit", "") == "hardware")
             std::cerr << "volref: notice: render.profile_options.texture_unit: \"hardware\" is a deprecated alias of \"h100\"\n";
         s.profile_options.texture_band = po.boolean("texture_band", false);
         s.profile_options.data_unorm16 = po.choice<bool>("texture_format", false, names::kTextureFormats);
-        using K = ProfileOptions::Kernel;  // issue 28: seed 001's kernel in float32, or the double profile
+        using K = ProfileOptions::Kernel;  // seed 001's kernel in float32, or the double profile
         s.profile_options.kernel = po.choice<K>("kernel", K::Float32, names::kKernels);
-        s.profile_options.tricubic = po.boolean("tricubic", false);  // issue 28: seed 001's --tricubic
+        s.profile_options.tricubic = po.boolean("tricubic", false);  // seed 001's --tricubic
         s.profile_options.intensity = po.number("intensity", 1.0, Range::non_negative());
         s.profile_options.density = po.number("density", 1.0, Range::non_negative());
         s.profile_options.transfer_scale = po.number("transfer_scale", 1.0, Range::non_negative());
         s.profile_options.iso_threshold = po.number("iso_threshold", 0.0);
         s.profile_options.brightness = po.number("brightness", 1.0, Range::non_negative());
     }
-    // The rules that are render.profile_options too (issue 29): set in one place only.
+    // The rules that are render.profile_options too: set in one place only.
     const ProfileRules& pr = s.profile_rules;
     const Json* po_json = r.find("profile_options");
     if (pr.texture_unit) {
@@ -1160,7 +1160,7 @@ Scene read_scene(const Json& root, const Context& ctx, const fs::path& base_dir)
     if (const Json* v = r.find("camera")) scene.camera = read_camera(*v, r.path("camera"), ctx);
     if (const Json* v = r.find("image")) scene.image = read_image(*v, r.path("image"), ctx);
     if (const Json* v = r.find("render")) scene.render = read_render(*v, r.path("render"), ctx);
-    if (scene.render.profile == ProfileId::VolPack) {  // issue 55: the scene names VolPack's inputs only
+    if (scene.render.profile == ProfileId::VolPack) {  // the scene names VolPack's inputs only
         const char* why = "not used by render.profile \"volpack\" (VolPack's inputs are render.profile_options)";
         if (scene.volumes.size() != 1) r.fail("volumes", "render.profile \"volpack\" renders one volume");
         const Json* one = r.find("volume");

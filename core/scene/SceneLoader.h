@@ -27,7 +27,7 @@ Scene parse_scene(const std::string& json_text, const std::filesystem::path& bas
 // Returns type, cylinder or sphere, and tessellate.
 BoundsSpec parse_shell(const std::string& json_text, const std::string& name);
 
-// render.profile's rules (issue 29) from a JSON object of its keys ("base" ignored), over the preset
+// render.profile's rules from a JSON object of its keys ("base" ignored), over the preset
 // `base`, as a scene's render.profile object is read; `name` starts messages.
 ProfileRules parse_profile_rules(const nlohmann::json& object, ProfileId base, const std::string& name);
 // Its inverse: profile_rules_object (SceneWriter.h).

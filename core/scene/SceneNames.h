@@ -3,7 +3,7 @@
 // The loader reads them (SceneLoader.cpp: ObjectReader::choice over these tables), the writer writes
 // them (SceneWriter.h: a resolved Scene back to the format), and trace / explain print them. A name
 // is written in one place only: a new value, or a renamed one, is one line here. Where a table lists
-// an alias (an earlier name still read, e.g. integrator "midpoint"), the canonical name comes first:
+// an alias (a second name read for the same value, e.g. integrator "midpoint"), the canonical name comes first:
 // name_of returns the first name of a value.
 #pragma once
 #include <optional>
@@ -64,7 +64,7 @@ inline constexpr Choice<Projection> kProjections[] = {{"composite", Projection::
 inline constexpr Choice<CompositeOrder> kOrders[] = {{"front-to-back", CompositeOrder::FrontToBack},
                                                      {"back-to-front", CompositeOrder::BackToFront}};
 inline constexpr Choice<StepUnits> kStepUnits[] = {{"voxel", StepUnits::Voxel}, {"world", StepUnits::World}};
-// "midpoint": the fixed-step integrator's earlier name (kept for existing scene files).
+// "midpoint": an alias of "fixed", read so that scene files that name it load.
 inline constexpr Choice<IntegrationMethod> kIntegrators[] = {{"fixed", IntegrationMethod::Fixed},
                                                              {"adaptive", IntegrationMethod::Adaptive},
                                                              {"midpoint", IntegrationMethod::Fixed}};
@@ -119,7 +119,7 @@ inline constexpr Choice<Rules::Arithmetic> kArithmetics[] = {{"double", Rules::A
 inline constexpr Choice<Rules::Gradient> kRuleGradients[] = {{"central", Rules::Gradient::Central},
                                                              {"forward", Rules::Gradient::Forward},
                                                              {"central-in-domain", Rules::Gradient::CentralInDomain}};
-// The slicers' rules (issue 54; conventions section 9, "Slice-order renderers").
+// The slicers' rules (conventions section 9, "Slice-order renderers").
 using SliceRules = Rules::Slices;
 inline constexpr Choice<SliceRules::Orientation> kSliceOrientations[] = {{"viewport", SliceRules::Orientation::Viewport},
                                                                        {"axis", SliceRules::Orientation::Axis},

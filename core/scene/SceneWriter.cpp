@@ -227,18 +227,18 @@ json profile_options_json(const RenderSpec& r) {
         j = {{"density", o.density}, {"transfer_scale", o.transfer_scale}, {"iso_threshold", o.iso_threshold}, {"brightness", o.brightness}};
     if (r.profile == ProfileId::GlslBasic) j = {{"intensity", o.intensity}};
     if (r.profile == ProfileId::CudaCurvilinear || r.profile == ProfileId::GlslBasic || r.profile == ProfileId::VtkGpu) {
-        // issue 17: listed when not the defaults; a texture unit set as a rule is the rule's
+        // listed when not the defaults; a texture unit set as a rule is the rule's
         if (o.texture_unit == ProfileOptions::TextureUnit::H100 && !rules.texture_unit)
             j["texture_unit"] = name_of(names::kTextureUnits, o.texture_unit);
         if (o.texture_band) j["texture_band"] = true;
         if (o.data_unorm16) j["texture_format"] = name_of(names::kTextureFormats, o.data_unorm16);
     }
     if (r.profile == ProfileId::CudaCurvilinear && o.kernel == ProfileOptions::Kernel::Double && !rules.arithmetic)
-        j["kernel"] = name_of(names::kKernels, o.kernel);  // issue 28
+        j["kernel"] = name_of(names::kKernels, o.kernel);
     if (r.profile == ProfileId::CudaCurvilinear && o.tricubic) j["tricubic"] = true;
-    if (r.profile == ProfileId::Fast && o.preintegration > 0) j["preintegration"] = o.preintegration;  // issue 31
-    if (o.framebuffer_band) j["framebuffer_band"] = true;  // issue 54: volumizer, placement "slices"
-    if (r.profile == ProfileId::VtkJs)  // issue 22
+    if (r.profile == ProfileId::Fast && o.preintegration > 0) j["preintegration"] = o.preintegration;
+    if (o.framebuffer_band) j["framebuffer_band"] = true;  // volumizer, placement "slices"
+    if (r.profile == ProfileId::VtkJs)
         j = {{"jitter", o.jitter},
              {"fixed_normal", o.fixed_normal},
              {"flip_normal", o.flip_normal},
@@ -248,7 +248,7 @@ json profile_options_json(const RenderSpec& r) {
     return j;
 }
 
-// render.profile_options of "volpack" (issue 55): every input, defaults included, as read_volpack_options reads them.
+// render.profile_options of "volpack": every input, defaults included, as read_volpack_options reads them.
 json volpack_json(const VolPackSpec& v) {
     static constexpr const char* kAxes[] = {"x", "y", "z"};
     auto table = [](const VolPackTable& t) {
@@ -292,7 +292,7 @@ json volpack_json(const VolPackSpec& v) {
 }
 
 json render_json(const RenderSpec& r) {
-    if (r.profile == ProfileId::VolPack && r.profile_options.volpack)  // issue 55: VolPack's inputs only
+    if (r.profile == ProfileId::VolPack && r.profile_options.volpack)  // VolPack's inputs only
         return json{{"profile", "volpack"}, {"profile_options", volpack_json(*r.profile_options.volpack)}};
     json j;
     j["projection"] = name_of(names::kProjections, r.projection);
@@ -305,7 +305,7 @@ json render_json(const RenderSpec& r) {
     j["integrator"] = name_of(names::kIntegrators, r.integrator);
     j["tolerance"] = r.tolerance;
     j["profile"] = name_of(names::kProfiles, r.profile);
-    if (!r.profile_rules.empty()) {  // issue 29: {"base": preset, the rules the scene sets}
+    if (!r.profile_rules.empty()) {  // {"base": preset, the rules the scene sets}
         j["profile"] = json{{"base", name_of(names::kProfiles, r.profile)}};
         const nlohmann::json rules = profile_rules_object(r.profile_rules);
         for (const auto& [key, value] : rules.items()) j["profile"][key] = value;
@@ -318,7 +318,7 @@ json render_json(const RenderSpec& r) {
 
 json scene_json(const Scene& scene) {
     json j;
-    if (scene.render.profile == ProfileId::VolPack) {  // issue 55: the volume's file and VolPack's inputs
+    if (scene.render.profile == ProfileId::VolPack) {  // the volume's file and VolPack's inputs
         const VolumeSpec& v = scene.volumes.front();
         j["volume"] = {{"source", source_json(v.source)}};
         if (v.origin) j["volume"]["origin"] = vec(*v.origin);
@@ -371,7 +371,7 @@ nlohmann::json profile_rules_object(const ProfileRules& r) {
     if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
     if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
     if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;
-    if (r.slices) {  // issue 54
+    if (r.slices) {  // the slicers' rules
         const P::Slices& s = *r.slices;
         nlohmann::json o;
         o["orientation"] = name_of(names::kSliceOrientations, s.orientation);

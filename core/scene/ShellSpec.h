@@ -1,6 +1,6 @@
 // The parameters of the curvilinear shells (scene key volume.bounds with type "cylindrical" or
 // "spherical"); angles in degrees as in scene files: plain scene description data (the scene loader
-// fills them; geometry/ and core/sample/ compute with them). Conventions (issue 5, docs/conventions.md):
+// fills them; geometry/ and core/sample/ compute with them). Conventions (docs/conventions.md):
 //   cylindrical: axis y through `center`; a point (r, theta, h) is at
 //                center + (r cos theta, h, -r sin theta), theta = atan2(-z, x) in [0, 360);
 //                grid axes (radius, angle, height).

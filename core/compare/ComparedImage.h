@@ -29,7 +29,7 @@ struct ComparedImage {
     Image rgba;                      // channels R, G, B, A: premultiplied, linear
     std::vector<double> error;       // the file's `error` channel (width * height), empty if none
     std::vector<char> fault;         // the file's `fault` channel != 0 (width * height: the rays a mirrored
-                                     // program does not finish, issue 28), empty if none
+                                     // program does not finish), empty if none
     int bits = 0;                    // bits per integer sample (8 for PNG), 0 for floating point
     bool unassociated = false;       // the file stored colour divided by alpha
     std::vector<double> stored;      // unassociated integer inputs: the stored (unassociated) R, G, B, A
@@ -37,7 +37,7 @@ struct ComparedImage {
     std::string description() const; // e.g. "64x64, 8-bit, unassociated alpha (premultiplied here)"
 };
 
-// Issue 28: the pixels where either input's `fault` channel is set (a mirrored program does not finish the
+// The pixels where either input's `fault` channel is set (a mirrored program does not finish the
 // ray), as (x, y); each is set to 0 in both images (RGBA and `error`), so that the metrics, the tolerance
 // test and --fit leave it out.
 std::vector<std::array<int, 2>> exclude_faults(ComparedImage& a, ComparedImage& b);

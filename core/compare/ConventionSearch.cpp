@@ -195,7 +195,7 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     const bool shaded = composite && scene.volume().shading.has_value();
     const bool box = scene.volume().bounds.type == BoundsSpec::Type::Box && !scene.volume().bounds.min && !scene.volume().bounds.max;
     std::vector<std::vector<json>> d;
-    // A slicer (placement "slices", issue 54): its surfaces, fragments and frame buffer; the rules of
+    // A slicer (placement "slices"): its surfaces, fragments and frame buffer; the rules of
     // "slices" are tried one key at a time ("slices.KEY", merged into the object by with_rules).
     if (!r.reference_integrators() && r.profile != ProfileId::Fast &&
         resolve_profile(r).placement == Profile::Placement::Slices) {

@@ -1,4 +1,4 @@
-// The convention search behind `volref compare GPU.exr --fit --scene SCENE` and volref.fit (issue 29):
+// The convention search behind `volref compare GPU.exr --fit --scene SCENE` and volref.fit:
 // which of another renderer's conventions explain the difference between its image G and volref's
 // render of the same scene.
 //

@@ -12,7 +12,7 @@
 //   shift      B(x, y) = A(x - sx, y - sy)                                   (two parameters, pixels)
 //              (A interpolated by Ceres' bicubic (Catmull-Rom) interpolator; |s| <= kMaxShiftPixels;
 //              residual over pixels at least kMaxShiftPixels from the border)
-//   conventions (issue 22; `--scene`): B re-rendered by volref with one convention changed (a flipped
+//   conventions (`--scene`): B re-rendered by volref with one convention changed (a flipped
 //              normal under one-sided lighting, a ray box half a voxel larger or smaller, opacity correction
 //              applied to MIP or not; no parameter), judged on R, G, B, A: before = RMS(B - A), after =
 //              RMS(B' - A), B' the re-rendered image.

@@ -5,7 +5,7 @@
 //   SSIM (core/compare/Ssim.h), over = pixels with |d| > tol in that channel.
 // Overall: the same over every channel's values (N = pixels x channels); SSIM = the mean of the
 // channels' SSIMs; over = pixels over the tolerance in any channel. Sums are accumulated in double.
-// Non-finite values (issue 22: vtk.js's float framebuffer holds NaN where alpha is 0): a value pair
+// Non-finite values (vtk.js's float framebuffer holds NaN where alpha is 0): a value pair
 // (a, b) with a non-finite member never enters the sums, the maxima or SSIM (N counts finite pairs;
 // SSIM and the fits see such pixels as 0 in both images, finite_copies). The pair agrees when both are
 // NaN or both the same infinity, and is then within any tolerance; otherwise it is over the tolerance.

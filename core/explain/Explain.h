@@ -41,7 +41,7 @@ struct CompositeSample {
 Explanation composite(const std::vector<CompositeSample>& samples, CompositeOrder order, double unit_distance,
                       double step);
 
-// composite --framebuffer (issue 54): the samples (listed front first) blended by a slicer's frame buffer,
+// composite --framebuffer: the samples (listed front first) blended by a slicer's frame buffer,
 // from the far end (or front to back, under, with `order`), each blend's source, factors, unrounded
 // result and stored value (FrameBuffer.h), and the band of every rounding variant.
 struct FrameBufferRules {
@@ -86,7 +86,7 @@ Explanation intersect_sphere(const Ray& ray, const SphericalShell& shell);
 // of `volref trace`, PixelTrace.h) and the pixel.
 Explanation ray(const PreparedScene& scene, int x, int y);
 
-// volpack-warp (issue 55): output pixel (x, y) of a render.profile "volpack" scene through VolPack's 2D
+// volpack-warp: output pixel (x, y) of a render.profile "volpack" scene through VolPack's 2D
 // warp: the view's factorisation, the pixel mapped back, the stepped fixed-point fractions, the weight
 // table's entry, the four intermediate pixels, the float sums and the truncated bytes.
 Explanation volpack_warp(const PreparedScene& scene, int x, int y);
@@ -97,7 +97,7 @@ Explanation volpack_voxel(const PreparedScene& scene, std::int64_t x, std::int64
 // scene file JSON (one note), composited by the reference at `step` voxels.
 Explanation volpack_scene(const PreparedScene& scene, double step);
 
-// texture-fetch (issue 27): one linearly filtered fetch of a 3D texture (a u16 volume read as unorm16,
+// texture-fetch: one linearly filtered fetch of a 3D texture (a u16 volume read as unorm16,
 // an f32 volume as float) at a coordinate (unnormalised texels, texel i centred at i + 0.5, or normalised
 // with `normalized`), by the H100 rule (`h100`, core/integrate/profiles/TextureUnit.h) or with exact
 // weights, every step; throws volref::Error naming --volume for any other type.

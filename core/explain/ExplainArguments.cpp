@@ -203,7 +203,7 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
             if (!named) throw Error("--order: expected " + scene_names::listing(scene_names::kOrders) + ", got \"" + s + "\"");
             order = *named;
         }
-        if (o.has("--framebuffer")) {  // issue 54: a slicer's blends, each stored in the frame buffer's format
+        if (o.has("--framebuffer")) {  // a slicer's blends, each stored in the frame buffer's format
             auto choice = [&](const std::string& key, const auto& table, auto fallback) {
                 if (!o.has(key)) return fallback;
                 const std::string v = o.one(key);
@@ -365,7 +365,7 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         const PreparedScene prepared(scene, options);
         return ray(prepared, p[0], p[1]);
     }
-    if (t == "volpack-warp" || t == "volpack-voxel" || t == "volpack-scene") {  // issue 55
+    if (t == "volpack-warp" || t == "volpack-voxel" || t == "volpack-scene") {
         const Options o(t, args, t == "volpack-warp"    ? std::set<std::string>{"--scene", "--pixel", "--set"}
                                  : t == "volpack-voxel" ? std::set<std::string>{"--scene", "--voxel", "--set"}
                                                         : std::set<std::string>{"--scene", "--step", "--set"});

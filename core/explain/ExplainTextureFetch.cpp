@@ -1,4 +1,4 @@
-// explain texture-fetch (issue 27): one linearly filtered 3D texture fetch worked out step by step with
+// explain texture-fetch: one linearly filtered 3D texture fetch worked out step by step with
 // the renderer's own rule (core/integrate/profiles/TextureUnit.h): the coordinate as the unit takes it,
 // the integer axis weights, the eight integer corner weights, the texels (truncated for float32), the
 // sum and its rounding, the result, and exact trilinear filtering at the same position beside it.

@@ -1,4 +1,4 @@
-// explain volpack-warp, volpack-voxel, volpack-scene (issue 55): one output pixel's 2D warp, one
+// explain volpack-warp, volpack-voxel, volpack-scene: one output pixel's 2D warp, one
 // voxel's classification and shading, and the continuous scene of a VolPack scene, with the volpack
 // profile's own renderer (VolPackRenderer.h, VolPack.h).
 #include <cmath>

@@ -102,7 +102,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     t.projection = r.projection;
     t.order = r.order;
     if (!v.classifier) {
-        // volpack (issue 55): VolPack's own renderer has no ray of volref's: the rows are the warp's taps
+        // volpack: VolPack's own renderer has no ray of volref's: the rows are the warp's taps
         // (each an intermediate pixel, `alpha` its weight) and then the pixel (explain volpack-warp).
         Collector collector(scene, t.samples);
         t.pixel = scene.trace_pixel(x, y, collector);
@@ -110,7 +110,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
     }
     t.intervals = scene.intervals(t.ray);
     t.step = v.step;
-    {  // issue 32: every sample is kept (and printed): counted against the memory limit before the march
+    {  // every sample is kept (and printed): counted against the memory limit before the march
         double samples = 0.0;
         for (const Interval& i : t.intervals) samples += double(segment_count(i, t.step)) + 1.0;  // + the exit (profiles)
         const double bytes = samples * double(sizeof(TracedSample) + conventions::kTraceBytesPerSampleOutput);
@@ -127,7 +127,7 @@ PixelTrace trace_pixel(const PreparedScene& scene, int x, int y) {
                resolve_profile(r).placement == Profile::Placement::Slices;
     Collector collector(scene, t.samples);
     t.pixel = scene.trace_pixel(x, y, collector);
-    for (TracedSample& s : t.samples) {  // issue 29: the rows' interval and step from its entry
+    for (TracedSample& s : t.samples) {  // the rows' interval and step from its entry
         for (std::size_t i = 0; i < t.intervals.size(); ++i)
             if (t.intervals[i].t0 <= s.record.t) s.interval = std::int64_t(i);
         if (s.interval >= 0 && t.step > 0.0)
@@ -220,7 +220,7 @@ std::vector<Column> columns(const PixelTrace& t) {
     } else {
         add("running", [=](const TracedSample& s) { return num(s.record.running); });
     }
-    if (t.slices) {  // issue 54: the surface each fragment lies on, and its blend before the frame buffer stored it
+    if (t.slices) {  // the surface each fragment lies on, and its blend before the frame buffer stored it
         add("surface", [](const TracedSample& s) { return std::to_string(s.record.surface); });
         for (int a = 0; a < 4; ++a)
             add(std::string("blend_") + "rgba"[a], [=](const TracedSample& s) { return num(s.record.blend_exact[a]); });

@@ -36,7 +36,7 @@ struct GridLocation {
 struct TracedSample {
     SampleRecord record;
     GridLocation grid;
-    // issue 29: where the sample lies, the same with empty-space skipping on or off: the interval
+    // where the sample lies, the same with empty-space skipping on or off: the interval
     // (index into PixelTrace::intervals: the last with t0 <= t) and the step from its entry,
     // segment = floor((t - t_entry) / h + kSegmentSlack) (kSegmentSlack = 1e-9, conventions section 4) (midpoints: the segment's index k; from the entry:
     // floor(first + k)). -1 for a sample before every interval.
@@ -58,7 +58,7 @@ struct PixelTrace {
     bool slices = false;         // placement "slices": each sample's surface and its blend's rounding are listed
     std::vector<TracedSample> samples;
     PixelValue pixel;            // what the integrator returned
-    std::string fault;           // issue 28: why the mirrored program does not finish this ray (empty: it does)
+    std::string fault;           // why the mirrored program does not finish this ray (empty: it does)
 };
 
 // Throws volref::Error: a pixel outside the image ("--pixel: ..."), first-hit ("trace: first-hit is

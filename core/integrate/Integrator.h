@@ -29,7 +29,7 @@ struct PixelValue {
     glm::dvec4 rgba{0.0};  // premultiplied
     double depth = std::numeric_limits<double>::infinity();  // first-hit: distance of the hit (Z)
     double error = 0.0;  // the estimated bound on |error| over R, G, B, A (integrators that write "error")
-    // The mirrored program cannot finish this ray (its loop cannot end: issue 28); rgba is NaN.
+    // The mirrored program cannot finish this ray (its loop cannot end); rgba is NaN.
     bool fault = false;
 };
 
@@ -70,7 +70,7 @@ public:
         (void)recorder;
         throw Error("trace: this projection or integrator is not supported yet");
     }
-    // Resumable integration (march/RaySpan.h, issue 30): the ray in spans, the accumulator's state
+    // Resumable integration (march/RaySpan.h): the ray in spans, the accumulator's state
     // handed from span to span; volref-mpi's ranks each integrate their span. An integrator that
     // cannot be resumed says so (resumable() false; the functions below then throw).
     virtual bool resumable() const { return false; }

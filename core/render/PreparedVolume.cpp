@@ -108,7 +108,7 @@ int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const
 
 namespace {
 
-// The box a profile's rays are clipped to (issue 29; Profile::RayBox): the domain, the texel box (the
+// The box a profile's rays are clipped to (Profile::RayBox): the domain, the texel box (the
 // domain grown by spacing / 2 on every side) or the profile's own box; reads outside the domain are
 // clamped to it (ProfileIntegrator::value). `warnings` gets a line when volume.bounds reaches past the
 // domain (the rays are clipped to the domain there).
@@ -198,7 +198,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     if (vs.transform) transform.emplace(*vs.transform);
     const Volume& volume = model.volume();
     if (scene.render.profile == ProfileId::VolPack) {
-        // VolPack's shear-warp (issue 55): VolPack's own classification and shading from
+        // VolPack's shear-warp: VolPack's own classification and shading from
         // render.profile_options (no transfer function, geometry or sample pipeline); the view is its own.
         bytes = volume.values.bytes() + volume.values.size() * (sizeof(float) + 3);  // the voxels' opacity, code, gradient
         check_memory(held_bytes + bytes, key + ": VolPack's classified voxels");
@@ -316,7 +316,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
 
     // The bounding geometry (in the volume's own space), and the box the default camera frames.
     glm::dvec3 lo, hi;
-    const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules (issue 29)
+    const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules
     if (vs.bounds.type == BoundsSpec::Type::Tetrahedra && vs.bounds.overlap == BoundsSpec::Overlap::Count &&
         (scene.render.reference_integrators() || scene.render.profile == ProfileId::Fast || resolved.placement != Profile::Placement::Slices))
         throw Error(key + ".bounds.overlap: \"count\" (each tetrahedron drawn on its own) is a slicer's: it applies to "
@@ -354,7 +354,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
     geometry.commit();
     world_box(transform ? &*transform : nullptr, lo, hi, view_lo, view_hi);
-    // issue 32: the samples one ray may take here, before any ray is cast (conventions::kMaxSamplesPerRay):
+    // the samples one ray may take here, before any ray is cast (conventions::kMaxSamplesPerRay):
     // no interval inside the volume's world box is longer than its diagonal.
     if (const double diagonal = glm::length(view_hi - view_lo); !(diagonal / step <= conventions::kMaxSamplesPerRay)) {
         char buf[200];
@@ -378,10 +378,10 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                         "\" casts rays through the whole grid (VTK's mapper has no bounds): remove volume.bounds");
         image_space = std::make_unique<vtkcpu::VtkFixedPointRenderer>(volume, *classifier, shader.get(), scene.render.projection,
                                                                       step, scene.camera, scene.image, vs.interpolation);
-    } else if (p.renderer == Profile::Renderer::VtkJs) {  // issue 22
+    } else if (p.renderer == Profile::Renderer::VtkJs) {
         integrator = std::make_unique<VtkJsIntegrator>(*context, volume, vs, scene);
     } else {
-        // placement "slices" (issue 54): the surfaces are placed from the frame's camera (for one volume
+        // placement "slices": the surfaces are placed from the frame's camera (for one volume
         // PreparedScene's, which frames this volume's box) and the geometry's box.
         std::optional<Camera> camera;
         SliceFrame frame;

@@ -104,7 +104,7 @@ namespace {
 // x86 by streaming stores (SSE2 _mm_stream_pd, then a store fence), which write whole cache lines without
 // reading them first: the frame never reads its image, and the 8 MiB of a 512 x 512 RGBA image in double
 // are larger than L2, so plain stores read each line back from memory first, and on an Intel Xeon those
-// reads held up the voxel fetches (docs/performance.md, "The film's rows by streaming stores (session 24)").
+// reads held up the voxel fetches (docs/performance.md, "The film's rows by streaming stores").
 // The same values either way; a destination not on 16 bytes (an odd channel count on an odd width) is copied.
 void write_tile(Image& image, const double* tile, std::size_t row, int x0, int y0, int x_end, int y_end) {
     const std::size_t n = std::size_t(x_end - x0) * image.channel_count();
@@ -201,7 +201,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
         // Step doubling: the image at h, and its error estimate from the image at h / 2.
         RenderOptions single = options;
         single.error_estimate = false;
-        // issue 32: the coarse image is held while the fine one is rendered, and the result is a third:
+        // the coarse image is held while the fine one is rendered, and the result is a third:
         // both renders count two more images against the memory limit (PreparedVolume's check).
         const HeldMemory images(2 * std::size_t(scene.image.width) * std::size_t(scene.image.height) * 6 * sizeof(double));
         const Image coarse = render_scene(scene, single, stats);
@@ -238,7 +238,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     const std::size_t error_channel = channels.size();
     if (error) channels.push_back("error");
     const std::size_t fault_channel = channels.size();
-    if (fault) channels.push_back("fault");  // issue 28: 1 where the mirrored program does not finish
+    if (fault) channels.push_back("fault");  // 1 where the mirrored program does not finish
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : tile_side(W, H, arena.max_concurrency());
@@ -289,7 +289,7 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     if (stats) stats->frames_s.push_back(std::chrono::duration<double>(Clock::now() - frame_start).count());
     }
     if (stats && options.count_samples) stats->sample_positions = count_sample_positions(prepared, scene, arena);
-    // issue 32: a NaN the scene did not ask for never leaves as a result. A scene asks for NaN in two ways:
+    // A NaN the scene did not ask for never leaves as a result. A scene asks for NaN in two ways:
     // a fault pixel (the mirrored program does not finish: fault channel 1), and the vtk-js profile, which
     // reproduces vtk.js's own (C / A) A, NaN where a ray accumulates A = 0 (its samples below the 0.001 cut-off; conventions
     // section 9). Any other NaN is refused here, before an image is written, with the first pixel named.

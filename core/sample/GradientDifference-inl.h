@@ -1,6 +1,6 @@
 // The gradient by differences (GradientField's "central" and "forward" schemes, conventions section 2)
 // as a template over a lane type L (core/Lanes.h: ScalarLanes for GradientField, SimdLanes for the
-// packet kernels, core/integrate/packet/PacketComposite.cpp): one formula for both (issue 30).
+// packet kernels, core/integrate/packet/PacketComposite.cpp): one formula for both.
 // Included once inside namespace volref (GradientField.cpp) and once inside each Highway target's
 // namespace; hence no include guard and no includes.
 

@@ -1,6 +1,6 @@
 // Trilinear reconstruction's arithmetic as templates over a lane type L (core/Lanes.h: ScalarLanes for
 // VolumeSampler and ShellSampler, SimdLanes for the packet kernels, packet/PacketKernels-inl.h), so
-// that the scalar and SIMD samplers share one formula, as the accumulators do (issue 30). Included once
+// that the scalar and SIMD samplers share one formula, as the accumulators do. Included once
 // inside namespace volref (Trilinear.h) and once inside each Highway target's namespace; hence no
 // include guard and no includes. Only the fetch of the eight corners is each sampler's own.
 

@@ -30,7 +30,7 @@ struct Cubic {
 // The value of f at the end t of a piece (a part of the ray inside one cell), read in the piece's own
 // cell: f(t), or f one double inside the piece (towards `toward`) where f(t) is not finite. At a grid
 // plane the sampler reads the cell above it, which may have a non-finite corner while the piece's cell
-// is finite (issue 18: a NaN layer hid the finite cell's maximum and crossing). Returns (t used, value).
+// is finite (a NaN layer would otherwise hide the finite cell's maximum and crossing). Returns (t used, value).
 template <class F>
 std::pair<double, double> piece_end(const F& f, double t, double toward) {
     const double v = f(t);

@@ -1,4 +1,4 @@
-// The one scalar ray march (issue 30; pbrt-v4's SampleT_maj shape): every fixed-step integrator, the
+// The one scalar ray march (pbrt-v4's SampleT_maj shape): every fixed-step integrator, the
 // several-volume mix, the profiles and the texture band are callbacks of march(). It owns the sample
 // placement (SamplePlacement.h: the reference's segment midpoints, or a profile's samples from the entry
 // or from the exit), the span a caller integrates (RaySpan.h: the samples whose position lies in

@@ -1,4 +1,4 @@
-// Resumable integration (issue 30): a ray integrated in parts, each part a span of the ray with the
+// Resumable integration: a ray integrated in parts, each part a span of the ray with the
 // accumulator's state handed in and out. volref-mpi's ranks each own the span of a ray inside their
 // brick (cli/mpi/); the single-process render integrates the whole ray as one span.
 //

@@ -37,7 +37,7 @@ inline Segment segment(const Interval& iv, double step, std::int64_t k, std::int
 inline double from_entry_count(const Interval& iv, double step, double first) {
     return std::max(1.0, std::floor(iv.length() / step + 1.0 - first));
 }
-// From the entry or the exit, by the step-count rule (issue 29; Profile::StepCount): ThroughExit is
+// From the entry or the exit, by the step-count rule (Profile::StepCount): ThroughExit is
 // from_entry_count; BeforeExit: n = max(0, ceil(L / h - first)), the samples with t < t1 (a shader's
 // `while (t < t_exit)`).
 template <class StepCount>

@@ -62,7 +62,7 @@ struct SampleRecord {
     // average/xray: s(v), the transfer function's coordinate of the value (what is integrated).
     double coordinate = 0.0;
     glm::dvec4 accumulated{0.0};        // premultiplied RGBA after this sample
-    // Placement "slices" (issue 54): the sampling surface k the sample lies on (0 the farthest); -1 otherwise.
+    // Placement "slices": the sampling surface k the sample lies on (0 the farthest); -1 otherwise.
     // `accumulated` is then the frame buffer as it holds the pixel after this fragment's blend.
     std::int64_t surface = -1;
     glm::dvec4 blend_exact{0.0};  // slices: the blend's result before the frame buffer stored it

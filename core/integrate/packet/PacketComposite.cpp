@@ -362,8 +362,9 @@ class CompositeLanes {
     // ray (p + 4 len d: where the lane will be unless it skips or its interval ends), for every
     // kPrefetchLaneStride-th lane: lanes 0, 5, 10, 15 of a 4 x 4 packet, its diagonal (neighbouring
     // lanes read mostly the same cache lines). The one-step-ahead fetch hides what the core's reorder
-    // window can hold; these hints retire at once. Measured (docs/performance.md, session 23): 3-5% on
-    // the fast profile's frame; every lane instead (64 hints a step) or 2 steps ahead: slower.
+    // window can hold; these hints retire at once. Measured (docs/performance.md, "Prefetch hints on the
+    // fast profile's lanes"): 3-5% on the fast profile's frame; every lane instead (64 hints a step) or 2
+    // steps ahead: slower.
     static constexpr int kPrefetchSteps = 4;
     static constexpr int kPrefetchLaneStride = 5;
 
@@ -568,8 +569,9 @@ private:
 // themselves would hold up the core's reorder window. The cell of the first segment's midpoint
 // t = (t0 + min(t0 + h, t1)) / 2 of the first interval (SamplePlacement.h; where the march samples
 // first unless skipping moves it on), its four x-rows (y, z and their next): a hint, nothing is read.
-// Measured (docs/performance.md, session 23): 2-5% on the fast profile's frame, nothing on the
-// reference's (double lanes, which do not take it), nothing more from the second sample as well.
+// Measured (docs/performance.md, "Prefetch hints on the fast profile's lanes"): 2-5% on the fast
+// profile's frame, nothing on the reference's (double lanes, which do not take it), nothing more from
+// the second sample as well.
 HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
                                        int count) {
     const auto* voxels = static_cast<const unsigned char*>(in.grid.voxels);
@@ -598,8 +600,9 @@ HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ra
 // packet's next step waits on its voxels and its skipping grid's cells; the other's work fills that
 // wait). Double lanes (the reference), and pre-integrated segments: one packet after the other. Each
 // packet's lanes take the same samples in the same order either way. Measured (docs/performance.md,
-// session 22): on float lanes 2 in flight 2-3% faster than 1 and 4 slower; on double lanes 2 in flight
-// 4% slower than 1 (twice the packets of a block, each twice the state).
+// "Primary rays on SIMD lanes and two packets in flight"): on float lanes 2 in flight 2-3% faster than
+// 1 and 4 slower; on double lanes 2 in flight 4% slower than 1 (twice the packets of a block, each
+// twice the state).
 template <typename T>
 constexpr int kInFlight = std::is_same_v<T, float> ? 2 : 1;
 template <typename T>

@@ -60,7 +60,7 @@ using ::volref::HWY_NAMESPACE::SimdLanes;
 #include "transfer/PiecewiseLinear-inl.h"
 #include "transfer/PreIntegration-inl.h"
 
-// Empty-space skipping of the composite packets, decided for all lanes at once (issue 31, part 1):
+// Empty-space skipping of the composite packets, decided for all lanes at once:
 // what a packet needs of the macrocell grid (MacrocellGrid.h) to find the kernel's cell of a position.
 struct VectorSkip {
     // Per octant o of ray directions and macrocell m, at o * (macrocells) + linear(m): the empty distance
@@ -108,7 +108,8 @@ struct RayPacketT {
     // Local coordinates (float lanes, the fast profile): each lane's ray starts at its first entry
     // point t_ref, relative to `local_origin` (the volume's origin), both in double before rounding,
     // and tm holds t - t_ref; so a volume far from the world origin loses no float precision
-    // (issue 18: 0.235 off at origin 5e5). t_ref = 0 and world coordinates otherwise.
+    // (in float world coordinates a volume at 5e5 from the origin is 0.235 off). t_ref = 0 and world
+    // coordinates otherwise.
     HWY_ALIGN double t_ref[kLanes] = {};
     HWY_ALIGN T t_ref_lane[kLanes] = {};
     // Each real lane's walk, constructed in place for the lanes < count (the others are never read:
@@ -442,8 +443,8 @@ using RayPacket = RayPacketT<double>;
 // u = clamp((x - origin) inv_spacing, 0, n - 1), cell min(floor(u), n - 2), Levoy's sum in order).
 // The voxels are read in their storage type (VoxelArray) and converted to double exactly, so the sum
 // is the same whatever the type. One switch on the type per packet sample, then per type:
-//   f64: each x-neighbour pair as one 128-bit load per lane (four rows, split into even and odd lanes;
-//     since session 25), 64-bit index gathers on a grid one voxel wide in x or the one-lane target;
+//   f64: each x-neighbour pair as one 128-bit load per lane (four rows, split into even and odd lanes),
+//     64-bit index gathers on a grid one voxel wide in x or the one-lane target;
 //   f32: each x-neighbour pair f(i, j, k), f(i + 1, j, k) as one 64-bit load (x_pair), promoted;
 //   i32, u32: 32-bit gathers with int32 indices, promoted to double (u32: read as i32, plus 2^32
 //     where negative, exact);
@@ -520,7 +521,7 @@ struct PacketTrilinearT {
             case ScalarType::I8: kind = fits32 && little ? Kind::I8 : Kind::Lanes; break;
             default: kind = Kind::Lanes; break;
         }
-        // Pairs: f32 voxels on float and (since session 16, loaded without a buffer) double lanes,
+        // Pairs: f32 voxels on float and double lanes (loaded without a buffer),
         // where the reference's step-1 frame measured 18% faster than with 32-bit gathers on AVX-512;
         // not on Highway's one-lane scalar target.
         pairs = kind == Kind::F32 && !flat[0] && little && hn::MaxLanes(D()) >= 2 && HWY_TARGET != HWY_SCALAR;

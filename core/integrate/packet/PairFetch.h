@@ -3,9 +3,9 @@
 // vectors (Loads), or 64-bit gathers, one per half vector of float lanes and one per vector of double lanes
 // (Gathers). The same values either way: a speed choice that changes no bit (conventions section 12).
 // Auto, the default: Gathers on Intel CPUs, Loads on others. Measured (docs/performance.md, "Voxel pairs by
-// gathers on Intel (session 24)"): on an Intel Xeon with AVX-512 the gathers made the reference's benchmark
-// frame 7% and the fast profile's 3.5% faster; on the AMD EPYC of sessions 13 to 23 the loads measured 18%
-// faster than 32-bit gathers (session 16) and 25% faster than these 64-bit gathers (session 20).
+// gathers on Intel"): on an Intel Xeon with AVX-512 the gathers made the reference's benchmark frame 7% and
+// the fast profile's 3.5% faster; on an AMD EPYC the loads measured 18% faster than 32-bit gathers and 25%
+// faster than these 64-bit gathers.
 #pragma once
 
 namespace volref {

@@ -1,4 +1,4 @@
-// A slicer's frame buffer (issue 54; conventions section 9, "Slice-order renderers"): one pixel's
+// A slicer's frame buffer (conventions section 9, "Slice-order renderers"): one pixel's
 // (C, A), cleared to (0, 0, 0, 0), into which each slice fragment (c, a) (colour not premultiplied,
 // alpha) is blended and stored in the buffer's format. The accumulator of placement "slices"
 // (ProfileIntegrator::composite_slices), and of `volref explain composite`'s 8-bit blend.

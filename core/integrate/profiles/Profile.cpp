@@ -10,7 +10,7 @@ namespace volref {
 
 namespace {
 
-// The reference's conventions as rules (issue 29): what a custom profile on base "reference" starts
+// The reference's conventions as rules: what a custom profile on base "reference" starts
 // from. The reference itself renders through its own integrators (RenderSpec::reference_integrators);
 // this preset's ProfileIntegrator differs from them only in rounding (and from a gradient cache, volume.
 // gradient.cache, by its interpolation).
@@ -53,7 +53,7 @@ Profile make_vtk_cpu() {
     return p;
 }
 
-// VolPack 1.0b3's shear-warp (issue 55): its own renderer (VolPackRenderer.h), its inputs
+// VolPack 1.0b3's shear-warp: its own renderer (VolPackRenderer.h), its inputs
 // render.profile_options (docs/conventions.md, "VolPack").
 Profile make_volpack() {
     Profile p;
@@ -63,7 +63,7 @@ Profile make_volpack() {
     return p;
 }
 
-// A textbook GLSL ray caster (issue 7): samples from the entry point on, acc += (1 - acc.a) col.a col
+// A textbook GLSL ray caster: samples from the entry point on, acc += (1 - acc.a) col.a col
 // with the transfer function's opacity used as the sample's alpha (no correction), stop at alpha >= 1,
 // central differences at +-0.1 in texture coordinates ([0, 1] over the volume's domain).
 Profile make_glsl_basic() {
@@ -77,7 +77,7 @@ Profile make_glsl_basic() {
     p.termination.alpha_at_least = 1.0;
     p.gradient_offset = 0.0;
     p.gradient_offset_texture = 0.1;
-    // Seed 002 (issue 17): acc += (1 - acc.a) * K * tf(v).a * v.rrra, samples with v < 0.01 skipped,
+    // Seed 002: acc += (1 - acc.a) * K * tf(v).a * v.rrra, samples with v < 0.01 skipped,
     // getNormalFromVol's normal = +grad f.
     p.color_from_value = true;
     p.value_cutoff = 0.01;
@@ -86,7 +86,7 @@ Profile make_glsl_basic() {
     return p;
 }
 
-// OSPRay SciVis / Open VKL (issue 7, spec section 9): alpha = 1 - exp(-a dt densityScale) with
+// OSPRay SciVis / Open VKL (spec section 9): alpha = 1 - exp(-a dt densityScale) with
 // densityScale 1 (the transfer-function opacity taken as an extinction coefficient per world unit),
 // forward-difference gradients (one voxel), termination at T <= 0.001. Placement: the reference's
 // segment midpoints (OSPRay jitters its samples inside each step; without jitter the midpoint is the
@@ -105,7 +105,7 @@ Profile make_ospray() {
     return p;
 }
 
-// A CUDA ray caster for cylindrical and spherical data (issue 7, shared spec section 9): samples from
+// A CUDA ray caster for cylindrical and spherical data (shared spec section 9): samples from
 // the entry point on at a step of size / n voxels, composited back to front by
 // sum = lerp(sum, col, col.a * density) over the samples with s >= the iso threshold, the transfer
 // function read from a 9-entry linearly filtered table over [0, 1] at s * transfer scale (texel position
@@ -128,7 +128,7 @@ Profile make_cuda_curvilinear() {
     return p;
 }
 
-// vtk.js 37.4.3's WebGL2 volume mapper (issue 22): its own integrator, VtkJsIntegrator.h (the fields
+// vtk.js 37.4.3's WebGL2 volume mapper: its own integrator, VtkJsIntegrator.h (the fields
 // below are not read; check_profile_applies reads grids).
 Profile make_vtk_js() {
     Profile p;
@@ -138,7 +138,7 @@ Profile make_vtk_js() {
     return p;
 }
 
-// OpenGL Volumizer (SGI, 1998; seed 003, ../shared/notes/volumizer.md; issue 54): planes parallel to
+// OpenGL Volumizer (SGI, 1998; seed 003, ../shared/notes/volumizer.md): planes parallel to
 // the viewport through the geometry's bounding box (samplingMode VIEWPORT_ALIGNED, samplingSpace OBJECT,
 // the first plane on the far bound: L1202, L1231-1233), spaced by the scene's step (the guide's
 // samplingPeriod of one voxel is `slices.period`), 3D textures of 8-bit texels over dataScaleRange
@@ -302,7 +302,7 @@ nlohmann::json profile_rules_json(const Profile& p) {
     if (p.gradient_offset_texture > 0.0) r.gradient_offset_texture = p.gradient_offset_texture;
     else r.gradient_offset = p.gradient_offset;
     r.clamp_shaded = p.clamp_shaded;
-    if (p.placement == Profile::Placement::Slices) {  // the rules a slicer reads (issue 54)
+    if (p.placement == Profile::Placement::Slices) {  // the rules a slicer reads
         r.slices = p.slices;
         r.texture = p.texture;
         r.texture_format = p.texel_format;

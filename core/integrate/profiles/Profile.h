@@ -26,7 +26,7 @@ struct Profile {
     // Which renderer reads the rest: a ray caster over the scene's rays (ProfileIntegrator), or VTK's
     // image-space fixed-point caster (VtkFixedPointRenderer.h: its own internal image, 15-bit fixed
     // point, texture display; the fields below are not read).
-    // VtkJs: VtkJsIntegrator.h (issue 22); VolPack: VolPackRenderer.h (issue 55)
+    // VtkJs: VtkJsIntegrator.h; VolPack: VolPackRenderer.h
     enum class Renderer { RayCaster, VtkFixedPoint, VtkJs, VolPack };
     Renderer renderer = Renderer::RayCaster;
 
@@ -34,7 +34,7 @@ struct Profile {
     // shells as well (no clamping: the intervals stay inside; no gradients).
     enum class Grids { Cartesian, CartesianAndShells };
     Grids grids = Grids::Cartesian;
-    // Seed 001's texture reads on shells (interpolateCyl / interpolateSpher; cuda-curvilinear, issue 17):
+    // Seed 001's texture reads on shells (interpolateCyl / interpolateSpher; cuda-curvilinear):
     // per grid axis x = (c - lo) / ((hi - lo) / n) (an angle taken in [0, 360) from lo); a point with any
     // x < 0 or x > n - 1 reads outVal = 0, here the data minimum (s = 0); otherwise tex3D with unnormalised
     // coordinates and cudaAddressModeClamp: trilinear at grid index clamp(x - 0.5, 0, n - 1) (texel i is
@@ -46,7 +46,7 @@ struct Profile {
     // Midpoints (the reference): segments of h, sampled at their midpoints, weighted by their lengths.
     // FromEntry: t0 + (first + k) h for k = 0 .. n-1, n by `step_count`. Positions past t1 read the
     //   texture clamped to the domain.
-    // FromExit: seed 001 (cuda-curvilinear, issue 17): `for (s = outAbs; s >= inAbs; s -= step)` over one
+    // FromExit: seed 001 (cuda-curvilinear): `for (s = outAbs; s >= inAbs; s -= step)` over one
     //   span [inAbs, outAbs] = [the first interval's t0, the last one's t1]: t1 - k h for k = 0 .. n - 1
     //   (first = 0), back to front; samples in the gaps between intervals read the field as value() says.
     using Placement = ProfileRules::Placement;
@@ -140,7 +140,7 @@ struct Profile {
     };
     Xray xray = Xray::LineIntegral;
 
-    // --- slicers (placement Slices; issue 54; Slices.h, FrameBuffer.h) ------------------------------
+    // --- slicers (placement Slices; Slices.h, FrameBuffer.h) ----------------------------------------
     // The sampling surfaces, what a slice fragment computes and the frame buffer that blends them
     // (conventions section 9, "Slice-order renderers"); read only under placement Slices.
     ProfileRules::Slices slices{};
@@ -174,7 +174,7 @@ struct Profile {
 // The preset a scene names (render.profile, or its "base").
 const Profile& profile(ProfileId id);
 
-// The profile a scene renders with (issue 29): the preset render.profile names with the scene's rules
+// The profile a scene renders with: the preset render.profile names with the scene's rules
 // (render.profile as an object) set over it; `name` says "custom (base ...)" when a rule is set.
 Profile resolve_profile(const RenderSpec& render);
 

@@ -59,7 +59,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         volume_ = &volume;
         if (!shell_) throw Error(std::string("render.profile: \"") + p_.name + "\" needs the shell's grid");
     }
-    // issue 17: the texture unit and its band (TextureUnit.h; conventions section 9, "The texture unit")
+    // the texture unit and its band (TextureUnit.h; conventions section 9, "The texture unit")
     const ProfileOptions& po = ctx.render.profile_options;
     if (po.data_unorm16 && !shell_)
         throw Error("render.profile_options.texture_format: \"unorm16\" is seed 001's data texture on a shell (cylindrical or spherical bounds)");
@@ -92,7 +92,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         const double n = double(volume.dims[std::size_t(axis)]);
         if (n > 1.0) step_ = ctx.step * (n - 1.0) / n;
     }
-    // issue 28: seed 001's kernel in float32 (Seed001Kernel.h) for what the seed renders (composite, x-ray)
+    // seed 001's kernel in float32 (Seed001Kernel.h) for what the seed renders (composite, x-ray)
     if (p_.id == ProfileId::CudaCurvilinear && shell_ && bounds && po.kernel == ProfileOptions::Kernel::Float32 &&
         (ctx.render.projection == Projection::Composite || ctx.render.projection == Projection::Xray)) {
         if (texture_unit_ == ProfileOptions::TextureUnit::Admissible)
@@ -100,7 +100,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         kernel_ = std::make_unique<Seed001Kernel>(seed001_frame(volume, *bounds, ctx.pipeline.classifier(), ctx.render, step_),
                                                   texture_unit_ == ProfileOptions::TextureUnit::H100, band_);
     }
-    if (po.tricubic) {  // issue 28: seed 001's cubicInterpolate (Seed001Kernel.h, seed001_cubic)
+    if (po.tricubic) {  // seed 001's cubicInterpolate (Seed001Kernel.h, seed001_cubic)
         if (!shell_)
             throw Error("render.profile_options.tricubic: seed 001's tri-cubic option reads a shell's data (cylindrical or spherical bounds)");
         if (!kernel_ && (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_))
@@ -138,7 +138,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
 
 ProfileIntegrator::~ProfileIntegrator() = default;
 
-// A rule this integrator cannot honour is an error naming it (issue 29): never ignored.
+// A rule this integrator cannot honour is an error naming it: never ignored.
 void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) const {
     const ProfileRules& r = render.profile_rules;
     auto fail = [](const std::string& key, const std::string& why) { throw Error("render.profile." + key + ": " + why); };
@@ -151,7 +151,7 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
                 fail(k, "seed 001's float32 kernel runs the program's own loop, whose rules are fixed (set render.profile.arithmetic "
                         "\"double\" to render with other rules)");
     if (r.first && p_.placement != Profile::Placement::FromEntry) fail("first", "the first sample's offset applies to placement \"from-entry\"");
-    if (p_.placement != Profile::Placement::Slices) {  // the slicers' rules (issue 54)
+    if (p_.placement != Profile::Placement::Slices) {  // the slicers' rules
         for (const char* k : {"slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
                               "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha", "texture_filter"})
             if (std::find(r.keys.begin(), r.keys.end(), k) != r.keys.end())
@@ -435,7 +435,7 @@ void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, doub
 
 }  // namespace
 
-// Seed 001's kernel (issue 28): the pixel, its band and fault; traced: each sample the kernel takes, at
+// Seed 001's kernel: the pixel, its band and fault; traced: each sample the kernel takes, at
 // t = s (the kernel's distance along its float ray from the origin), its value as the profile's value.
 template <class Rec>
 PixelValue ProfileIntegrator::seed_kernel(const Ray& ray, Rec& rec) const {

@@ -64,10 +64,10 @@ public:
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
                       const BoundsSpec* bounds = nullptr, const SliceFrame* slice_frame = nullptr);
     ~ProfileIntegrator() override;
-    // render.profile_options.texture_band (issue 17): PixelValue::error is the texture band (band()).
-    // render.profile_options.framebuffer_band (issue 54): the frame buffer's band.
+    // render.profile_options.texture_band: PixelValue::error is the texture band (band()).
+    // render.profile_options.framebuffer_band: the frame buffer's band.
     bool writes_error() const override { return band_ || framebuffer_band_; }
-    // cuda-curvilinear's float32 kernel (issue 28): the rays seed 001's loop cannot finish.
+    // cuda-curvilinear's float32 kernel: the rays seed 001's loop cannot finish.
     bool writes_fault() const override { return kernel_ != nullptr; }
     std::string fault_reason(const Ray& ray) const override;
 
@@ -139,11 +139,11 @@ private:
     bool normalized_coordinates_ = true;         // GLSL's texture(): normalised; seed 001's tex3D: not
     const VolumeSampler* cartesian_ = nullptr;         // texture_unit / band on Cartesian grids
     const class TransferFunction* transfer_ = nullptr;  // band without a table: its knots
-    std::unique_ptr<Seed001Kernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell (issue 28)
+    std::unique_ptr<Seed001Kernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell
     template <class Rec>
     PixelValue seed_kernel(const Ray& ray, Rec& rec) const;
 
-    // --- placement "slices" (issue 54; ProfileSlices.cpp, Slices.h, FrameBuffer.h) -------------------
+    // --- placement "slices" (ProfileSlices.cpp, Slices.h, FrameBuffer.h) -----------------------------
     struct Fragment {
         double s = 0.0;        // the texture's filtered value (post) or the trilinear s (pre-unweighted)
         glm::dvec3 color{0.0};  // the classification's colour (not premultiplied)

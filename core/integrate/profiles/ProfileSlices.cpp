@@ -1,4 +1,4 @@
-// ProfileIntegrator's placement "slices" (issue 54; conventions section 9, "Slice-order renderers"): a
+// ProfileIntegrator's placement "slices" (conventions section 9, "Slice-order renderers"): a
 // slicer's pixel as the sequence of frame-buffer blends of the fragments its centre ray crosses. The
 // surfaces are Slices.h's, the frame buffer FrameBuffer.h's; this file is what one fragment computes
 // (the texture's texels and filter, the table or the transfer function, the alpha) and the loop.

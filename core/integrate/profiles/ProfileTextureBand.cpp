@@ -1,6 +1,6 @@
 // The texture band of a mirror profile with a texture unit (render.profile_options.texture_band;
 // conventions section 9, "The texture unit"): ProfileIntegrator::band and its interval arithmetic,
-// apart from the loops of ProfileIntegrator.cpp (issue 30, part 5).
+// apart from the loops of ProfileIntegrator.cpp.
 #include "core/integrate/profiles/ProfileIntegrator.h"
 
 #include <algorithm>

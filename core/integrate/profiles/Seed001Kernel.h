@@ -1,5 +1,5 @@
 // Seed001Kernel: seed 001's CUDA kernel (tests/gpu/cuda/cuda_curvilinear.cu) as it runs on an NVIDIA GPU,
-// in float32 on the CPU (issue 28): the bounding triangles the host builds (volref's tessellation, minus the
+// in float32 on the CPU: the bounding triangles the host builds (volref's tessellation, minus the
 // centre, in float), rayIntersectTriangles with baryTriangleCoefs and its fallback as written, the march
 // `for (float s = outAbs; s >= inAbs; s -= step)` at O + s vect, cartToCyl / cartToSpher, the data texture
 // (unsigned shorts, read as normalised float through the texture unit: TextureUnit.h, exact or h100), the

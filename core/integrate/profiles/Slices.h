@@ -1,4 +1,4 @@
-// A slicer's sampling surfaces (issue 54; conventions section 9, "Slice-order renderers"): OpenGL
+// A slicer's sampling surfaces (conventions section 9, "Slice-order renderers"): OpenGL
 // Volumizer and every 2D/3D-texture slicer cut the volume's geometry with a family of surfaces, the
 // level sets lambda(x) = lambda_k of one function, and a pixel's samples are its centre ray's crossings
 // with them. SliceLattice is that family for one frame (built once, from the camera and the geometry's

@@ -1,4 +1,4 @@
-// TextureUnit: an NVIDIA texture unit's linear filter, bit for bit (issue 27), and the band that bounds
+// TextureUnit: an NVIDIA texture unit's linear filter, bit for bit, and the band that bounds
 // what any unit of its family can return against exact trilinear filtering. The profiles vtk-gpu,
 // glsl-basic and cuda-curvilinear read it (render.profile_options.texture_unit "h100", texture_band;
 // ProfileIntegrator); `volref explain texture-fetch` prints its steps; docs/conventions.md section 9,

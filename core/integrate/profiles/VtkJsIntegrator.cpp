@@ -91,7 +91,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
         case CameraSpec::Type::Perspective:
         case CameraSpec::Type::Orthographic:
             forward_ = glm::normalize(scene.camera.target - scene.camera.eye);
-            // The proxy quad (issue 28, part 5): the window rectangle of the texel box's corners (VolumeMapper.js
+            // The proxy quad: the window rectangle of the texel box's corners (VolumeMapper.js
             // setCameraShaderParameters: boundsDC of getBounds(), the spatial extent, whatever ray_box says).
             // The camera basis and projection as core/camera/Camera.cpp builds the pixel rays.
             if (o.subpixel_bits > 0) {
@@ -190,7 +190,7 @@ bool VtkJsIntegrator::box(const Ray& ray, double& t0, double& t1) const {
     return t1 > t0 && t1 > 0.0;
 }
 
-// The ray vtk.js casts through the pixel whose centre `ray` passes through (issue 28, part 5): the
+// The ray vtk.js casts through the pixel whose centre `ray` passes through: the
 // rasteriser interpolates vertexVCVSOutput (the quad's corners unprojected onto the near plane,
 // vtkVolumeVS.glsl) over the quad as snapped to its sub-pixel grid (SwiftShader SetupRoutine: the plane
 // equations are set up from the fixed-point corners X, Y and the corners' own varyings). Per axis the
@@ -225,7 +225,7 @@ Ray VtkJsIntegrator::rasterised(const Ray& ray) const {
 
 namespace {
 
-// GLSL pow(x, e) in the shader as SwiftShader evaluates it (issue 28, part 5): exp2(e log2(x)) with
+// GLSL pow(x, e) in the shader as SwiftShader evaluates it: exp2(e log2(x)) with
 // log2(0) = -127, so pow(0, e) = 2^(-127 e) and not 0: a sample whose table opacity is exactly 1 counts
 // 1 - 2^(-127 e) for a fraction e of a step (measured: e = 0.00262 gives 0.206 where pow would give 1).
 // For x > 0 the correctly rounded pow (SwiftShader's is within a few float ulps of it).

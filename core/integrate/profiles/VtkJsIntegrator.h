@@ -1,9 +1,9 @@
-// VtkJsIntegrator: the `vtk-js` profile (issue 22): vtk.js 37.4.3's volume ray caster
+// VtkJsIntegrator: the `vtk-js` profile: vtk.js 37.4.3's volume ray caster
 // (Rendering/OpenGL/VolumeMapper.js and its fragment shader Rendering/OpenGL/glsl/vtkVolumeFS.glsl.js,
 // npm @kitware/vtk.js) reproduced as shipped, in double arithmetic, from the scene volref renders.
 // docs/conventions.md section 9, "vtk-js", states every formula with the vtk.js lines it follows; in
 // short (h the step in world units, l the opacity unit distance, n the dims, s the spacing):
-//   - each pixel's ray is the one vtk.js's rasteriser interpolates (issue 28, part 5): vtk.js draws a
+//   - each pixel's ray is the one vtk.js's rasteriser interpolates: vtk.js draws a
 //     screen-space quad over the window rectangle of the texel box's 8 projected corners
 //     (VolumeMapper.js boundsDC, vtkVolumeVS.glsl) and takes the ray origin and direction from the
 //     varying vertexVCVSOutput; the rasteriser snaps the quad's corners to 1 / 2^b of a pixel

@@ -64,7 +64,7 @@ void print_row(const ChannelMetrics& c) {
                 c.ssim ? number(*c.ssim, "%.6f").c_str() : "n/a", c.over);
 }
 
-// B's scene re-rendered with each convention changed (issue 22): the vtk-js profile's options
+// B's scene re-rendered with each convention changed: the vtk-js profile's options
 // flip_normal (shaded composite, one-sided lighting), ray_box and mip_correction (mip/minip). Other
 // profiles: not applicable (no such option).
 std::vector<ConventionVariant> convention_variants(const std::filesystem::path& path,
@@ -220,7 +220,7 @@ int run_compare(const CompareArgs& args) {
     Image scene_render;  // B when compare renders it: the search's base render too
     if (!args.b.empty()) {
         b = read_compared_image(args.b, background);
-    } else {  // issue 29: B is the scene rendered, composited as read_compared_image composites an EXR
+    } else {  // B is the scene rendered, composited as read_compared_image composites an EXR
         b.path = args.scene.string() + " (rendered)";
         scene_render = render_scene(*scene);
         const Image& im = scene_render;
@@ -238,7 +238,7 @@ int run_compare(const CompareArgs& args) {
                     " but " + args.b.string() + " is " + std::to_string(b.rgba.width) + "x" +
                     std::to_string(b.rgba.height) + ": compare needs images of the same size");
 
-    // issue 28: pixels where a mirrored program does not finish (either image's `fault` channel) are
+    // Pixels where a mirrored program does not finish (either image's `fault` channel) are
     // reported apart and left out of the metrics and the tolerance test (0 in both).
     const std::vector<std::array<int, 2>> faults = exclude_faults(a, b);
     const ToleranceSpec tspec{args.tolerance, args.tolerance_from_error};
@@ -250,7 +250,7 @@ int run_compare(const CompareArgs& args) {
     if (args.fit)
         fit = explain_difference(a.rgba, b.rgba,
                                  args.scene.empty() ? std::vector<ConventionVariant>{} : convention_variants(args.scene, background));
-    // issue 29: the rules of the scene's profile and the image models that explain A (ConventionSearch.h)
+    // The rules of the scene's profile and the image models that explain A (ConventionSearch.h)
     std::optional<SearchResult> search;
     if (scene) {
         SearchOptions so;

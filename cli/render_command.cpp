@@ -36,7 +36,7 @@ int run_render(const RenderArgs& args) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_image(image, args.output, scene.image.background);
     std::fprintf(stderr, "volref: rendered %dx%d in %.3f s\n", image.width, image.height, seconds);
-    // issue 28: the rays the mirrored program does not finish (NaN pixels, "fault" channel 1)
+    // The rays the mirrored program does not finish (NaN pixels, "fault" channel 1)
     for (std::size_t c = 0; c < image.channels.size(); ++c)
         if (image.channels[c] == "fault") {
             std::size_t n = 0;

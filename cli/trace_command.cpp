@@ -26,7 +26,7 @@ int run_trace(const TraceArgs& args) {
     options.empty_space_skipping = !args.no_skipping;
     const PreparedScene prepared(scene, options);
     const explain::PixelTrace trace = explain::trace_pixel(prepared, pixel[0], pixel[1]);
-    if (trace.pixel.fault)  // issue 28: the CSV has no place for it; JSON carries it as "fault" too
+    if (trace.pixel.fault)  // the CSV has no place for it; JSON carries it as "fault" too
         std::fprintf(stderr, "volref: pixel (%d, %d): the mirrored program does not finish this ray: %s\n", pixel[0],
                      pixel[1], trace.fault.c_str());
     std::ostringstream text;

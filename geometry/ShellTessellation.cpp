@@ -61,7 +61,7 @@ void check_n(int n) {
     if (n < 3) throw Error("tessellate: needs at least 3 segments per full turn, not " + std::to_string(n));
 }
 
-// issue 32: the mesh's memory (conventions::kMeshBytesPerTriangle per triangle, at most `triangles`),
+// The mesh's memory (conventions::kMeshBytesPerTriangle per triangle, at most `triangles`),
 // checked against --max-memory before it is built.
 void check_mesh_memory(double triangles, int n) {
     const double bytes = triangles * double(conventions::kMeshBytesPerTriangle);

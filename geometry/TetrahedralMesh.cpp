@@ -405,7 +405,7 @@ void orient_one(TetrahedralMesh& mesh, std::size_t k, const std::string& where, 
 
 void check_vertex(const glm::dvec3& p, const std::string& where) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) throw Error(where + " is not finite " + point(p));
-    // issue 32: within volref's number range, like every coordinate of a scene (conventions::kMaxMagnitude)
+    // within volref's number range, like every coordinate of a scene (conventions::kMaxMagnitude)
     if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > conventions::kMaxMagnitude)
         throw Error(where + " " + point(p) + " is beyond volref's range (|x| <= 1e100)");
 }
@@ -514,7 +514,7 @@ TetrahedralMesh read_tetrahedra(const std::string& path) {
                     " does not match the " + std::to_string(n) + " cells of CELLS (line " + std::to_string(seen["CELLS"]) + ")");
     if (n == 0) throw Error(path + ": line " + std::to_string(seen["CELLS"]) + ": CELLS: the file has no tetrahedra");
 
-    // issue 32: the boundary's memory (conventions::kMeshBytesPerTriangle per face) before it is built.
+    // the boundary's memory (conventions::kMeshBytesPerTriangle per face) before it is built.
     check_memory(n * 4 * conventions::kMeshBytesPerTriangle, path + ": " + std::to_string(n) + " tetrahedra");
     const std::size_t nv = mesh.vertices.size();
     mesh.tetrahedra.resize(n);

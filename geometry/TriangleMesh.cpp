@@ -40,7 +40,7 @@ std::string first_line(const std::string& s) {
     return line;
 }
 
-// What tinyobjloader lets pass (issue 32), checked on the text first: a vertex coordinate that is not a
+// What tinyobjloader lets pass, checked on the text first: a vertex coordinate that is not a
 // finite number (it reads "nan" or "1e999" as 0 or inf), and a face index that is 0, beyond the vertices
 // read so far or does not fit an int (it wraps 99999999999999999999 to a small index). Errors name the line.
 void check_obj_text(const std::string& path, std::string_view text) {
@@ -177,7 +177,7 @@ TriangleMesh read_mesh(const std::string& path) {
         const glm::dvec3& p = mesh.vertices[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             throw Error(path + ": vertex " + std::to_string(i) + " is not finite");
-        // issue 32: within volref's number range, like every coordinate of a scene (conventions::kMaxMagnitude)
+        // within volref's number range, like every coordinate of a scene (conventions::kMaxMagnitude)
         if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > conventions::kMaxMagnitude)
             throw Error(path + ": vertex " + std::to_string(i) + " " + point(p) + " is beyond volref's range (|x| <= 1e100)");
     }

@@ -3,7 +3,7 @@
 // world space: x_world = A x_local + b, with A the upper-left 3x3 block and b the last column.
 //
 // A world ray x(t) = o + t d becomes the local ray x_local(t) = A^-1 (o - b) + t A^-1 d: the same t
-// (so segment lengths and distances stay world lengths), a direction that is no longer unit. The
+// (so segment lengths and distances stay world lengths), a direction that is in general not unit. The
 // bounding shapes and crop planes are intersected with the local ray; samples are taken at
 // A^-1 (x - b); gradients come back by the chain rule, grad_world f = A^-T grad_local f.
 #pragma once

@@ -7,7 +7,7 @@
 // the scene key. NaN and infinite values are allowed (rendered transparent, docs/accuracy.md).
 //
 // The array is copied once into a Volume (core/grid/Volume.h) in its own type, and the scene's volume
-// holds it in memory (VolumeSourceSpec::memory, issue 29): no file is written or read.
+// holds it in memory (VolumeSourceSpec::memory): no file is written or read.
 #pragma once
 #include <memory>
 

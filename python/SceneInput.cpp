@@ -44,7 +44,7 @@ bool is_path_like(py::handle scene) {
 }
 
 json to_json(py::handle v, const std::string& prefix, const std::string& path, int depth) {
-    // A dict or list that contains itself, or one nested too deep, would recurse without end (issue 32):
+    // A dict or list that contains itself, or one nested too deep, would recurse without end:
     // the same limit as every JSON document volref reads (conventions::kMaxJsonDepth).
     if (depth > conventions::kMaxJsonDepth)
         throw Error(where(prefix, path.substr(0, 200)) + "...: nested deeper than " + std::to_string(conventions::kMaxJsonDepth) +
@@ -175,7 +175,7 @@ std::unique_ptr<SceneInput> read_scene_input(py::handle scene, py::handle overri
             const std::string key = py::isinstance<py::str>(item.first) ? item.first.cast<std::string>() : "";
             if (key == "source" && is_ndarray(item.second)) {
                 const std::string source = child(path, "source");
-                // In memory (issue 29): the source names a file that is never opened; the parsed scene's
+                // In memory: the source names a file that is never opened; the parsed scene's
                 // volume then holds the array's copy (VolumeSourceSpec::memory).
                 const std::string name = "numpy-volume-" + std::to_string(in->arrays.size()) + ".raw";
                 in->arrays.push_back({name, py::reinterpret_borrow<py::object>(item.second), source,

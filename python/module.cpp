@@ -286,7 +286,7 @@ compare::ComparedImage compared_input(py::handle v, const char* name, py::handle
             if (background) composite_over_background(c, *background);  // the associated input over it (as the CLI)
             for (int k = 0; k < 4; ++k) out.rgba.at(x, y, std::size_t(k)) = c[k];
         }
-    if (fault) {  // issue 28
+    if (fault) {  // the rays a mirrored program does not finish
         const py::array_t<double, py::array::forcecast> e(*fault);
         const auto q = e.unchecked<2>();
         out.fault.resize(std::size_t(w) * std::size_t(h));
@@ -376,7 +376,7 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     if (from_error && a.error.empty() && b.error.empty())
         throw Error("error: neither " + a.path.string() + " nor " + b.path.string() + " has an `error` channel");
 
-    const std::vector<std::array<int, 2>> faults = compare::exclude_faults(a, b);  // issue 28
+    const std::vector<std::array<int, 2>> faults = compare::exclude_faults(a, b);
     const compare::ToleranceSpec tspec{absolute, from_error};
     compare::ImageMetrics m;
     {
@@ -394,15 +394,15 @@ py::object compare_images(py::object a_arg, py::object b_arg, py::object toleran
     j["overall"] = compare::channel_json(m.overall, m.pixels);
     j["pixels"] = m.pixels;
     j["pixels_over"] = m.overall.over;
-    j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};  // issue 22
-    j["fault"] = nlohmann::json::array();  // issue 28: the pixels (x, y) where a mirrored program does not finish
+    j["non_finite"] = {{"a", m.non_finite_a}, {"b", m.non_finite_b}, {"disagree", m.non_finite_disagree}};
+    j["fault"] = nlohmann::json::array();  // the pixels (x, y) where a mirrored program does not finish
     for (const auto& f : faults) j["fault"].push_back({f[0], f[1]});
     j["fraction_over"] = m.fraction_over();
     j["within_tolerance"] = m.overall.over == 0;
     return json_loads(j.dump());
 }
 
-// ---- fit, heatmap, write_image, profiles (issue 29) -------------------------------------------
+// ---- fit, heatmap, write_image, profiles ------------------------------------------------------
 
 // A (height, width) float64 array of `values` (row 0 on top).
 py::array_t<double> image_plane(const std::vector<double>& values, int width, int height) {

@@ -1,6 +1,6 @@
 // A piecewise-linear table's interpolation (PiecewiseLinear.h states the rule) as templates over a
 // lane type L (core/Lanes.h: ScalarLanes for PiecewiseLinear, SimdLanes for the packet kernels'
-// tables, core/integrate/packet/PacketComposite.cpp): one formula for both (issue 30). Finding the
+// tables, core/integrate/packet/PacketComposite.cpp): one formula for both. Finding the
 // rows is each form's own (a binary search; a count of the rows at or below v). Included once inside
 // namespace volref (PiecewiseLinear.h) and once inside each Highway target's namespace; hence no
 // include guard and no includes.

@@ -1,9 +1,9 @@
 // Gradient shading's arithmetic (conventions section 8; Shader.h states the model) as templates over
 // a lane type L (core/Lanes.h: ScalarLanes for Shader, SimdLanes for the packet kernels,
 // core/integrate/packet/PacketComposite.cpp), so that the scalar and SIMD paths share one formula, as
-// the accumulators do (issue 30). Included once inside namespace volref (Shader.cpp) and once inside
+// the accumulators do. Included once inside namespace volref (Shader.cpp) and once inside
 // each Highway target's namespace; hence no include guard and no includes. Every product and sum is
-// written in the order the scalar shader has always evaluated it (glm's dot: (x + y) + z).
+// written in the order the scalar shader evaluates it (glm's dot: (x + y) + z).
 
 // The shading coefficients the lanes read (ks = 0 for nodal; phong: R.V instead of N.H).
 struct ShadingConstants {

@@ -17,7 +17,7 @@ VolumeLayout read_volume_header(const std::filesystem::path& path, const std::st
                     ": volref-mpi reads bricks as sub-boxes of uncompressed samples stored in the volume's axis order; "
                     "this file has " + h.not_direct + " (rewrite it with `volref convert " + path.filename().string() +
                     " OUT.raw`)");
-    // Every rank checks that the data file holds the volume (issue 32), as `volref render` does, not only
+    // Every rank checks that the data file holds the volume, as `volref render` does, not only
     // its own brick: a short file, or one longer than the dims say (NIfTI aside: bytes after its image are
     // ignored, docs/formats.md), is an error on every rank.
     const std::uint64_t size = io::check_input_file(h.data, h.data_where);

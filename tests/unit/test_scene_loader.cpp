@@ -2,6 +2,7 @@
 // error (each naming the file and the JSON path), --set overrides, and files on disk.
 #include <gtest/gtest.h>
 
+#include "ErrorOf.h"
 #include "TempDir.h"
 
 #include <cmath>
@@ -42,20 +43,7 @@ std::string source_with(const std::string& source) {
     return R"({"volume": {"source": )" + source + "}}";
 }
 
-// The message of the Error thrown by `f`, or "" (with a test failure) if none is thrown.
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "not a volref::Error: " << e.what();
-        return "";
-    }
-    ADD_FAILURE() << "no error thrown";
-    return "";
-}
+using test::error_of;
 
 // Success when parsing `json` throws an Error whose one-line message starts with
 // "scene.json: <path>: " and contains `phrase`.

@@ -3,6 +3,7 @@
 // against chords computed here by hand.
 #include <gtest/gtest.h>
 
+#include "ErrorOf.h"
 #include "TempDir.h"
 
 #include <cmath>
@@ -752,17 +753,7 @@ TEST(TriangleMesh, ZeroAreaTrianglesAreHandled) {
     }
 }
 
-// The message of the Error thrown by `f`.
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no error thrown";
-    return "";
-}
+using test::error_of;
 
 TEST(TriangleMesh, OpenAndInconsistentMeshesAreErrors) {
     TempDir dir;

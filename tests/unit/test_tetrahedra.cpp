@@ -5,6 +5,7 @@
 // icosphere and the shell between two icospheres), the scene key and a render against box bounds.
 #include <gtest/gtest.h>
 
+#include "ErrorOf.h"
 #include "TempDir.h"
 
 #include <algorithm>
@@ -45,16 +46,7 @@ struct TempDir : test::TempDir {
     TempDir() : test::TempDir("tetra_test") {}
 };
 
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no error thrown";
-    return "";
-}
+using test::error_of;
 
 ::testing::AssertionResult same(const std::vector<Interval>& got, const std::vector<Interval>& want, double tol) {
     auto list = [](const std::vector<Interval>& v) {

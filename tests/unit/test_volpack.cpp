@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ErrorOf.h"
 #include "TempDir.h"
 #include "core/Error.h"
 #include "core/camera/Camera.h"
@@ -78,15 +79,7 @@ struct Float32Column {
     }
 };
 
-std::string error_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no error thrown";
-    return "";
-}
+using test::error_of;
 
 // A u8 NRRD of `bytes` (x fastest).
 void write_u8_nrrd(const test::TempDir& dir, const std::string& name, std::array<int, 3> dims, const std::vector<std::uint8_t>& bytes) {

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Speed at equal error (issue 19): volref's reference and fast profiles at several steps against VTK's
 # vtkFixedPointVolumeRayCastMapper on the benchmark frame, interleaved, at 1 and 2 threads; rewrites the
-# "## Speed at equal error (issue 19)" section of docs/performance.md (bench/vtk/equal_error.py says
+# "## Speed at equal error" section of docs/performance.md (bench/vtk/equal_error.py says
 # what it measures and how).
 #
 #   bench/speed_at_equal_error.sh            # about 6 min on 2 cores

@@ -3,7 +3,7 @@
 # volref's reference of the continuous scene each one discretises (step 1/8 voxel; 1/16 and the adaptive
 # integrator as its convergence check), the error's causes, and the times of VolPack, volref's volpack
 # profile, the reference and the fast profile at VolPack's RMSE, interleaved at 1 and 2 threads; rewrites
-# the "## VolPack (issue 55): its error against the reference, and its speed" section of
+# the "## VolPack: its error against the reference, and its speed" section of
 # docs/performance.md (bench/volpack/volpack_error.py says what it measures and how).
 #
 #   bench/volpack_error.sh            # about 25 min on 2 cores (the adaptive renders take half)

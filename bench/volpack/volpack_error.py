@@ -3,7 +3,7 @@
 (bench/volpack/*.json, volpack scenes) against volref's reference of the continuous scene each one
 discretises (`volref explain volpack-scene`), and the times of VolPack, of volref's volpack profile, of the
 reference and of the fast profile at the step where its error equals VolPack's. Writes the section
-"## VolPack (issue 55): its error against the reference, and its speed" (OUTDIR/section.md, and into
+"## VolPack: its error against the reference, and its speed" (OUTDIR/section.md, and into
 docs/performance.md with --doc). Run through bench/volpack_error.sh.
 
     volpack_error.py OUTDIR [--doc DOC] [--reps N] [--frames N] [--threads "1 2"] [--tolerance T]
@@ -58,7 +58,7 @@ ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
 sys.path.insert(0, os.path.join(ROOT, "tests", "volpack"))
 import run_case as rc  # noqa: E402  (volpack_args, read_u8_volume, read_pam, read_exr, compare)
 
-HEADING = "## VolPack (issue 55): its error against the reference, and its speed"
+HEADING = "## VolPack: its error against the reference, and its speed"
 AFTER_HEADING = "## volref beside VTK"  # a new section goes after this one
 SCENES = ["ml256_unshaded", "ml256_shaded", "ml64_unshaded", "ml64_shaded", "brain_unshaded_thresholds",
           "brain_unshaded_nothresholds", "brain_shaded_thresholds", "brain_shaded_nothresholds"]
@@ -467,8 +467,7 @@ def section(recs, meta):
     for t in T:
         rs = [r["median"][f"fast_{t}"] / r["median"]["volpack"] for r in recs if r["fast_equal"] and r["median"].get(f"fast_{t}")]
         if rs:
-            L.append(f"- At equal RMSE the fast profile's frame is {min(rs):.1f}x to {max(rs):.1f}x VolPack's at {t} thread(s) "
-                     "(VolPack's frame against volref's: issue 57).")
+            L.append(f"- At equal RMSE the fast profile's frame is {min(rs):.1f}x to {max(rs):.1f}x VolPack's at {t} thread(s).")
     for t in T:
         rs = [(r["median"][f"profile_setup_{t}"] + r["median"][f"profile_frame_{t}"])
               / (r["median"]["volpack_normals"] + r["median"]["volpack_classify"] + r["median"]["volpack"]) for r in recs]

@@ -35,7 +35,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 import compare  # noqa: E402  (read_rgb, errors)
 
-SECTION = "## Speed at equal error (issue 19)"
+SECTION = "## Speed at equal error"
 
 ap = argparse.ArgumentParser()
 ap.add_argument("out")
@@ -159,7 +159,7 @@ def med(name, t):
 names = ["%s-%s" % (p, step_text(s)) for p, s in settings]
 lines = [SECTION, "",
          "*Written by `%s` (bench/vtk/equal_error.py); rerunning the command replaces this section.*" % a.command, "",
-         "The benchmark frame of issue 19: `bench/vtk/scenes/composite.json` (Marschner-Lobb 256^3, fm 6, alpha "
+         "The benchmark frame: `bench/vtk/scenes/composite.json` (Marschner-Lobb 256^3, fm 6, alpha "
          "0.25, over [-127.5, 127.5]^3; 512 x 512, perspective, composite unshaded, the tent opacity around f = 0.5, "
          "opacity unit distance 4), volref reading the float32 NRRD of `bench/make_ml_volume` (VTK builds the same "
          "float32 field). Frame times only: volref's `--timing --repeat %d` frames (after its set-up), VTK's %d timed "

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# bench/mpi_two_ranks.sh: volref-mpi at 2 ranks against 1 on the two scenes of issue 30 (docs/performance.md,
-# "Session 18"): bench/device/scenes/strong.json (fixed step) and adaptive.json (the adaptive chain).
+# bench/mpi_two_ranks.sh: volref-mpi at 2 ranks against 1 on the two scenes of volref-mpi's checks (docs/performance.md,
+# "Two ranks against one"): bench/device/scenes/strong.json (fixed step) and adaptive.json (the adaptive chain).
 #
 #   bench/mpi_two_ranks.sh [ROUNDS]        # default 6 rounds, about 2 min on 2 idle cores
 #   VOLREF_MPI=/path/to/volref-mpi bench/mpi_two_ranks.sh

@@ -9,7 +9,7 @@
 #   lib/            the libraries both need, Debian's OpenMPI 4.1.4 and PMIx and every library of their
 #                   plugins (not glibc, libstdc++ or libgcc_s: the machine's newer ones serve)
 #   root/usr, root/etc  OpenMPI's and PMIx's plugin and help trees, used in place through OPAL_PREFIX
-#   scenes/         the scaling scenes (docs/performance.md, "volref-mpi on 16 cores")
+#   scenes/         the scaling scenes (docs/performance.md, "16 cores, measured")
 # Checked in a clean Debian 12 chroot without OpenMPI (../shared/tools/fresh-debian's base) before use.
 set -euo pipefail
 P=$(cd "$(dirname "$0")/../.." && pwd); B=$(cd "${1:-$P/build}" && pwd); D=$P/bench/device; C=$D/carry

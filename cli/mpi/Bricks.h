@@ -52,7 +52,7 @@ std::vector<Brick> split_lattice(const Lattice& cells, int count, const WorkBins
 // kWorkPacketLanes neighbouring rays together, and a step's time goes with the voxels its lanes wait for, so
 // step j of a packet costs kWorkStepCost + (the distinct cache lines of kWorkLineBytes that the lanes with a
 // j-th sample start their cells on), in units of one line. kWorkStepCost = 16 was measured (docs/
-// performance.md, "a span's first segment without a bisection"). The cost is shared equally among those
+// performance.md, "volref-mpi on the resumable march"). The cost is shared equally among those
 // lanes' bins in units of 1 / 840 (840 = lcm(1, ..., 8)), so every value added is an integer and the
 // ranks' sums are exact in any order.
 inline constexpr int kWorkPacketLanes = 8;

@@ -128,8 +128,8 @@ private:
 // `volref render`'s order (Renderer.h): kPixelBlockWidth x kPixelBlockHeight blocks in row order, row
 // order inside each, so that a batch of kMaxPacketRays of them (fixed_chain) makes the render's packets
 // (4 x 4 on 16 float lanes) and not rows of 16 x 1: with blocks of 256 pixels in rows the fast profile's
-// chained frame was 1.15x slower at one rank (docs/performance.md, "each rank's time, and the chain's
-// arrays at set-up").
+// chained frame was 1.15x slower at one rank (docs/performance.md, "volref-mpi on
+// the resumable march").
 constexpr int kChainTile = 16;
 constexpr std::size_t kChainBlock = std::size_t(kChainTile) * kChainTile;
 static_assert(kChainTile % kPixelBlockWidth == 0 && kChainTile % kPixelBlockHeight == 0);

@@ -1,8 +1,8 @@
 // volref-mpi's output, written by rank 0: OUT ending in ".img" is the pixels as doubles (the tests'
 // format) and is written here; any other format goes through libvolref_tools (core/film/ImageWriter.h),
 // loaded at run time on rank 0 only. So no rank links OpenImageIO, whose 280 libraries take a rank
-// longer to load than a small frame takes to render (docs/performance.md, "page faults and libraries
-// were a rank's fixed costs").
+// longer to load than a small frame takes to render (docs/performance.md, "Two ranks
+// against one").
 #pragma once
 #include <string>
 

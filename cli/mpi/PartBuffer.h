@@ -4,8 +4,8 @@
 // image's parts on one 2-core VM (about 3 ms per MB: a rank pays it whatever its share of the
 // work; 3-6 ms on another); on 2 MiB transparent huge pages (madvise MADV_HUGEPAGE, which Debian's
 // default "madvise" mode honours) 0.9-5 ms, but 12-17 ms when the kernel compacts memory to find the huge
-// pages. Measured in docs/performance.md ("page faults and libraries were a rank's fixed costs", "a span's
-// first segment without a bisection"). The parts and the chain's arrays are
+// pages. Measured in docs/performance.md ("Two ranks against one", "volref-mpi on the
+// resumable march"). The parts and the chain's arrays are
 // made at set-up (main.cpp fresh_parts, Chain.h fresh_chain), outside render_s. Values are unaffected.
 #pragma once
 #include <sys/mman.h>

@@ -20,7 +20,7 @@
 // least kHugeBufferBytes is aligned to 2 MiB and advised onto transparent huge pages before its first
 // touch (madvise MADV_HUGEPAGE, where the system has it: Debian's default THP mode is "madvise", so
 // without the advice a 64 MiB volume is 16,384 pages of 4 KiB and the ray marcher's voxel reads miss
-// the TLB). Measured in docs/performance.md, "Huge pages for the voxels on Intel".
+// the TLB). On the EPYC they did not help (docs/performance.md, "What did not help").
 #pragma once
 #include <algorithm>
 #include <array>

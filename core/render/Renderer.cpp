@@ -104,7 +104,7 @@ namespace {
 // x86 by streaming stores (SSE2 _mm_stream_pd, then a store fence), which write whole cache lines without
 // reading them first: the frame never reads its image, and the 8 MiB of a 512 x 512 RGBA image in double
 // are larger than L2, so plain stores read each line back from memory first, and on an Intel Xeon those
-// reads held up the voxel fetches (docs/performance.md, "The film's rows by streaming stores").
+// reads held up the voxel fetches (the film variants: docs/performance.md, "What did not help").
 // The same values either way; a destination not on 16 bytes (an odd channel count on an odd width) is copied.
 void write_tile(Image& image, const double* tile, std::size_t row, int x0, int y0, int x_end, int y_end) {
     const std::size_t n = std::size_t(x_end - x0) * image.channel_count();

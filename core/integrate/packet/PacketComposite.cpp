@@ -362,8 +362,8 @@ class CompositeLanes {
     // ray (p + 4 len d: where the lane will be unless it skips or its interval ends), for every
     // kPrefetchLaneStride-th lane: lanes 0, 5, 10, 15 of a 4 x 4 packet, its diagonal (neighbouring
     // lanes read mostly the same cache lines). The one-step-ahead fetch hides what the core's reorder
-    // window can hold; these hints retire at once. Measured (docs/performance.md, "Prefetch hints on the
-    // fast profile's lanes"): 3-5% on the fast profile's frame; every lane instead (64 hints a step) or 2
+    // window can hold; these hints retire at once. Measured (the variants: docs/performance.md,
+    // "What did not help"): 3-5% on the fast profile's frame; every lane instead (64 hints a step) or 2
     // steps ahead: slower.
     static constexpr int kPrefetchSteps = 4;
     static constexpr int kPrefetchLaneStride = 5;
@@ -569,7 +569,7 @@ private:
 // themselves would hold up the core's reorder window. The cell of the first segment's midpoint
 // t = (t0 + min(t0 + h, t1)) / 2 of the first interval (SamplePlacement.h; where the march samples
 // first unless skipping moves it on), its four x-rows (y, z and their next): a hint, nothing is read.
-// Measured (docs/performance.md, "Prefetch hints on the fast profile's lanes"): 2-5% on the fast
+// Measured (the variants: docs/performance.md, "What did not help"): 2-5% on the fast
 // profile's frame, nothing on the reference's (double lanes, which do not take it), nothing more from
 // the second sample as well.
 HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
@@ -599,8 +599,8 @@ HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ra
 // The packets of `count` rays. Float lanes (the fast profile): two at a time, their steps interleaved (a
 // packet's next step waits on its voxels and its skipping grid's cells; the other's work fills that
 // wait). Double lanes (the reference), and pre-integrated segments: one packet after the other. Each
-// packet's lanes take the same samples in the same order either way. Measured (docs/performance.md,
-// "Primary rays on SIMD lanes and two packets in flight"): on float lanes 2 in flight 2-3% faster than
+// packet's lanes take the same samples in the same order either way. Measured (more in flight: docs/performance.md,
+// "What did not help"): on float lanes 2 in flight 2-3% faster than
 // 1 and 4 slower; on double lanes 2 in flight 4% slower than 1 (twice the packets of a block, each
 // twice the state).
 template <typename T>

@@ -250,7 +250,7 @@ struct ProfileOptions {
     // the fetch's position (a Monte Carlo of the units the band covers).
     enum class TextureUnit { Exact, H100, Admissible };
     TextureUnit texture_unit = TextureUnit::Exact;
-    // cuda-curvilinear on shells (Seed001Kernel.h): "float32" (the default) runs seed 001's kernel
+    // cuda-curvilinear on shells (CudaCurvilinearKernel.h): "float32" (the default) runs seed 001's kernel
     // as the program does, in float32 on the host's bounding triangles with its unsigned-short data (composite
     // and x-ray; other projections keep the double-precision profile); "double": the double-precision
     // profile on the exact shell.

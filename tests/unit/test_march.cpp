@@ -96,13 +96,13 @@ TEST(March, FromTheEntryAndFromTheExitByHand) {
     EXPECT_EQ(t, (std::vector<double>{1.5, 1.25, 1.0, 0.75, 0.5}));
 }
 
-// vtk.js's shader loop (ShaderEnds), by hand. Hull [0, 3.5], h = 1, first (the jitter) 0.5: R = 3.5;
+// vtk.js's shader loop (HullPartialEnds), by hand. Hull [0, 3.5], h = 1, first (the jitter) 0.5: R = 3.5;
 // the entry at 0 for 0.5 step; the counter c = 0.5 (0.5 + 1 < 3.5: t = 0.5), 1.5 (2.5 < 3.5: t = 1.5),
 // 2.5 (3.5 < 3.5 fails); the exit at 3.5 for R - c = 1 step. R <= 1 (hull [2, 2.75]): the entry alone,
 // for R = 0.75 step. A callback that stops at an inner sample gets no exit sample.
 TEST(March, VtkJsShaderLoopByHand) {
     using End = MarchSample::End;
-    MarchOptions o{.step = 1.0, .placement = {MarchPlacement::Kind::ShaderEnds, 0.5, true}};
+    MarchOptions o{.step = 1.0, .placement = {MarchPlacement::Kind::HullPartialEnds, 0.5, true}};
     const std::vector<MarchSample> m = marched({{0.0, 1.0}, {2.0, 3.5}}, o);
     ASSERT_EQ(m.size(), 4u);
     const double t[] = {0.0, 0.5, 1.5, 3.5}, steps[] = {0.5, 1.0, 1.0, 1.0};
@@ -114,30 +114,30 @@ TEST(March, VtkJsShaderLoopByHand) {
     }
     // first = 1, h = 0.4 over [0, 1.1]: R = 2.75 (rounded); c = 1 (2 < 2.75: t = 0.4), c = 2 (3 < 2.75
     // fails); the exit for 2.75 - 2 = 0.75 step (to rounding).
-    o = {.step = 0.4, .placement = {MarchPlacement::Kind::ShaderEnds, 1.0, true}};
+    o = {.step = 0.4, .placement = {MarchPlacement::Kind::HullPartialEnds, 1.0, true}};
     const std::vector<MarchSample> n = marched({{0.0, 1.1}}, o);
     ASSERT_EQ(n.size(), 3u);
     EXPECT_EQ(n[1].t, 0.4);
     EXPECT_EQ(n[2].t, 1.1);
     EXPECT_NEAR(n[2].steps, 0.75, 1e-15);
-    const std::vector<MarchSample> thin = marched({{2.0, 2.75}}, {.step = 1.0, .placement = {MarchPlacement::Kind::ShaderEnds, 0.5, true}});
+    const std::vector<MarchSample> thin = marched({{2.0, 2.75}}, {.step = 1.0, .placement = {MarchPlacement::Kind::HullPartialEnds, 0.5, true}});
     ASSERT_EQ(thin.size(), 1u);
     EXPECT_EQ(thin[0].t, 2.0);
     EXPECT_EQ(thin[0].end, End::Only);
     EXPECT_EQ(thin[0].steps, 0.75);
-    EXPECT_EQ(marched({{0.0, 3.5}}, {.step = 1.0, .placement = {MarchPlacement::Kind::ShaderEnds, 0.5, true}}, 2).size(), 2u);
+    EXPECT_EQ(marched({{0.0, 3.5}}, {.step = 1.0, .placement = {MarchPlacement::Kind::HullPartialEnds, 0.5, true}}, 2).size(), 2u);
 }
 
-// Seed 001's loop (FromExitFloat32): s = t1, s - h, ... in float32 while s >= t0. With h = 0.25 over
+// Seed 001's loop (FromExitFloatSteps): s = t1, s - h, ... in float32 while s >= t0. With h = 0.25 over
 // [0, 1] every s is exact: 1, 0.75, 0.5, 0.25, 0. With h = 0.1f over [0.5, 1] float32 rounding decides
 // the last sample: the float32 steps give 1, 0.9, 0.79999995, 0.6999999, 0.5999999 and then
 // 0.4999999 < 0.5, so five samples, not six as in exact arithmetic (1 - 5 h = 0.5).
 TEST(March, SeedOneFloat32LoopByHand) {
-    const MarchOptions o{.step = 0.25, .placement = {MarchPlacement::Kind::FromExitFloat32, 0.0, true}};
+    const MarchOptions o{.step = 0.25, .placement = {MarchPlacement::Kind::FromExitFloatSteps, 0.0, true}};
     std::vector<double> t;
     for (const MarchSample& m : marched({{0.0, 1.0}}, o)) t.push_back(m.t);
     EXPECT_EQ(t, (std::vector<double>{1.0, 0.75, 0.5, 0.25, 0.0}));
-    const MarchOptions p{.step = double(0.1f), .placement = {MarchPlacement::Kind::FromExitFloat32, 0.0, true}};
+    const MarchOptions p{.step = double(0.1f), .placement = {MarchPlacement::Kind::FromExitFloatSteps, 0.0, true}};
     const std::vector<MarchSample> m = marched({{0.5, 1.0}}, p);
     float s = 1.0f;
     std::vector<float> expected;

@@ -10,7 +10,7 @@
 // The callback gets one MarchSample per sample and returns true to go on, false to stop (opaque, a
 // hit, early termination). Its SIMD form is the packet kernels' walk (packet/PacketKernels-inl.h:
 // ForwardSegmentWalk::next_run, the same segments in the same order); the mirrored programs' loops are
-// placements of it too (vtk.js's shader loop: ShaderEnds; seed 001's float32 kernel: FromExitFloat32).
+// placements of it too (vtk.js's shader loop: HullPartialEnds; seed 001's float32 kernel: FromExitFloatSteps).
 // Only the adaptive integrator and vtk-cpu's image-space renderer place their samples their own way
 // (docs/architecture.md, "One march").
 #pragma once
@@ -30,7 +30,7 @@ namespace volref {
 // One sample of the march: its position t and the length d it stands for; for the segment placement
 // also its segment (t = s.midpoint(), d = s.length()), the interval it lies in and its index k of the
 // interval's n segments. A profile's sample from the entry or the exit has s = {t, t}, k and n its count.
-// ShaderEnds also says which sample it is (`end`) and the part of a step it stands for (`steps`).
+// HullPartialEnds also says which sample it is (`end`) and the part of a step it stands for (`steps`).
 struct MarchSample {
     enum class End { None, Entry, Exit, Only };
     double t = 0.0, d = 0.0;
@@ -44,17 +44,17 @@ struct MarchSample {
 enum class MarchOrder { FrontToBack, BackToFront };
 
 // Where the samples lie (SamplePlacement.h; conventions sections 4 and 9).
-// ShaderEnds (vtk.js's vtkVolumeFS.glsl, over the hull [t0, t1] of the intervals, R = (t1 - t0) / h):
+// HullPartialEnds (vtk.js's vtkVolumeFS.glsl, over the hull [t0, t1] of the intervals, R = (t1 - t0) / h):
 // where R <= 1 the entry alone (End::Only, standing for R steps); else the entry (End::Entry, standing
 // for `first` steps), then t0 + c h for c = first, first + 1, ... (the shader's float counter, c += 1)
 // while c + 1 < R, then where R - c > 0 the exit t1 (End::Exit, standing for R - c steps).
-// FromExitFloat32 (seed 001's CUDA kernel, `for (float s = outAbs; s >= inAbs; s -= step)`): s = t1,
+// FromExitFloatSteps (seed 001's CUDA kernel, `for (float s = outAbs; s >= inAbs; s -= step)`): s = t1,
 // then s - h, ..., in float32 (t1, t0 and h are floats the caller gives as doubles), while s >= t0;
 // the caller checks first that s - h moves s (else the program does not end).
 struct MarchPlacement {
-    enum class Kind { Midpoints, FromEntry, FromExit, ShaderEnds, FromExitFloat32 };
+    enum class Kind { Midpoints, FromEntry, FromExit, HullPartialEnds, FromExitFloatSteps };
     Kind kind = Kind::Midpoints;
-    double first = 0.0;  // FromEntry, ShaderEnds: the first (inner) sample's distance from the entry, in steps
+    double first = 0.0;  // FromEntry, HullPartialEnds: the first (inner) sample's distance from the entry, in steps
     bool through_exit = true;  // FromEntry / FromExit: sample_count's rule (ThroughExit, else BeforeExit)
 };
 
@@ -134,18 +134,18 @@ void march(const std::vector<Interval>& intervals, const MarchOptions& o, Fn&& o
     const double h = o.step;
     using Kind = MarchPlacement::Kind;
     // The shaders' placements cast one segment through the hull [first t0, last t1] of the intervals.
-    const bool over_hull = o.placement.kind == Kind::FromExit || o.placement.kind == Kind::FromExitFloat32 ||
-                           o.placement.kind == Kind::ShaderEnds;
+    const bool over_hull = o.placement.kind == Kind::FromExit || o.placement.kind == Kind::FromExitFloatSteps ||
+                           o.placement.kind == Kind::HullPartialEnds;
     if (over_hull && intervals.empty()) return;
     const Interval hull = over_hull ? Interval{intervals.front().t0, intervals.back().t1} : Interval{};
-    if (o.placement.kind == Kind::FromExitFloat32) {  // seed 001's kernel: float32 s = t1, s - h, ... >= t0
+    if (o.placement.kind == Kind::FromExitFloatSteps) {  // seed 001's kernel: float32 s = t1, s - h, ... >= t0
         const float in = float(hull.t0), step = float(h);
         std::int64_t k = 0;
         for (float s = float(hull.t1); s >= in; s -= step, ++k)
             if (cancel_polled(k) || !on_sample(MarchSample{double(s), h, {double(s), double(s)}, 0, k, 0})) return;
         return;
     }
-    if (o.placement.kind == Kind::ShaderEnds) {  // vtk.js's shader loop
+    if (o.placement.kind == Kind::HullPartialEnds) {  // vtk.js's shader loop
         using End = MarchSample::End;
         auto at = [&](double t, std::int64_t k, End end, double steps) {
             MarchSample m{t, h, {t, t}, 0, k, 0};

@@ -16,7 +16,7 @@
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
-#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/CudaCurvilinearKernel.h"
 #include "core/integrate/profiles/Slices.h"
 #include "core/integrate/profiles/TextureUnit.h"
 #include "core/sample/VolumeSampler.h"
@@ -92,15 +92,15 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         const double n = double(volume.dims[std::size_t(axis)]);
         if (n > 1.0) step_ = ctx.step * (n - 1.0) / n;
     }
-    // seed 001's kernel in float32 (Seed001Kernel.h) for what the seed renders (composite, x-ray)
+    // seed 001's kernel in float32 (CudaCurvilinearKernel.h) for what the seed renders (composite, x-ray)
     if (p_.id == ProfileId::CudaCurvilinear && shell_ && bounds && po.kernel == ProfileOptions::Kernel::Float32 &&
         (ctx.render.projection == Projection::Composite || ctx.render.projection == Projection::Xray)) {
         if (texture_unit_ == ProfileOptions::TextureUnit::Admissible)
             throw Error("render.profile_options.texture_unit: the float32 kernel reads through the exact or the h100 unit");
-        kernel_ = std::make_unique<Seed001Kernel>(seed001_frame(volume, *bounds, ctx.pipeline.classifier(), ctx.render, step_),
+        kernel_ = std::make_unique<CudaCurvilinearKernel>(seed001_frame(volume, *bounds, ctx.pipeline.classifier(), ctx.render, step_),
                                                   texture_unit_ == ProfileOptions::TextureUnit::H100, band_);
     }
-    if (po.tricubic) {  // seed 001's cubicInterpolate (Seed001Kernel.h, seed001_cubic)
+    if (po.tricubic) {  // seed 001's cubicInterpolate (CudaCurvilinearKernel.h, seed001_cubic)
         if (!shell_)
             throw Error("render.profile_options.tricubic: seed 001's tri-cubic option reads a shell's data (cylindrical or spherical bounds)");
         if (!kernel_ && (texture_unit_ != ProfileOptions::TextureUnit::Exact || band_))
@@ -439,7 +439,7 @@ void begin_record(Rec& rec, SampleRecord& r, const glm::dvec3& x, double t, doub
 // t = s (the kernel's distance along its float ray from the origin), its value as the profile's value.
 template <class Rec>
 PixelValue ProfileIntegrator::seed_kernel(const Ray& ray, Rec& rec) const {
-    std::vector<Seed001Kernel::Sample> samples;
+    std::vector<CudaCurvilinearKernel::Sample> samples;
     const Seed001Pixel px = kernel_->pixel(ray, Rec::kOn ? &samples : nullptr);
     PixelValue out;
     out.rgba = px.rgba;
@@ -448,7 +448,7 @@ PixelValue ProfileIntegrator::seed_kernel(const Ray& ray, Rec& rec) const {
     if constexpr (Rec::kOn) {
         const glm::dvec3 c = kernel_->frame().center;
         const double h = double(kernel_->frame().step);
-        for (const Seed001Kernel::Sample& s : samples) {
+        for (const CudaCurvilinearKernel::Sample& s : samples) {
             SampleRecord r{};
             const glm::dvec3 x = c + glm::dvec3(s.point[0], s.point[1], s.point[2]);
             begin_record(rec, r, x, double(s.s), h, lo_ + width_ * double(s.sample));

@@ -32,7 +32,7 @@
 namespace volref {
 
 class ShellGrid;
-class Seed001Kernel;
+class CudaCurvilinearKernel;
 class Camera;
 struct BoundsSpec;
 struct TriangleMesh;
@@ -139,7 +139,7 @@ private:
     bool normalized_coordinates_ = true;         // GLSL's texture(): normalised; seed 001's tex3D: not
     const VolumeSampler* cartesian_ = nullptr;         // texture_unit / band on Cartesian grids
     const class TransferFunction* transfer_ = nullptr;  // band without a table: its knots
-    std::unique_ptr<Seed001Kernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell
+    std::unique_ptr<CudaCurvilinearKernel> kernel_;  // cuda-curvilinear, kernel "float32", on a shell
     template <class Rec>
     PixelValue seed_kernel(const Ray& ray, Rec& rec) const;
 

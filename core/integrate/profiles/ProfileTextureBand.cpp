@@ -18,7 +18,7 @@
 #include "core/Error.h"
 #include "core/integrate/march/SamplePlacement.h"
 #include "core/integrate/march/Accumulators.h"
-#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/CudaCurvilinearKernel.h"
 #include "core/integrate/profiles/TextureUnit.h"
 #include "core/sample/VolumeSampler.h"
 #include "geometry/ShellCoordinates.h"

@@ -308,11 +308,11 @@ PixelValue VtkJsIntegrator::integrate_impl(const Ray& ray_in, const std::vector<
         }
     };
 
-    // The samples: march()'s ShaderEnds placement over [t0, t1] (the entry, t0 + (j + k) h while
+    // The samples: march()'s HullPartialEnds placement over [t0, t1] (the entry, t0 + (j + k) h while
     // j + k + 1 < R, the exit; R = (t1 - t0) / h; R <= 1: the entry alone).
     MarchOptions o;
     o.step = h;
-    o.placement.kind = MarchPlacement::Kind::ShaderEnds;
+    o.placement.kind = MarchPlacement::Kind::HullPartialEnds;
     o.placement.first = jitter_;
     const std::vector<Interval> hull{Interval{t0, t1}};
     using End = MarchSample::End;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/film/ImageWriter.h"
-#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/CudaCurvilinearKernel.h"
 #include "core/render/PreparedVolume.h"
 #include "transfer/Classifier.h"
 #include "geometry/ShellCoordinates.h"
@@ -50,7 +50,7 @@ int run(int argc, char** argv) {
     if (cam.type != CameraSpec::Type::Perspective && cam.type != CameraSpec::Type::Orthographic)
         fail(2, "camera: perspective or orthographic");
 
-    // The frame is volref's own (core/integrate/profiles/Seed001Kernel.h, seed001_frame), so that this
+    // The frame is volref's own (core/integrate/profiles/CudaCurvilinearKernel.h, seed001_frame), so that this
     // program and the cuda-curvilinear profile read the same bounding triangles (volref's tessellation,
     // bounds.tessellate segments per turn, 64 when absent, minus the centre, in float), the same unsigned
     // shorts and the same 9-entry table. Its data are the volume as volref renders it (build_volume_model):

@@ -1,9 +1,9 @@
-// Seed 001's kernel in float32 (Seed001Kernel.h). Every float operation below is the kernel's, in its
+// Seed 001's kernel in float32 (CudaCurvilinearKernel.h). Every float operation below is the kernel's, in its
 // order; `fma` marks where nvcc (NVVM, -fmad=true) contracts a * b + c: a sum of products a*b + c*d
 // becomes fma(a, b, c*d), a*b - c*d becomes fma(a, b, -(c*d)), x + s*v becomes fma(s, v, x), and a
 // three-term dot product fma(a.z, b.z, fma(a.x, b.x, a.y*b.y)). The project compiles with
 // -ffp-contract=off, so nothing else is fused here.
-#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/CudaCurvilinearKernel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -144,14 +144,14 @@ Seed001Frame seed001_frame(const Volume& volume, const BoundsSpec& bounds, const
     return f;
 }
 
-Seed001Kernel::Seed001Kernel(Seed001Frame frame, bool h100, bool band) : f_(std::move(frame)), h100_(h100), band_(band) {
+CudaCurvilinearKernel::CudaCurvilinearKernel(Seed001Frame frame, bool h100, bool band) : f_(std::move(frame)), h100_(h100), band_(band) {
     const float nx = float(f_.dims[0]), ny = float(f_.dims[1]), nz = float(f_.dims[2]);
     if (f_.geom_type == 0) step_ = {f_.geom_size[0] / nx, f_.geom_size[1] / ny, f_.geom_size[2] / nz};
     else step_ = {f_.geom_size[0] / nz, f_.geom_size[1] / nx, 2.0f * f_.geom_size[2] / ny};  // length, long, lat
 }
 
 // --- rayIntersectTriangles ------------------------------------------------------------------------
-Seed001Kernel::Span Seed001Kernel::intersect(const F3& O, const F3& V, std::vector<Hit>* hits) const {
+CudaCurvilinearKernel::Span CudaCurvilinearKernel::intersect(const F3& O, const F3& V, std::vector<Hit>* hits) const {
     Span sp;
     bool in_found = false, out_found = false;
     float in_v = 0.0f, out_v = 0.0f;
@@ -198,7 +198,7 @@ Seed001Kernel::Span Seed001Kernel::intersect(const F3& O, const F3& V, std::vect
     return sp;
 }
 
-Seed001Kernel::Span Seed001Kernel::span_of(const std::vector<Hit>& hits, const std::vector<char>& accepted, float geom_r) {
+CudaCurvilinearKernel::Span CudaCurvilinearKernel::span_of(const std::vector<Hit>& hits, const std::vector<char>& accepted, float geom_r) {
     Span sp;
     bool in_found = false, out_found = false;
     float in_v = 0.0f, out_v = 0.0f;
@@ -224,7 +224,7 @@ Seed001Kernel::Span Seed001Kernel::span_of(const std::vector<Hit>& hits, const s
 }
 
 // --- interpolateCyl / interpolateSpher and the texture unit -----------------------------------------
-float Seed001Kernel::sample_at(const F3& p) const {
+float CudaCurvilinearKernel::sample_at(const F3& p) const {
     F3 tex;
     if (f_.geom_type == 0) {
         float angle = atan2_f(-p[2], p[0]);
@@ -245,7 +245,7 @@ float Seed001Kernel::sample_at(const F3& p) const {
 }
 
 // tex3D(dataTex, x, y, z): unnormalised coordinates, clamped to the edge, the unsigned shorts read as q / 65535.
-float Seed001Kernel::fetch(const F3& tex) const {
+float CudaCurvilinearKernel::fetch(const F3& tex) const {
     if (!h100_) return static_cast<float>(exact_fetch({double(tex[0]), double(tex[1]), double(tex[2])}));
     const tu::Fetch3d fe = tu::locate_3d({double(tex[0]), double(tex[1]), double(tex[2])}, f_.dims);
     std::array<std::uint16_t, 8> q;
@@ -256,7 +256,7 @@ float Seed001Kernel::fetch(const F3& tex) const {
     return tu::filter_unorm16(fe.w.data(), q.data(), 8);
 }
 
-double Seed001Kernel::exact_fetch(const std::array<double, 3>& tex) const {
+double CudaCurvilinearKernel::exact_fetch(const std::array<double, 3>& tex) const {
     const tu::Fetch3d fe = tu::locate_3d(tex, f_.dims);
     const std::array<double, 8> e = tu::exact_weights(fe.axis);
     double v = 0.0;
@@ -290,7 +290,7 @@ float lerp_f(float a, float b, float t) { return std::fma(t, b - a, a); }  // a 
 }  // namespace
 
 // cubicInterpolate: 8 tex3D reads at the mixture coordinates, then lerps along x, y, z in the seed's order.
-float Seed001Kernel::cubic(const F3& tex) const {
+float CudaCurvilinearKernel::cubic(const F3& tex) const {
     const F3 mx = cubic_mixture(tex[0]), my = cubic_mixture(tex[1]), mz = cubic_mixture(tex[2]);
     const float v000 = fetch({mx[0], my[0], mz[0]}), v010 = fetch({mx[0], my[1], mz[0]});
     const float v001 = fetch({mx[0], my[0], mz[1]}), v011 = fetch({mx[0], my[1], mz[1]});
@@ -303,7 +303,7 @@ float Seed001Kernel::cubic(const F3& tex) const {
     return lerp_f(z0, z1, mz[2]);
 }
 
-std::array<float, 4> Seed001Kernel::table_fetch(float u) const {
+std::array<float, 4> CudaCurvilinearKernel::table_fetch(float u) const {
     std::array<float, 4> out{};
     if (h100_) {
         const tu::AxisRead r = tu::axis_read(tu::unnormalized(double(u), 9), 9);
@@ -325,22 +325,22 @@ std::array<float, 4> Seed001Kernel::table_fetch(float u) const {
 }
 
 // --- the kernel ------------------------------------------------------------------------------------
-Seed001Pixel Seed001Kernel::pixel(const Ray& ray) const { return pixel(ray, nullptr); }
+Seed001Pixel CudaCurvilinearKernel::pixel(const Ray& ray) const { return pixel(ray, nullptr); }
 
 namespace {
 
-// The kernel's loop over [in, out] by float32 steps from the exit (March.h, FromExitFloat32).
+// The kernel's loop over [in, out] by float32 steps from the exit (March.h, FromExitFloatSteps).
 std::vector<Interval> hull(float in, float out) { return {Interval{double(in), double(out)}}; }
 MarchOptions float_from_exit(float step) {
     MarchOptions o;
     o.step = double(step);
-    o.placement.kind = MarchPlacement::Kind::FromExitFloat32;
+    o.placement.kind = MarchPlacement::Kind::FromExitFloatSteps;
     return o;
 }
 
 }  // namespace
 
-Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) const {
+Seed001Pixel CudaCurvilinearKernel::pixel(const Ray& ray, std::vector<Sample>* samples) const {
     // The host: origin - centre and the unit direction, in double, then float.
     const glm::dvec3 o = ray.origin - f_.center, dv = glm::normalize(ray.direction);
     const F3 O{to_f(o.x), to_f(o.y), to_f(o.z)}, V{to_f(dv.x), to_f(dv.y), to_f(dv.z)};
@@ -370,7 +370,7 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
         }
         std::array<float, 4> sum{0.0f, 0.0f, 0.0f, 0.0f};
         float max_val = 0.0f;
-        // The loop `for (float s = outAbs; s >= inAbs; s -= step)`: march()'s FromExitFloat32 placement.
+        // The loop `for (float s = outAbs; s >= inAbs; s -= step)`: march()'s FromExitFloatSteps placement.
         march(hull(in, sp.out_abs), float_from_exit(f_.step), [&](const MarchSample& m) {
             const float s = float(m.t);  // exact: m.t holds the float s
             const F3 point = along(O, s, V);
@@ -412,7 +412,7 @@ Seed001Pixel Seed001Kernel::pixel(const Ray& ray, std::vector<Sample>* samples) 
 // derivatives, plus a few ulps for sqrtf, atan2f's 2 ulp and the divisions); where a coordinate may
 // cross 0 or n - 1 the sample may be outVal (0); near the angle 0 the atan2 + 2 pi branch may flip
 // (outVal); a move of half a texel or more: the whole data range [0, 1].
-void Seed001Kernel::sample_range(const F3& p, double eps, double& lo, double& hi) const {
+void CudaCurvilinearKernel::sample_range(const F3& p, double eps, double& lo, double& hi) const {
     const double x = p[0], y = p[1], z = p[2];
     const double rel = 0x1p-19;  // relative rounding of each texture coordinate (ulps of sqrt, atan2, divisions)
     std::array<double, 3> tex{}, delta{};
@@ -510,14 +510,14 @@ void Seed001Kernel::sample_range(const F3& p, double eps, double& lo, double& hi
 
 // The 9-entry table over normalised coordinates [ulo, uhi], the position widened by the 20-bit cut and the
 // float32 product sample * transferScale: texture_unit::table_hull per channel.
-void Seed001Kernel::table_range(double ulo, double uhi, double* lo, double* hi) const {
+void CudaCurvilinearKernel::table_range(double ulo, double uhi, double* lo, double* hi) const {
     const double move = 9.0 * tu::kNormalizedDelta + 9.0 * 2.0 * kU;
     const double plo = std::clamp(ulo * 9.0 - 0.5 - move, 0.0, 8.0), phi = std::clamp(uhi * 9.0 - 0.5 + move, 0.0, 8.0);
     for (int c = 0; c < 4; ++c)
         tu::table_hull([&](int j) { return double(f_.table[std::size_t(j)][std::size_t(c)]); }, 9, plo, phi, lo[c], hi[c]);
 }
 
-Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Span& sp, bool& may_fault) const {
+CudaCurvilinearKernel::Box CudaCurvilinearKernel::span_range(const F3& O, const F3& V, const Span& sp, bool& may_fault) const {
     Box box{};
     if (!sp.ok || !(sp.out_abs >= 0.0f)) return box;  // the pixel stays 0
     const float in = std::fmax(0.0f, sp.in_abs);
@@ -562,7 +562,7 @@ Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Spa
             sum_hi[c] = h;
         }
     };
-    // The kernel's samples (march()'s FromExitFloat32, as pixel()), at most 2^26.
+    // The kernel's samples (march()'s FromExitFloatSteps, as pixel()), at most 2^26.
     float last = sp.out_abs;
     std::int64_t count = 0;
     bool capped = false;
@@ -586,7 +586,7 @@ Seed001Kernel::Box Seed001Kernel::span_range(const F3& O, const F3& V, const Spa
     return box;
 }
 
-double Seed001Kernel::band(const F3& O, const F3& V, const std::vector<Hit>& hits, const Span& nominal,
+double CudaCurvilinearKernel::band(const F3& O, const F3& V, const std::vector<Hit>& hits, const Span& nominal,
                            const glm::dvec4& rendered, bool& may_fault) const {
     std::vector<std::size_t> unsure;
     std::vector<char> accepted(hits.size());

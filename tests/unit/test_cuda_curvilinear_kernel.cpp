@@ -1,4 +1,4 @@
-// cuda-curvilinear's float32 kernel (issue 28; core/integrate/profiles/Seed001Kernel.h): seed 001's kernel
+// cuda-curvilinear's float32 kernel (issue 28; core/integrate/profiles/CudaCurvilinearKernel.h): seed 001's kernel
 // as it runs on the GPU. By hand: one chord through the host's 64-sided cylinder; against the H100: a ray
 // the real program never finished (tests/gpu/h100/seed001, its guard's mark); the fault channel through
 // render, trace and compare; the band against the exact unit on random cylinders; the loader's errors.
@@ -19,7 +19,7 @@
 #include "core/Error.h"
 #include "core/explain/PixelTrace.h"
 #include "core/film/ImageWriter.h"
-#include "core/integrate/profiles/Seed001Kernel.h"
+#include "core/integrate/profiles/CudaCurvilinearKernel.h"
 #include "core/render/PreparedScene.h"
 #include "core/scene/SceneLoader.h"
 
@@ -99,7 +99,7 @@ Scene random_cylinder_scene(std::mt19937_64& g, std::array<int, 3> dims, bool xr
 // Composite: the 9-entry table over [0, 3] holds colour (1 - j/8, 0, j/8) and opacity 0.5 + 0.5 j/8, read
 // at pos = clamp(9 s - 0.5, 0, 8) (exact unit); sum = lerp(sum, col, col.a) from k = 0 (the back). X-ray:
 // the largest s (k = 1: r = 0.749214, s = 0.832286). float32 arithmetic: within 2e-6 of the double values.
-TEST(Seed001Kernel, ChordThroughTheHostsTrianglesByHand) {
+TEST(CudaCurvilinearKernel, ChordThroughTheHostsTrianglesByHand) {
     EXPECT_EQ(chord_sample(0), 0.0);  // r = 0.9988: outVal
     EXPECT_EQ(chord_sample(4), 0.0);  // z = 0.0025: angle 357.2 degrees, x_angle = 7.94: outVal
     EXPECT_EQ(chord_sample(7), 0.0);  // r = 0.7541
@@ -127,7 +127,7 @@ TEST(Seed001Kernel, ChordThroughTheHostsTrianglesByHand) {
 // (-1, outAbs, inAbs, -1) with outAbs = 3550161.25, inAbs = 3.2778039: its float32 intersection accepted a
 // nearly parallel triangle 3.5e6 away, where s -= 0.01 leaves s unchanged. The kernel finds the same
 // triangle, the same outAbs and inAbs bit for bit, and faults: NaN, fault channel 1, the reason traced.
-TEST(Seed001Kernel, TheRayTheH100NeverFinished) {
+TEST(CudaCurvilinearKernel, TheRayTheH100NeverFinished) {
     const std::string dir = std::string(VOLREF_SOURCE_DIR) + "/tests/gpu/h100/seed001/";
     auto in = OIIO::ImageInput::open(dir + "sphere-composite.h100.exr");
     ASSERT_TRUE(in);
@@ -155,7 +155,7 @@ TEST(Seed001Kernel, TheRayTheH100NeverFinished) {
 
 // The fault channel through the image and `volref compare`: a pixel with fault = 1 in either image is
 // reported apart and left out of the metrics and the tolerance test.
-TEST(Seed001Kernel, CompareLeavesFaultsOut) {
+TEST(CudaCurvilinearKernel, CompareLeavesFaultsOut) {
     const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "seed001-fault";
     std::filesystem::create_directories(dir);
     Image a(2, 1, {"R", "G", "B", "A", "fault"}), b(2, 1, {"R", "G", "B", "A"});
@@ -179,7 +179,7 @@ TEST(Seed001Kernel, CompareLeavesFaultsOut) {
 }
 
 // The loader and the kernel's refusals name the key.
-TEST(Seed001Kernel, ErrorsNameTheKey) {
+TEST(CudaCurvilinearKernel, ErrorsNameTheKey) {
     std::string m = error_of(chord_scene("composite", R"("kernel": "fast")"));
     EXPECT_NE(m.find("render.profile_options.kernel"), std::string::npos) << m;
     // a shell the seed cannot describe (radius from 0.2): the float32 kernel refuses, "double" renders it
@@ -194,7 +194,7 @@ TEST(Seed001Kernel, ErrorsNameTheKey) {
 
 // The band of the float32 kernel (texture_band) holds the kernel through the exact unit as well as the
 // h100 one, on random cylinders and perspective views (8 x 8 pixels), composite and x-ray.
-TEST(Seed001Kernel, BandHoldsTheOtherUnit) {
+TEST(CudaCurvilinearKernel, BandHoldsTheOtherUnit) {
     std::mt19937_64 g(28);
     double used = 0.0;
     for (int trial = 0; trial < 6; ++trial) {
@@ -219,7 +219,7 @@ TEST(Seed001Kernel, BandHoldsTheOtherUnit) {
     EXPECT_GT(used, 0.01);  // the two units differ somewhere by a visible part of the band
 }
 
-// ---- seed 001's tri-cubic option (render.profile_options.tricubic; Seed001Kernel.h, seed001_cubic) ----
+// ---- seed 001's tri-cubic option (render.profile_options.tricubic; CudaCurvilinearKernel.h, seed001_cubic) ----
 
 namespace {
 
@@ -247,7 +247,7 @@ Seed001Frame ramp_frame(bool tricubic) {
 
 }  // namespace
 
-TEST(Seed001Kernel, CubicClosedFormOnARamp) {
+TEST(CudaCurvilinearKernel, CubicClosedFormOnARamp) {
     // the formula in double against the closed form, and against the expansion with the weights as written
     for (double t : {1.0, 1.25, 1.5, 2.1, 3.75, 5.999}) {
         const double a = t - std::floor(t);
@@ -265,18 +265,18 @@ TEST(Seed001Kernel, CubicClosedFormOnARamp) {
     EXPECT_NEAR(cubic_of_index(2.25, 8.0), 1.84375, 1e-15);  // 2.25 - 0.5 + 0.25 * 0.75 * 0.5
     // The float32 kernel (exact unit) on unsigned shorts round(65535 i / 7): within their rounding, also
     // where a = 0 (w2 + w3 = 0: a NaN coordinate read with weight 0) and next to the edges (clamped reads).
-    const Seed001Kernel k(ramp_frame(true), false, false);
+    const CudaCurvilinearKernel k(ramp_frame(true), false, false);
     for (float t : {1.0f, 1.25f, 2.5f, 3.0f, 4.8f, 6.0f, 0.3f, 6.7f, 0.0f, 7.0f}) {
         const float v = k.cubic({t, 3.3f, 5.0f});
         ASSERT_TRUE(std::isfinite(v)) << t;
         EXPECT_NEAR(double(v), cubic_of_index(double(t), 8.0) / 7.0, 1e-5) << t;
         // the H100 rule: 8-bit weights, within kL1Max / 2 of the three texels' range (2 / 7)
-        const Seed001Kernel h(ramp_frame(true), true, false);
+        const CudaCurvilinearKernel h(ramp_frame(true), true, false);
         EXPECT_NEAR(double(h.cubic({t, 3.3f, 5.0f})), cubic_of_index(double(t), 8.0) / 7.0, 0.0295867919921875 / 2 * 2.0 / 7.0 + 1e-5) << t;
     }
     // without the option the same point is one linear read: (t - 0.5) / 7 (the shorts 9362 and 18724 read
     // with weights 1/4, 3/4: 16383.5 / 65535, within 0.5 / 65535)
-    const Seed001Kernel lin(ramp_frame(false), false, false);
+    const CudaCurvilinearKernel lin(ramp_frame(false), false, false);
     EXPECT_NEAR(double(lin.fetch({2.25f, 3.3f, 5.0f})), 16383.5 / 65535.0, 1e-7);
     EXPECT_NEAR(double(lin.fetch({2.25f, 3.3f, 5.0f})), 1.75 / 7.0, 0.5 / 65535.0);
 }
@@ -284,7 +284,7 @@ TEST(Seed001Kernel, CubicClosedFormOnARamp) {
 // The chord of ChordThroughTheHostsTrianglesByHand with tricubic: the data is the radial index, constant
 // along angle and height, so each sample is the radial cubic of x_r = 4 r (over the range [0, 3]:
 // cubic_of_index / 3), outVal where x_r > 3 or x_angle > 7. X-ray: the largest.
-TEST(Seed001Kernel, TricubicChordByHand) {
+TEST(CudaCurvilinearKernel, TricubicChordByHand) {
     double best = 0.0;
     for (int k = 0; k <= 7; ++k) {
         const double z = -(1.0 - 0.05 * std::tan(2.8125 * 3.14159265358979323846 / 180.0)) + 0.25 * k;
@@ -308,7 +308,7 @@ TEST(Seed001Kernel, TricubicChordByHand) {
 }
 
 // The band holds the tri-cubic kernel through the other unit (BandHoldsTheOtherUnit's scenes).
-TEST(Seed001Kernel, TricubicBandHoldsTheOtherUnit) {
+TEST(CudaCurvilinearKernel, TricubicBandHoldsTheOtherUnit) {
     std::mt19937_64 g(281);
     double used = 0.0;
     for (int trial = 0; trial < 4; ++trial) {
@@ -338,7 +338,7 @@ TEST(Seed001Kernel, TricubicBandHoldsTheOtherUnit) {
     EXPECT_GT(used, 0.005);
 }
 
-TEST(Seed001Kernel, TricubicRefusalsNameTheKey) {
+TEST(CudaCurvilinearKernel, TricubicRefusalsNameTheKey) {
     // the double kernel reads exactly: the h100 unit with it is refused
     std::string m = error_of(chord_scene("composite", R"("tricubic": true, "kernel": "double", "texture_unit": "h100")"));
     EXPECT_NE(m.find("render.profile_options.tricubic"), std::string::npos) << m;

@@ -1,4 +1,4 @@
-// Seed001Kernel: seed 001's CUDA kernel (tests/gpu/cuda/cuda_curvilinear.cu) as it runs on an NVIDIA GPU,
+// CudaCurvilinearKernel: seed 001's CUDA kernel (tests/gpu/cuda/cuda_curvilinear.cu) as it runs on an NVIDIA GPU,
 // in float32 on the CPU: the bounding triangles the host builds (volref's tessellation, minus the
 // centre, in float), rayIntersectTriangles with baryTriangleCoefs and its fallback as written, the march
 // `for (float s = outAbs; s >= inAbs; s -= step)` at O + s vect, cartToCyl / cartToSpher, the data texture
@@ -96,11 +96,11 @@ struct Seed001Pixel {
     std::int64_t samples = 0;
 };
 
-class Seed001Kernel {
+class CudaCurvilinearKernel {
 public:
     // h100: the data and table fetches through TextureUnit.h's H100 rule (else exact weights, rounded
     // to float32); band: also compute the error channel.
-    Seed001Kernel(Seed001Frame frame, bool h100, bool band);
+    CudaCurvilinearKernel(Seed001Frame frame, bool h100, bool band);
     // One pixel: the host's float ray (origin - centre, normalize(direction)) through the kernel.
     Seed001Pixel pixel(const Ray& ray) const;
     // Every sample of one ray as the kernel takes it, for trace: (s, the point in the seed's frame, the

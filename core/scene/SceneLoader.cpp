@@ -927,10 +927,10 @@ VolPackTable read_volpack_table(const Json& v, const std::string& path, const Co
         if (n < 2) ctx.fail(rp, "expected at least 2 points [x, y]");
         for (std::size_t i = 0; i < n; ++i) {
             const std::string ip = index_path(rp, i);
-            const std::vector<double> xy = read_numbers(element(ramp, i), ip, ctx, 2);
-            const std::int64_t x = read_integer(element(element(ramp, i), 0), index_path(ip, 0), ctx, Range::closed(0, max_index));
-            const double y = read_number(element(element(ramp, i), 1), index_path(ip, 1), ctx, Range::closed(0.0, 1.0));
-            (void)xy;
+            const Json& point = element(ramp, i);
+            read_numbers(point, ip, ctx, 2);  // [x, y]: two numbers
+            const std::int64_t x = read_integer(element(point, 0), index_path(ip, 0), ctx, Range::closed(0, max_index));
+            const double y = read_number(element(point, 1), index_path(ip, 1), ctx, Range::closed(0.0, 1.0));
             if (i == 0 && x != 0) ctx.fail(index_path(ip, 0), "the first point's x must be 0 (vpRamp sets only the entries between its points)");
             if (i > 0 && x <= t.ramp.back().first) ctx.fail(index_path(ip, 0), "x must increase strictly (vpRamp returns VPERROR_BAD_VALUE)");
             t.ramp.emplace_back(int(x), float(y));

@@ -161,13 +161,13 @@ VolPackRenderer::VolPackRenderer(const Volume& volume, const VolPackSpec& spec, 
     stride_ = view_.axis == 0 ? std::array<std::int64_t, 3>{nx, nxy, 1}
               : view_.axis == 1 ? std::array<std::int64_t, 3>{nxy, 1, nx}
                                 : std::array<std::int64_t, 3>{1, nx, nxy};
-    classify(volume);
+    classify();
     composite();
     depth_cue();
     prepare_warp();
 }
 
-void VolPackRenderer::classify(const Volume&) {
+void VolPackRenderer::classify() {
     const bool exact_normals = spec_.normal_code == VolPackSpec::NormalCode::Exact;
     normals_ = volume_normals(scalars_.data(), dims_, exact_normals);
     shade_table_ = shade_table(spec_, view_.model);
@@ -189,12 +189,24 @@ void VolPackRenderer::classify(const Volume&) {
             shade_normal(spec_, view_.model, nrm, &voxel_shade_[i * std::size_t(C)]);
         }
     }
-    // VPRenderAffine: the depth-cue factor starts at 1 on the first slice composited, times the ratio per slice.
-    slice_dc_.resize(std::size_t(view_.kcount));
+    // VPRenderAffine: each slice's place and weights (float), and the depth-cue factor: 1 on the first
+    // slice composited, times the ratio per slice.
+    const View& w = view_;
+    slices_.resize(std::size_t(w.kcount));
     float dc = 1.0f;
-    for (float& s : slice_dc_) {
-        s = dc;
-        dc *= view_.slice_dc_ratio;
+    for (int n = 0; n < w.kcount; ++n) {
+        Slice& s = slices_[std::size_t(n)];
+        s.k = w.reverse_slice_order ? w.kcount - 1 - n : n;
+        const float slice_u = float(w.shear_i * s.k + w.trans_i), slice_v = float(w.shear_j * s.k + w.trans_j);
+        s.u = int(std::ceil(slice_u)) - 1;
+        s.v = int(std::ceil(slice_v)) - 1;
+        const float fu = slice_u - float(s.u), fv = slice_v - float(s.v);
+        s.weight[0] = fu * fv;
+        s.weight[1] = fu * (1.0f - fv);
+        s.weight[2] = (1.0f - fu) * fv;
+        s.weight[3] = (1.0f - fu) * (1.0f - fv);
+        s.dc = dc;
+        dc *= w.slice_dc_ratio;
     }
 }
 
@@ -204,18 +216,14 @@ void VolPackRenderer::composite_pixel(int u, int v, float* color, float& opacity
     const float min_opacity = float(spec_.min_voxel_opacity), max_opacity = float(spec_.max_ray_opacity);
     const bool sample_order = spec_.correction_order == VolPackSpec::CorrectionOrder::Sample;
     float clr[3] = {0.0f, 0.0f, 0.0f}, opc = 0.0f;
-    for (int n = 0; n < w.kcount; ++n) {
-        const int k = w.reverse_slice_order ? w.kcount - 1 - n : n;
-        // The slice's place in the intermediate image and its four weights (float, VPRenderAffine).
-        const float slice_u = float(w.shear_i * k + w.trans_i), slice_v = float(w.shear_j * k + w.trans_j);
-        const int su = int(std::ceil(slice_u)) - 1, sv = int(std::ceil(slice_v)) - 1;
-        const int i = u - su, j = v - sv;
+    for (const Slice& slice : slices_) {
+        const int k = slice.k;
+        const int i = u - slice.u, j = v - slice.v;
         if (i < 0 || i > w.icount || j < 0 || j > w.jcount) continue;
-        const float fu = slice_u - float(su), fv = slice_v - float(sv);
-        const float weight[4] = {fu * fv, fu * (1.0f - fv), (1.0f - fu) * fv, (1.0f - fu) * (1.0f - fv)};
+        const float* weight = slice.weight;
         const int ti[4] = {i - 1, i - 1, i, i}, tj[4] = {j - 1, j, j - 1, j};  // TL, BL, TR, BR
         float acc_opc = 0.0f, acc_clr[3] = {0.0f, 0.0f, 0.0f};
-        const float dc = slice_dc_[std::size_t(n)];
+        const float dc = slice.dc;
         for (int t = 0; t < 4; ++t) {
             if (ti[t] < 0 || ti[t] >= w.icount || tj[t] < 0 || tj[t] >= w.jcount) continue;  // zero outside
             const std::size_t idx = std::size_t(ti[t] * stride_[0] + tj[t] * stride_[1] + std::int64_t(k) * stride_[2]);
@@ -277,6 +285,8 @@ void VolPackRenderer::depth_cue() {
                                          : (depth_dj > 0 ? left_depth + depth_dj * H : left_depth);
     const int max_depth_int = int(max_depth * depth_quant);
     const int table_len = max_depth_int >= 0 ? max_depth_int + 1 : 0;
+    std::vector<float> table(static_cast<std::size_t>(table_len));  // VPComputeDepthCueTable
+    for (int c = 0; c < table_len; ++c) table[std::size_t(c)] = float(front * std::exp(-density * (1.0 - c * kDepthCueQuantization)));
     const float di_quant = depth_di * depth_quant, dj_quant = depth_dj * depth_quant;
     float left_quant = left_depth * depth_quant;
     const int C = spec_.channels;
@@ -290,7 +300,7 @@ void VolPackRenderer::depth_cue() {
             if (d >= table_len)
                 throw Error("render.profile_options.depth_cue: VolPack stops on this view (VPDepthCueIntImage: \"depth too "
                             "large\", a VPBug abort): the volume lies behind depth 0 of the window; move window's near and far");
-            const float factor = float(front * std::exp(-density * (1.0 - d * kDepthCueQuantization)));
+            const float factor = table[std::size_t(d)];
             IntermediatePixel& p = image_[std::size_t(j) * std::size_t(w.intermediate_width) + std::size_t(i)];
             for (int c = 0; c < C; ++c) p.color[c] *= factor;
         }

@@ -82,7 +82,7 @@ public:
     std::optional<CameraSpec> view_camera() const override { return camera(); }
 
 private:
-    void classify(const Volume& volume);
+    void classify();
     void composite();
     void depth_cue();
     void prepare_warp();
@@ -98,7 +98,15 @@ private:
     std::vector<float> opacity_;      // per voxel (x fastest): corrected opacity, 0 when not kept (sample order: q / 255)
     std::vector<float> shade_table_;  // channels per normal code
     std::vector<float> voxel_shade_;  // normal_code "exact": channels per voxel
-    std::vector<float> slice_dc_;     // the depth-cue factor of the n-th slice composited
+    // Per slice composited (n-th from the front), what is the same for every intermediate pixel: its slice
+    // k, its place in the intermediate image (ceil(slice_u) - 1, ...), its four float weights TL, BL, TR, BR
+    // and its depth-cue factor (VPRenderAffine).
+    struct Slice {
+        int k = 0, u = 0, v = 0;
+        float weight[4] = {};
+        float dc = 1.0f;
+    };
+    std::vector<Slice> slices_;
     std::array<std::int64_t, 3> stride_{};  // object-index strides of the permuted axes (i, j, k)
     std::vector<IntermediatePixel> image_;  // intermediate_width x intermediate_height, row v = j
     struct Scanline {

@@ -22,7 +22,7 @@ inline constexpr int kWarpWeightEntries = 64;    // WARP_WEIGHT_ENTRIES (2^WARP_
 inline constexpr int kWarpWeightShift = 31 - 6;  // FIX31_TO_WGTIND: the 31-bit fraction's top 6 bits
 inline constexpr double kDepthCueQuantization = 1.0 / 255.0;  // DEFAULT_DC_QUANTIZATION
 // volref's own: a warped byte "may round either way" (the `error` channel) when its float value before
-// truncation lies within this many 8-bit units of an integer (conventions "VolPack": kVolPackTieWindow).
+// truncation lies within this many 8-bit units of an integer (conventions section 9, "VolPack", the error channel).
 inline constexpr double kTieWindow = 1.0 / 1024.0;
 
 using Matrix4 = std::array<std::array<double, 4>, 4>;  // vpMatrix4: m[row][column]

@@ -9,13 +9,11 @@
 
 namespace volref {
 
-namespace {
-[[noreturn]] void not_resumable() {
+void Integrator::not_resumable() {
     throw Error("render: this projection, integrator or profile cannot be integrated in spans (volref-mpi) yet");
 }
-}  // namespace
+void Integrator::not_traced() { throw Error("trace: this projection or integrator is not supported yet"); }
 
-void Integrator::integrate_span(const Ray&, const std::vector<Interval>&, const RaySpan&, RayState&) const { not_resumable(); }
 void Integrator::merge_spans(RayState&, const RayState&) const { not_resumable(); }
 PixelValue Integrator::finish(const Ray&, const std::vector<Interval>&, const RayState&) const { not_resumable(); }
 

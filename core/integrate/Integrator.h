@@ -48,82 +48,127 @@ struct IntegrationContext {
     double field(const Ray& ray, double t) const { return pipeline.value(ray, t); }
 };
 
+// One call's rays (count <= kMaxPacketRays), and what is asked of them:
+//   whole rays:  out[i] = the pixel of rays[i] over intervals[i];
+//   spans:       `spans` and `states` set: states[i] continued over the samples spans[i] owns
+//                (march/RaySpan.h), front to back; `out` unused;
+//   a trace:     `recorder` set (count 1, a whole ray): out[0] as for whole rays, every sample the loop
+//                visits reported to the recorder (SampleRecorder.h), the pixel the render's bit for bit.
+// `simd`: the SIMD packet path may serve these rays where the integrator has one (each ray's result
+// then differs from the scalar loop's by at most that path's documented rounding); else each ray takes
+// the scalar loop. An integrator whose lanes are float (the fast profile) has only its packet path.
+struct RayBatch {
+    const Ray* rays = nullptr;
+    const std::vector<Interval>* intervals = nullptr;
+    int count = 0;
+    PixelValue* out = nullptr;
+    const RaySpan* spans = nullptr;
+    RayState* states = nullptr;
+    SampleRecorder* recorder = nullptr;
+    bool simd = false;
+    bool resuming() const { return states != nullptr; }
+};
+
+// What an integrator can do and writes, fixed when it is built.
+struct IntegratorTraits {
+    // Its rays can be integrated in spans (RayBatch::spans), the states merged and finished.
+    bool resumable = false;
+    // A span's result depends on the state in front of it (early termination): the spans must then be
+    // resumed in ray order, not merged.
+    bool spans_in_order = false;
+    bool writes_depth = false;  // the "Z" channel (first-hit)
+    bool writes_error = false;  // PixelValue::error is this integrator's error estimate (the "error" channel)
+    bool writes_fault = false;  // PixelValue::fault can be set (a mirrored program's loop that cannot end)
+};
+
+// Turns rays and their intervals into pixels. One virtual entry point, run(); the others are
+// wrappers of it. `intervals` are sorted and disjoint; an empty list gives the background (all zero,
+// depth inf).
 class Integrator {
 public:
     explicit Integrator(const IntegrationContext& ctx) : ctx_(ctx) {}
     virtual ~Integrator() = default;
-    // `intervals` are sorted and disjoint; an empty list gives the background (all zero, depth inf).
-    virtual PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const = 0;
-    // `count` rays at once (count <= kMaxPacketRays); the default integrates them one by one.
-    // Integrators with a SIMD path override it; each out[i] must equal integrate(rays[i],
-    // intervals[i]) up to the documented rounding of that path.
-    virtual void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
-                                  int count) const {
-        for (int i = 0; i < count; ++i) out[i] = integrate(rays[i], intervals[i]);
-    }
-    // integrate() by the same loop, reporting every sample it visits to `recorder` (SampleRecorder.h),
-    // for `volref trace` and `volref explain`. The result is integrate()'s, bit for bit.
-    virtual PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                        SampleRecorder& recorder) const {
-        (void)ray;
-        (void)intervals;
-        (void)recorder;
-        throw Error("trace: this projection or integrator is not supported yet");
-    }
-    // Resumable integration (march/RaySpan.h): the ray in spans, the accumulator's state
-    // handed from span to span; volref-mpi's ranks each integrate their span. An integrator that
-    // cannot be resumed says so (resumable() false; the functions below then throw).
-    virtual bool resumable() const { return false; }
-    // Continues `state` over the samples `span` owns, front to back: span after span, the whole
-    // ray's pixel (finish) is integrate()'s bit for bit.
-    virtual void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                RayState& state) const;
-    // `count` rays at once (<= kMaxPacketRays); the default resumes them one by one. Each state must
-    // equal integrate_span's up to the documented rounding of the SIMD path.
-    virtual void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
-                                       RayState* states, int count) const {
-        for (int i = 0; i < count; ++i) integrate_span(rays[i], intervals[i], spans[i], states[i]);
-    }
+    virtual void run(const RayBatch& batch) const = 0;
     // `back`, integrated from a fresh state over a span behind `front`'s, added to `front`: equal to
     // resuming `front` over that span up to rounding, where spans_in_order() is false.
     virtual void merge_spans(RayState& front, const RayState& back) const;
     // The pixel of a ray whose spans have all been integrated into `state`.
     virtual PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const;
-    // True when a span's result depends on the state in front of it (early termination): the spans
-    // must then be resumed in ray order, not merged.
-    virtual bool spans_in_order() const { return false; }
-
-    // The extra channels this projection writes (e.g. "Z" for first-hit).
-    virtual bool writes_depth() const { return false; }
-    // True when PixelValue::error is this integrator's error estimate (the "error" channel).
-    virtual bool writes_error() const { return false; }
-    // True when PixelValue::fault can be set (the "fault" channel: a mirrored program's loop that cannot end).
-    virtual bool writes_fault() const { return false; }
     // Why the mirrored program does not finish `ray` (empty when it does), for trace and explain.
     virtual std::string fault_reason(const Ray& ray) const {
         (void)ray;
         return {};
     }
 
+    // One ray by the scalar loop (the fast profile: its packet path).
+    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
+        PixelValue out;
+        run({.rays = &ray, .intervals = &intervals, .count = 1, .out = &out});
+        return out;
+    }
+    // `count` rays at once (count <= kMaxPacketRays), by the SIMD path where there is one.
+    void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out, int count) const {
+        run({.rays = rays, .intervals = intervals, .count = count, .out = out, .simd = true});
+    }
+    // integrate() by the same loop, reporting every sample it visits to `recorder`, for `volref trace`
+    // and `volref explain`. The result is integrate()'s, bit for bit.
+    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals, SampleRecorder& recorder) const {
+        PixelValue out;
+        run({.rays = &ray, .intervals = &intervals, .count = 1, .out = &out, .recorder = &recorder});
+        return out;
+    }
+    // Continues `state` over the samples `span` owns: span after span, the whole ray's pixel (finish)
+    // is integrate()'s bit for bit.
+    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const {
+        run({.rays = &ray, .intervals = &intervals, .count = 1, .spans = &span, .states = &state});
+    }
+    // `count` spans at once, by the SIMD path where there is one.
+    void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
+                               RayState* states, int count) const {
+        run({.rays = rays, .intervals = intervals, .count = count, .spans = spans, .states = states, .simd = true});
+    }
+
+    const IntegratorTraits& traits() const { return traits_; }
+    bool resumable() const { return traits_.resumable; }
+    bool spans_in_order() const { return traits_.spans_in_order; }
+    bool writes_depth() const { return traits_.writes_depth; }
+    bool writes_error() const { return traits_.writes_error; }
+    bool writes_fault() const { return traits_.writes_fault; }
+
 protected:
+    // The error of a batch this integrator cannot serve (spans where it is not resumable, a trace where
+    // it has no traced loop).
+    [[noreturn]] static void not_resumable();
+    [[noreturn]] static void not_traced();
+
     const IntegrationContext& ctx_;
+    IntegratorTraits traits_;
 };
 
 // An integrator whose one loop, Derived::integrate_impl<Rec>(ray, intervals, rec), serves both the
 // render (NoRecording) and `volref trace` (Recording, SampleRecorder.h): the same statements, so the
-// traced pixel is the rendered one bit for bit. Derived befriends this class.
+// traced pixel is the rendered one bit for bit. A resumable Derived also has
+// integrate_span_impl(ray, intervals, span, state). Derived befriends this class.
 template <class Derived>
 class OneLoopIntegrator : public Integrator {
 public:
     using Integrator::Integrator;
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override {
-        NoRecording rec;
-        return static_cast<const Derived&>(*this).integrate_impl(ray, intervals, rec);
-    }
-    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                SampleRecorder& recorder) const override {
-        Recording rec{recorder};
-        return static_cast<const Derived&>(*this).integrate_impl(ray, intervals, rec);
+    void run(const RayBatch& b) const override {
+        const Derived& self = static_cast<const Derived&>(*this);
+        for (int i = 0; i < b.count; ++i) {
+            if (b.resuming()) {
+                if constexpr (requires { self.integrate_span_impl(b.rays[i], b.intervals[i], b.spans[i], b.states[i]); })
+                    self.integrate_span_impl(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
+                else
+                    not_resumable();
+            } else if (b.recorder) {
+                Recording rec{*b.recorder};
+                b.out[i] = self.integrate_impl(b.rays[i], b.intervals[i], rec);
+            } else {
+                NoRecording rec;
+                b.out[i] = self.integrate_impl(b.rays[i], b.intervals[i], rec);
+            }
+        }
     }
 };
 

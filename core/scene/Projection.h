@@ -38,5 +38,7 @@ constexpr bool is_first_hit(Projection p) { return accumulation(p) == Accumulati
 constexpr bool shades_samples(Projection p) { return is_composite(p) || is_first_hit(p); }
 // An extremum's direction: mip keeps the largest value, minip the smallest.
 constexpr bool takes_maximum(Projection p) { return p == Projection::Mip; }
+// A line integral's normalisation: average divides by the length, xray multiplies by render.gain.
+constexpr bool takes_mean(Projection p) { return p == Projection::Average; }
 
 }  // namespace volref

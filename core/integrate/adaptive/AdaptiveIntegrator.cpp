@@ -29,8 +29,15 @@ namespace gk = gauss_kronrod;
 
 using adaptive_detail::rounding_bound;
 
-AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx)
+    : Integrator(ctx), kind_(accumulation(ctx.render.projection)), maximum_(takes_maximum(ctx.render.projection)),
+      mean_(takes_mean(ctx.render.projection)) {
     const RenderSpec& r = ctx.render;
+    // Resumable for the accumulations whose parts are independent (extremum, line integral): each
+    // span's extremum (classified here) or sums, merged behind the state (march/SpanStates.h). Not the
+    // composite, whose state (AdaptiveComposite) volref-mpi hands on itself.
+    traits_.resumable = kind_ == Accumulation::Extremum || kind_ == Accumulation::LineIntegral;
+    traits_.writes_error = true;
     if (r.early_termination)
         throw Error("render.integrator: \"adaptive\" integrates the whole ray; it cannot be combined with render.early_termination");
     cartesian_ = ctx.pipeline.cartesian_sampler();
@@ -57,7 +64,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
     const bool smooth_between_cuts = cubic_ && !ctx.pipeline.shaded() && !ctx.pipeline.classifier().needs_gradient() &&
                                      (rows_ || ctx.pipeline.preclassified());
     weak_ = !smooth_between_cuts;
-    if ((r.projection == Projection::Mip || r.projection == Projection::Minip) &&
+    if (kind_ == Accumulation::Extremum &&
         !(cartesian_ && (cubic_ || cartesian_->interpolation() == Interpolation::Nearest)))
         throw Error("render.integrator: \"adaptive\" mip/minip needs a Cartesian grid with trilinear or nearest "
                     "interpolation (the extremum is found exactly there)");
@@ -65,16 +72,21 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx) : Integrat
 
 double AdaptiveIntegrator::safety() const { return weak_ ? conventions::kAdaptiveWeakSafety : 1.0; }
 
-PixelValue AdaptiveIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    switch (ctx_.render.projection) {
-        case Projection::Composite: return composite(ray, intervals);
-        case Projection::Average:
-        case Projection::Xray: return line_integral(ray, intervals);
-        case Projection::Mip:
-        case Projection::Minip: return extremum(ray, intervals);
-        case Projection::FirstHit: break;  // FirstHitIntegrator
+void AdaptiveIntegrator::run(const RayBatch& b) const {
+    if (b.recorder) not_traced();
+    for (int i = 0; i < b.count; ++i) {
+        if (b.resuming()) {
+            resume(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
+            continue;
+        }
+        switch (kind_) {
+            case Accumulation::Composite: b.out[i] = composite(b.rays[i], b.intervals[i]); break;
+            case Accumulation::LineIntegral: b.out[i] = line_integral(b.rays[i], b.intervals[i]); break;
+            case Accumulation::Extremum: b.out[i] = extremum(b.rays[i], b.intervals[i]); break;
+            case Accumulation::FirstHit:  // FirstHitIntegrator
+                throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
+        }
     }
-    throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
 }
 
 // The part of `iv` whose pieces a span can own: [t0 - m, t1 + m] of the span with m two of the ray's
@@ -435,7 +447,7 @@ PixelValue AdaptiveIntegrator::line_pixel(const std::vector<Interval>& intervals
     PixelValue out;
     if (intervals.empty()) return out;
     const double L = line_length(intervals);
-    const bool mean = ctx_.render.projection == Projection::Average;
+    const bool mean = mean_;
     const double g = mean ? (L > 0.0 ? integral.value() / L : 0.0) : ctx_.render.gain * integral.value();
     out.rgba = glm::dvec4(g, g, g, 1.0);
     out.error = (mean ? (L > 0.0 ? error / L : 0.0) : ctx_.render.gain * error) + rounding_bound(out.rgba);
@@ -451,7 +463,7 @@ double AdaptiveIntegrator::line_length(const std::vector<Interval>& intervals) {
 double AdaptiveIntegrator::line_budget(double length) const {
     // Pixel = I / L (average) or gain I (xray); its tolerance spread over the length.
     const double tol = ctx_.render.tolerance;
-    if (ctx_.render.projection == Projection::Average) return tol;
+    if (mean_) return tol;
     return length > 0.0 ? tol / (ctx_.render.gain * length) : 0.0;
 }
 
@@ -470,7 +482,7 @@ void AdaptiveIntegrator::line_piece(const Ray& ray, double a, double b, double p
 // ---------------------------------------------------------------------------------------------
 
 PixelValue AdaptiveIntegrator::extremum(const Ray& ray, const std::vector<Interval>& intervals) const {
-    Extremum<Scalar> acc(ctx_.render.projection == Projection::Mip);
+    Extremum<Scalar> acc(maximum_);
     extremum_over(ray, intervals, RaySpan{}, acc);
     PixelValue out;
     if (acc.any()) out.rgba = extremum_rgba(ray, acc.where());
@@ -497,38 +509,38 @@ glm::dvec4 AdaptiveIntegrator::extremum_rgba(const Ray& ray, double t) const {
     return glm::dvec4(p.opacity * p.color, p.opacity);
 }
 
-// Resumable for the projections whose parts are independent (mip, minip, average, x-ray): each span's
-// extremum (classified here) or sums, merged behind the state (march/SpanStates.h). The composite's
-// state is AdaptiveComposite's (volref-mpi hands it on itself).
-bool AdaptiveIntegrator::resumable() const { return ctx_.render.projection != Projection::Composite; }
-
-void AdaptiveIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                        RayState& state) const {
+void AdaptiveIntegrator::resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                RayState& state) const {
     RayState part;
-    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip) {
-        Extremum<Scalar> acc(ctx_.render.projection == Projection::Mip);
-        extremum_over(ray, intervals, span, acc);
-        if (!acc.any()) return;
-        extremum_state::save(acc.value(), acc.where(), extremum_rgba(ray, acc.where()), part);
-    } else if (resumable()) {
-        LineSums st;
-        line_over(ray, intervals, span, st);
-        line_state::save(st.integral, CompensatedSum(), st.error, part);
-    } else {
-        return Integrator::integrate_span(ray, intervals, span, state);  // (throws)
+    switch (kind_) {
+        case Accumulation::Extremum: {
+            Extremum<Scalar> acc(maximum_);
+            extremum_over(ray, intervals, span, acc);
+            if (!acc.any()) return;
+            extremum_state::save(acc.value(), acc.where(), extremum_rgba(ray, acc.where()), part);
+            break;
+        }
+        case Accumulation::LineIntegral: {
+            LineSums st;
+            line_over(ray, intervals, span, st);
+            line_state::save(st.integral, CompensatedSum(), st.error, part);
+            break;
+        }
+        case Accumulation::Composite:
+        case Accumulation::FirstHit: not_resumable();
     }
     merge_spans(state, part);
 }
 
 void AdaptiveIntegrator::merge_spans(RayState& front, const RayState& back) const {
-    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip)
-        extremum_state::merge(front, back, ctx_.render.projection == Projection::Mip);
+    if (kind_ == Accumulation::Extremum)
+        extremum_state::merge(front, back, maximum_);
     else
         line_state::merge(front, back);
 }
 
 PixelValue AdaptiveIntegrator::finish(const Ray&, const std::vector<Interval>& intervals, const RayState& state) const {
-    if (ctx_.render.projection == Projection::Mip || ctx_.render.projection == Projection::Minip) {
+    if (kind_ == Accumulation::Extremum) {
         PixelValue out;
         if (extremum_state::seen(state)) out.rgba = extremum_state::rgba(state);
         out.error = rounding_bound(out.rgba);

@@ -68,13 +68,10 @@ class AdaptiveIntegrator final : public Integrator {
 public:
     // Throws volref::Error (naming render.integrator) for what it does not integrate.
     explicit AdaptiveIntegrator(const IntegrationContext& ctx);
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    bool writes_error() const override { return true; }
-    // Resumable (march/RaySpan.h) for mip, minip, average and x-ray: the pieces whose midpoints a span
-    // owns. Not the composite, whose state (AdaptiveComposite) volref-mpi hands on itself.
-    bool resumable() const override;
-    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                        RayState& state) const override;
+    // Whole rays and spans (RayBatch), every ray by its pieces; the error channel always. Resumable for
+    // mip, minip, average and x-ray: the pieces whose midpoints a span owns. Not the composite, whose
+    // state (AdaptiveComposite) volref-mpi hands on itself. There is no traced loop.
+    void run(const RayBatch& batch) const override;
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
@@ -128,6 +125,7 @@ public:
     double line_budget(double length) const;
 
 private:
+    void resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;
@@ -142,6 +140,9 @@ private:
     // Beam space: the crossings of the grid's coordinate surfaces inside each piece, found by sampling.
     void sampled_shell_cuts(const Ray& ray, std::vector<double>& out) const;
 
+    Accumulation kind_;                   // accumulation(render.projection)
+    bool maximum_ = false;                // Extremum: mip (else minip)
+    bool mean_ = false;                   // LineIntegral: average (else xray)
     const VolumeSampler* cartesian_ = nullptr;
     const ShellGrid* shell_grid_ = nullptr;  // beam-space grid (shell bounds), else null
     double cut_offset_ = 0.0;             // 0: cell faces; 0.5: nearest regions

@@ -40,21 +40,22 @@ void record_opacity(SampleRecord& r, const SampleOpacity<Scalar>& o) {
 
 }  // namespace
 
-PixelValue CompositeIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    if (packet_ && packet_->fast) {  // the fast profile has only its packet path
-        PixelValue out;
-        composite_packet(*packet_, &ray, &intervals, &out, 1);
-        return out;
+void CompositeIntegrator::run(const RayBatch& b) const {
+    const bool packets = packet_ && (b.simd || packets_only_);
+    if (b.recorder) {
+        if (packets_only_) fast_profile_not_traced();
+        Recording rec{*b.recorder};
+        b.out[0] = whole_ray(b.rays[0], b.intervals[0], rec);
+        return;
     }
+    if (b.resuming()) {
+        if (packets) return composite_packet(*packet_, b.rays, b.intervals, nullptr, b.count, b.spans, b.states);
+        for (int i = 0; i < b.count; ++i) resume(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
+        return;
+    }
+    if (packets) return composite_packet(*packet_, b.rays, b.intervals, b.out, b.count);
     NoRecording rec;
-    return whole_ray(ray, intervals, rec);
-}
-
-PixelValue CompositeIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                                 SampleRecorder& recorder) const {
-    if (packet_ && packet_->fast) fast_profile_not_traced();
-    Recording rec{recorder};
-    return whole_ray(ray, intervals, rec);
+    for (int i = 0; i < b.count; ++i) b.out[i] = whole_ray(b.rays[i], b.intervals[i], rec);
 }
 
 template <class Rec>
@@ -74,10 +75,9 @@ PixelValue CompositeIntegrator::whole_ray(const Ray& ray, const std::vector<Inte
 
 // Front to back: the state is FrontToBack's, resumed (composite_state, march/SpanStates.h). Back to
 // front: the span's part from a fresh BackToFront, put behind the state.
-void CompositeIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                         RayState& state) const {
+void CompositeIntegrator::resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                 RayState& state) const {
     if (state.stopped != 0.0) return;
-    if (packet_ && packet_->fast) return composite_packet(*packet_, &ray, &intervals, nullptr, 1, &span, &state);
     NoRecording rec;
     if (ctx_.render.order == CompositeOrder::FrontToBack) {
         FrontToBack<Scalar> acc;
@@ -95,26 +95,15 @@ void CompositeIntegrator::integrate_span(const Ray& ray, const std::vector<Inter
     }
 }
 
-void CompositeIntegrator::integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals,
-                                                const RaySpan* spans, RayState* states, int count) const {
-    if (packet_) composite_packet(*packet_, rays, intervals, nullptr, count, spans, states);
-    else Integrator::integrate_span_packet(rays, intervals, spans, states, count);
-}
-
 void CompositeIntegrator::merge_spans(RayState& front, const RayState& back) const {
-    if (packet_ && packet_->fast) product_state::merge(front, back);
+    if (packets_only_) product_state::merge(front, back);
     else composite_state::merge(front, back);
 }
 
 PixelValue CompositeIntegrator::finish(const Ray&, const std::vector<Interval>&, const RayState& state) const {
     PixelValue out;
-    out.rgba = packet_ && packet_->fast ? product_state::rgba(state) : composite_state::rgba(state);
+    out.rgba = packets_only_ ? product_state::rgba(state) : composite_state::rgba(state);
     return out;
-}
-
-bool CompositeIntegrator::spans_in_order() const {
-    const Termination& t = packet_ ? packet_->termination : termination_;
-    return t.test_alpha_above || t.test_alpha_at_least || t.test_transmittance;
 }
 
 Termination early_termination(const RenderSpec& render) {

@@ -41,26 +41,15 @@ class CompositeIntegrator final : public Integrator {
 public:
     explicit CompositeIntegrator(const IntegrationContext& ctx);
     ~CompositeIntegrator() override;
-    // The fast profile (FastProfile.h) integrates every ray by the packet kernel, one ray or many.
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                SampleRecorder& recorder) const override;
-    // The SIMD path (PacketComposite.h) where the scene allows it, else one ray at a time.
-    void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
-                          int count) const override;
+    // Whole rays, spans and traces (RayBatch): the SIMD path (PacketComposite.h) where the scene allows
+    // it and the batch asks for it, else the scalar loops below; the fast profile (FastProfile.h) has
+    // only its packet path. Resuming: front to back continues FrontToBack's state (composite_state,
+    // SpanStates.h); back to front puts each span's part behind the state; the fast profile continues
+    // its float transmittance product (product_state).
+    void run(const RayBatch& batch) const override;
     bool has_packet_path() const { return packet_.has_value(); }
-
-    // Resumable (march/RaySpan.h): front to back resumes FrontToBack's state (the packet path where it
-    // applies); back to front puts each span's part behind the state (composite_state, SpanStates.h).
-    // The fast profile resumes its float transmittance product (product_state, SpanStates.h).
-    bool resumable() const override { return true; }
-    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                        RayState& state) const override;
-    void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
-                               RayState* states, int count) const override;
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
-    bool spans_in_order() const override;
 
 private:
     // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h. The one loop of each
@@ -68,6 +57,7 @@ private:
     // stops (opaque or terminated early).
     template <class Rec>
     PixelValue whole_ray(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    void resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     template <class Rec>
     bool front_to_back(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                        FrontToBack<Scalar>& acc, Rec& rec) const;
@@ -75,6 +65,8 @@ private:
     void back_to_front(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                        BackToFront<Scalar>& acc, Rec& rec) const;
     Termination termination_;  // early_termination(render)
+    // The lanes are float (the fast profile): the packet path is the only one, its state product_state.
+    bool packets_only_ = false;
     std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
     std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
     std::vector<std::int32_t> skip_radius_;         // per octant: the empty distance ahead, or minus the solid one (the packets' skipping)

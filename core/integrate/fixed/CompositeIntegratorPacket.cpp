@@ -18,6 +18,11 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
     : Integrator(ctx), termination_(early_termination(ctx.render)) {
     const SamplePipeline& p = ctx.pipeline;
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
+    packets_only_ = fast;
+    // The spans resume in ray order where a ray can stop early (the termination the path applies).
+    auto stops_early = [](const Termination& t) { return t.test_alpha_above || t.test_alpha_at_least || t.test_transmittance; };
+    traits_.resumable = true;
+    traits_.spans_in_order = stops_early(termination_);
     // Where the packet path does not apply the reference takes the scalar path; the fast profile has
     // no scalar path and says why (FastProfile.h).
     auto unavailable = [&](const char* reason) {
@@ -113,17 +118,10 @@ CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
         if (ctx.render.profile_options.preintegration > 0)
             make_preintegrated(in, *tf, v, ctx.render.profile_options.preintegration, *fast_copies_);
     }
+    traits_.spans_in_order = stops_early(in.termination);
     packet_ = in;
 }
 
 CompositeIntegrator::~CompositeIntegrator() = default;
-
-void CompositeIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
-                                           int count) const {
-    if (packet_)
-        composite_packet(*packet_, rays, intervals, out, count);
-    else
-        Integrator::integrate_packet(rays, intervals, out, count);
-}
 
 }  // namespace volref

@@ -14,6 +14,8 @@ namespace volref {
 
 ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
+    packets_only_ = fast;
+    traits_.resumable = true;
     auto unavailable = [&](const char* reason) {
         if (fast) fast_profile_unavailable(reason);
     };
@@ -37,29 +39,43 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
 
 ExtremumIntegrator::~ExtremumIntegrator() = default;
 
-void ExtremumIntegrator::integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
-                                          int count) const {
-    if (!packet_) return Integrator::integrate_packet(rays, intervals, out, count);
-    RayExtremum e[kMaxPacketRays];
-    extremum_packet(*packet_, rays, intervals, e, count);
-    for (int i = 0; i < count; ++i) out[i] = pixel(rays[i], e[i].any, e[i].t);
-}
-
-PixelValue ExtremumIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    if (packet_ && packet_->fast) {  // the fast profile has only its packet path
-        PixelValue out;
-        integrate_packet(&ray, &intervals, &out, 1);
-        return out;
+void ExtremumIntegrator::run(const RayBatch& b) const {
+    const bool packets = packet_ && (b.simd || packets_only_);
+    if (b.recorder) {
+        if (packets_only_) fast_profile_not_traced();
+        Recording rec{*b.recorder};
+        b.out[0] = integrate_impl(b.rays[0], b.intervals[0], rec);
+        return;
+    }
+    if (b.resuming()) {
+        // A span's extremum (the packet path wherever it applies: bitwise the scalar one), classified
+        // here, behind the state (extremum_state, march/SpanStates.h).
+        RayExtremum e[kMaxPacketRays];
+        if (packet_) {
+            extremum_packet(*packet_, b.rays, b.intervals, e, b.count, b.spans);
+        } else {
+            NoRecording rec;
+            for (int i = 0; i < b.count; ++i) {
+                const Extremum<Scalar> acc = extremum(b.rays[i], b.intervals[i], b.spans[i], rec);
+                e[i] = RayExtremum{acc.any(), acc.value(), acc.where()};
+            }
+        }
+        for (int i = 0; i < b.count; ++i) {
+            if (!e[i].any) continue;
+            RayState part;
+            extremum_state::save(e[i].value, e[i].t, pixel(b.rays[i], true, e[i].t).rgba, part);
+            extremum_state::merge(b.states[i], part, maximum_);
+        }
+        return;
+    }
+    if (packets) {
+        RayExtremum e[kMaxPacketRays];
+        extremum_packet(*packet_, b.rays, b.intervals, e, b.count);
+        for (int i = 0; i < b.count; ++i) b.out[i] = pixel(b.rays[i], e[i].any, e[i].t);
+        return;
     }
     NoRecording rec;
-    return integrate_impl(ray, intervals, rec);
-}
-
-PixelValue ExtremumIntegrator::integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                                SampleRecorder& recorder) const {
-    if (packet_ && packet_->fast) fast_profile_not_traced();
-    Recording rec{recorder};
-    return integrate_impl(ray, intervals, rec);
+    for (int i = 0; i < b.count; ++i) b.out[i] = integrate_impl(b.rays[i], b.intervals[i], rec);
 }
 
 // With Rec::kOn each sample is also classified (unshaded, for the record) and the record carries the
@@ -97,33 +113,6 @@ Extremum<Scalar> ExtremumIntegrator::extremum(const Ray& ray, const std::vector<
         return true;
     });
     return acc;
-}
-
-// A span's extremum (the packet path where it applies: bitwise the scalar one), classified here,
-// behind the state (extremum_state, march/SpanStates.h).
-void ExtremumIntegrator::integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
-                                               RayState* states, int count) const {
-    RayExtremum e[kMaxPacketRays];
-    if (packet_) {
-        extremum_packet(*packet_, rays, intervals, e, count, spans);
-    } else {
-        NoRecording rec;
-        for (int i = 0; i < count; ++i) {
-            const Extremum<Scalar> acc = extremum(rays[i], intervals[i], spans[i], rec);
-            e[i] = RayExtremum{acc.any(), acc.value(), acc.where()};
-        }
-    }
-    for (int i = 0; i < count; ++i) {
-        if (!e[i].any) continue;
-        RayState part;
-        extremum_state::save(e[i].value, e[i].t, pixel(rays[i], true, e[i].t).rgba, part);
-        extremum_state::merge(states[i], part, maximum_);
-    }
-}
-
-void ExtremumIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                        RayState& state) const {
-    integrate_span_packet(&ray, &intervals, &span, &state, 1);
 }
 
 void ExtremumIntegrator::merge_spans(RayState& front, const RayState& back) const {

@@ -19,19 +19,10 @@ class ExtremumIntegrator final : public Integrator {
 public:
     ExtremumIntegrator(const IntegrationContext& ctx, bool maximum);
     ~ExtremumIntegrator() override;
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    PixelValue integrate_traced(const Ray& ray, const std::vector<Interval>& intervals,
-                                SampleRecorder& recorder) const override;
-    // The SIMD path (PacketExtremum.h) for trilinear volumes, bitwise the scalar result.
-    void integrate_packet(const Ray* rays, const std::vector<Interval>* intervals, PixelValue* out,
-                          int count) const override;
-
-    // Resumable (march/RaySpan.h): each span's extremum, classified by the span that took it.
-    bool resumable() const override { return true; }
-    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                        RayState& state) const override;
-    void integrate_span_packet(const Ray* rays, const std::vector<Interval>* intervals, const RaySpan* spans,
-                               RayState* states, int count) const override;
+    // Whole rays, spans and traces (RayBatch): the SIMD path (PacketExtremum.h, bitwise the scalar
+    // result) for trilinear volumes where the batch asks for it, else the scalar loop; resuming, each
+    // span's extremum, classified by the span that took it.
+    void run(const RayBatch& batch) const override;
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
@@ -42,6 +33,7 @@ private:
     Extremum<Scalar> extremum(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, Rec& rec) const;
     PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
+    bool packets_only_ = false;  // float lanes (the fast profile): the packet path is the only one
     std::optional<PacketExtremumInputs> packet_;
     std::unique_ptr<FloatCopies> fast_copies_;  // the fast profile's float voxels, when needed
 };

@@ -70,21 +70,32 @@ FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrat
     const VolumeSampler* s = ctx.pipeline.cartesian_sampler();
     if (s && s->interpolation() == Interpolation::Trilinear) trilinear_ = s;
     adaptive_ = ctx.render.integrator == IntegrationMethod::Adaptive;
+    traits_.resumable = true;
+    traits_.writes_depth = true;
+    traits_.writes_error = adaptive_;
     if (adaptive_ && !trilinear_)
         throw Error("render.integrator: \"adaptive\" first-hit needs a Cartesian grid with trilinear interpolation "
                     "(the crossing is a root of the cell's cubic)");
 }
 
-PixelValue FirstHitIntegrator::integrate(const Ray& ray, const std::vector<Interval>& intervals) const {
-    RayState state;
-    integrate_span(ray, intervals, RaySpan{}, state);
-    return finish(ray, intervals, state);
+// A whole ray is its one span, finished; there is no traced loop.
+void FirstHitIntegrator::run(const RayBatch& b) const {
+    if (b.recorder) not_traced();
+    for (int i = 0; i < b.count; ++i) {
+        if (b.resuming()) {
+            search(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
+        } else {
+            RayState state;
+            search(b.rays[i], b.intervals[i], RaySpan{}, state);
+            b.out[i] = finish(b.rays[i], b.intervals[i], state);
+        }
+    }
 }
 
 // The one search: the brackets (segments) or cell pieces whose midpoints `span` owns, front to back;
 // a hit is classified here and stops the ray (hit_state, march/SpanStates.h).
-void FirstHitIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                        RayState& state) const {
+void FirstHitIntegrator::search(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                RayState& state) const {
     if (state.stopped != 0.0) return;
     const double iso = *ctx_.render.isovalue;
     auto g = [&](double t) { return ctx_.field(ray, t) - iso; };

@@ -27,17 +27,14 @@ class VolumeSampler;
 class FirstHitIntegrator final : public Integrator {
 public:
     explicit FirstHitIntegrator(const IntegrationContext& ctx);
-    PixelValue integrate(const Ray& ray, const std::vector<Interval>& intervals) const override;
-    bool writes_depth() const override { return true; }
-    bool writes_error() const override { return adaptive_; }
-    // Resumable (march/RaySpan.h): the search over a span's brackets or pieces; a hit stops the ray.
-    bool resumable() const override { return true; }
-    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                        RayState& state) const override;
+    // Whole rays and spans (RayBatch): the search over a span's brackets or pieces; a hit stops the ray.
+    // The depth channel always, the error channel with render.integrator "adaptive".
+    void run(const RayBatch& batch) const override;
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
 private:
+    void search(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     const VolumeSampler* trilinear_ = nullptr;  // Cartesian trilinear sampler, else null
     bool adaptive_ = false;
 };

@@ -52,8 +52,8 @@ void LineIntegralIntegrator::line(const Ray& ray, const std::vector<Interval>& i
 }
 
 // Resumable: the sums continue (line_state, march/SpanStates.h).
-void LineIntegralIntegrator::integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                            RayState& state) const {
+void LineIntegralIntegrator::integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals,
+                                                 const RaySpan& span, RayState& state) const {
     LineIntegral<CompensatedSum> acc(line_state::integral(state), line_state::length(state));
     NoRecording rec;
     line(ray, intervals, span, acc, rec);

@@ -14,12 +14,10 @@ namespace volref {
 
 class LineIntegralIntegrator final : public OneLoopIntegrator<LineIntegralIntegrator> {
 public:
-    LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : OneLoopIntegrator(ctx), mean_(mean) {}
-
     // Resumable (march/RaySpan.h): the two sums continue span after span.
-    bool resumable() const override { return true; }
-    void integrate_span(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                        RayState& state) const override;
+    LineIntegralIntegrator(const IntegrationContext& ctx, bool mean) : OneLoopIntegrator(ctx), mean_(mean) {
+        traits_.resumable = true;
+    }
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
@@ -27,6 +25,7 @@ private:
     friend class OneLoopIntegrator<LineIntegralIntegrator>;
     template <class Rec>
     PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    void integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     template <class Rec>
     void line(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, LineIntegral<CompensatedSum>& acc,
               Rec& rec) const;

@@ -91,7 +91,7 @@ MultiVolumeIntegrator::MixedSegment MultiVolumeIntegrator::mix(const Ray* rays, 
 
 MultiVolumeIntegrator::MultiVolumeIntegrator(std::vector<Member> volumes, const RenderSpec& render, double step)
     : volumes_(std::move(volumes)), render_(render), step_(step) {
-    if (render_.integrator == IntegrationMethod::Adaptive && render_.projection == Projection::Composite)
+    if (render_.integrator == IntegrationMethod::Adaptive && is_composite(render_.projection))
         for (const Member& m : volumes_) adaptive_.push_back(std::make_unique<AdaptiveIntegrator>(*m.context));
 }
 
@@ -248,31 +248,30 @@ PixelValue MultiVolumeIntegrator::combine(const PixelValue* values, const std::v
     for (std::size_t k = 0; k < volumes_.size(); ++k) {
         if (intervals[k].empty()) continue;
         const PixelValue& v = values[k];
-        switch (render_.projection) {
-            case Projection::Mip:
-            case Projection::Minip:
+        switch (accumulation(render_.projection)) {
+            case Accumulation::Extremum:
                 if (!any) {
                     out.rgba = v.rgba;
                 } else {
                     for (int c = 0; c < 4; ++c)
-                        out.rgba[c] = render_.projection == Projection::Mip ? std::max(out.rgba[c], v.rgba[c])
-                                                                            : std::min(out.rgba[c], v.rgba[c]);
+                        out.rgba[c] = takes_maximum(render_.projection) ? std::max(out.rgba[c], v.rgba[c])
+                                                                        : std::min(out.rgba[c], v.rgba[c]);
                 }
                 out.error = std::max(out.error, v.error);
                 break;
-            case Projection::Average: {
-                double L = 0.0;
-                for (const Interval& iv : intervals[k]) L += iv.length();
-                for (int c = 0; c < 4; ++c) weighted[c].add(L * v.rgba[c]);
-                length.add(L);
-                error.add(L * v.error);
+            case Accumulation::LineIntegral:
+                if (takes_mean(render_.projection)) {  // length-weighted
+                    double L = 0.0;
+                    for (const Interval& iv : intervals[k]) L += iv.length();
+                    for (int c = 0; c < 4; ++c) weighted[c].add(L * v.rgba[c]);
+                    length.add(L);
+                    error.add(L * v.error);
+                } else {
+                    for (int c = 0; c < 3; ++c) weighted[c].add(v.rgba[c]);
+                    error.add(v.error);
+                }
                 break;
-            }
-            case Projection::Xray:
-                for (int c = 0; c < 3; ++c) weighted[c].add(v.rgba[c]);
-                error.add(v.error);
-                break;
-            case Projection::FirstHit: {
+            case Accumulation::FirstHit: {
                 const bool nearer = v.depth < out.depth ||
                                     (v.depth == out.depth && std::tie(v.rgba.r, v.rgba.g, v.rgba.b, v.rgba.a) <
                                                                  std::tie(out.rgba.r, out.rgba.g, out.rgba.b, out.rgba.a));
@@ -283,16 +282,17 @@ PixelValue MultiVolumeIntegrator::combine(const PixelValue* values, const std::v
                 if (!std::isfinite(out.depth)) out.error = std::max(out.error, v.error);
                 continue;  // `any` means "a hit" here
             }
-            case Projection::Composite: break;  // composite() mixes instead
+            case Accumulation::Composite: break;  // composite() mixes instead
         }
         any = true;
     }
     if (!any) return out;
-    if (render_.projection == Projection::Average) {
+    if (!is_line_integral(render_.projection)) return out;
+    if (takes_mean(render_.projection)) {
         const double g = weighted[0].value() / length.value();
         out.rgba = glm::dvec4(g, g, g, 1.0);
         out.error = error.value() / length.value();
-    } else if (render_.projection == Projection::Xray) {
+    } else {
         out.rgba = glm::dvec4(weighted[0].value(), weighted[1].value(), weighted[2].value(), 1.0);
         out.error = error.value();
     }

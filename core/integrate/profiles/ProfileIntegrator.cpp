@@ -108,12 +108,15 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
         tricubic_ = true;
     }
     check_rules(ctx.render, cartesian != nullptr);
+    traits_.writes_error = band_;
+    traits_.writes_fault = kernel_ != nullptr;
     if (p_.placement == Profile::Placement::Slices) {
         if (!slice_frame) throw Error("render.profile.placement: \"slices\" needs the frame's camera");
         const auto [smin, smax] = volume.value_range();
         lo_ = smin;
         width_ = smax - smin;
         prepare_slices(volume, *slice_frame);
+        traits_.writes_error = band_ || framebuffer_band_;
         return;  // the slicer's table and texels (prepare_slices): nothing below is read
     }
     offset_ = p_.gradient_offset_texture > 0.0 ? p_.gradient_offset_texture * (domain_hi_ - domain_lo_)
@@ -453,7 +456,7 @@ PixelValue ProfileIntegrator::seed_kernel(const Ray& ray, Rec& rec) const {
             const glm::dvec3 x = c + glm::dvec3(s.point[0], s.point[1], s.point[2]);
             begin_record(rec, r, x, double(s.s), h, lo_ + width_ * double(s.sample));
             r.sample.classified = s.used;
-            r.composited = ctx_.render.projection == Projection::Composite;
+            r.composited = is_composite(ctx_.render.projection);
             r.running = kernel_->frame().xray ? double(s.sum[0]) : 0.0;
             r.accumulated = glm::dvec4(s.sum[0], s.sum[1], s.sum[2], s.sum[3]);
             rec.recorder.record(r);
@@ -473,13 +476,12 @@ PixelValue ProfileIntegrator::integrate_impl(const Ray& ray, const std::vector<I
     if (kernel_) return seed_kernel(ray, rec);
     if (lattice_) return slices(ray, intervals, rec);
     PixelValue out;
-    switch (ctx_.render.projection) {
-        case Projection::Composite: out = composite(ray, intervals, rec); break;
-        case Projection::Mip: out = extremum(ray, intervals, true, rec); break;
-        case Projection::Minip: out = extremum(ray, intervals, false, rec); break;
-        case Projection::Average: out = line_integral(ray, intervals, true, rec); break;
-        case Projection::Xray: out = line_integral(ray, intervals, false, rec); break;
-        case Projection::FirstHit: break;
+    const Projection p = ctx_.render.projection;
+    switch (accumulation(p)) {
+        case Accumulation::Composite: out = composite(ray, intervals, rec); break;
+        case Accumulation::Extremum: out = extremum(ray, intervals, takes_maximum(p), rec); break;
+        case Accumulation::LineIntegral: out = line_integral(ray, intervals, takes_mean(p), rec); break;
+        case Accumulation::FirstHit: break;  // refused (check_profile_applies)
     }
     if (band_) out.error = band(ray, intervals, out.rgba);
     return out;

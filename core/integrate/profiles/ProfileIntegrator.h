@@ -64,11 +64,9 @@ public:
     ProfileIntegrator(const IntegrationContext& ctx, const Profile& profile, const Volume& volume,
                       const BoundsSpec* bounds = nullptr, const SliceFrame* slice_frame = nullptr);
     ~ProfileIntegrator() override;
-    // render.profile_options.texture_band: PixelValue::error is the texture band (band()).
-    // render.profile_options.framebuffer_band: the frame buffer's band.
-    bool writes_error() const override { return band_ || framebuffer_band_; }
-    // cuda-curvilinear's float32 kernel: the rays seed 001's loop cannot finish.
-    bool writes_fault() const override { return kernel_ != nullptr; }
+    // Traits: the error channel with render.profile_options.texture_band (PixelValue::error is the
+    // texture band, band()) or framebuffer_band (the frame buffer's band); the fault channel with
+    // cuda-curvilinear's float32 kernel (the rays seed 001's loop cannot finish, fault_reason).
     std::string fault_reason(const Ray& ray) const override;
 
 private:

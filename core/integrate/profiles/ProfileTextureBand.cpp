@@ -222,7 +222,7 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
         glm::dvec3 g{0.0}, dg{0.0};  // shaded composite: the exact gradient and the half-widths of its box
     };
     std::vector<S> samples;
-    const Shader* shader = ctx_.render.projection == Projection::Composite ? ctx_.pipeline.shader() : nullptr;
+    const Shader* shader = is_composite(ctx_.render.projection) ? ctx_.pipeline.shader() : nullptr;
     for_each_sample(intervals, [&](double t, double d) {
         const glm::dvec3 x = ray.at(t);
         const Fetch f = texture_fetch(x);
@@ -242,8 +242,8 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
         samples.push_back(q);
         return true;
     });
-    switch (ctx_.render.projection) {
-        case Projection::Composite:
+    switch (accumulation(ctx_.render.projection)) {
+        case Accumulation::Composite:
             if (p_.compositing == Profile::Compositing::Lerp) {
                 // sum = sum (1 - w) + col w per channel, w = opacity density, col = (rgb, opacity)
                 Iv sum[4] = {};
@@ -295,9 +295,8 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
                 }
             }
             break;
-        case Projection::Mip:
-        case Projection::Minip: {
-            const bool maximum = ctx_.render.projection == Projection::Mip;
+        case Accumulation::Extremum: {
+            const bool maximum = takes_maximum(ctx_.render.projection);
             Iv v{};
             bool found = false;
             for (const S& q : samples) {
@@ -314,9 +313,8 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
             hull_into(p);
             break;
         }
-        case Projection::Average:
-        case Projection::Xray: {
-            const bool mean = ctx_.render.projection == Projection::Average;
+        case Accumulation::LineIntegral: {
+            const bool mean = takes_mean(ctx_.render.projection);
             const Classifier& cl = ctx_.pipeline.classifier();
             const bool weighted = mean && p_.average == Profile::Average::MeanOpacityTimesNormalised;
             Iv g{}, largest{0.0, 0.0};
@@ -346,7 +344,7 @@ double ProfileIntegrator::band(const Ray& ray, const std::vector<Interval>& inte
             hull_into(p);
             break;
         }
-        case Projection::FirstHit: break;
+        case Accumulation::FirstHit: break;
     }
     if (!any) return 0.0;
     double e = 0.0;

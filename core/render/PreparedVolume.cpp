@@ -286,14 +286,13 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         shader = std::make_unique<Shader>(*vs.shading, scene.lights,
                                           conventions::kZeroGradientRelative * std::max(std::fabs(vmin), std::fabs(vmax)) / voxel);
     }
-    PipelineStages stages;
-    stages.cartesian = model.cartesian.get();
-    stages.shell_grid = model.shell_grid.get();
-    // make_classifier builds a TransferFunction exactly when the spec names no other classification.
-    stages.transfer_function = vs.classification ? nullptr : static_cast<const TransferFunction*>(classifier.get());
-    stages.grid_gradient = gradient_field.get();
+    // The volume's one description (VolumeView.h). make_classifier builds a TransferFunction exactly
+    // when the spec names no other classification.
+    view = describe_volume(volume, model.cartesian.get(), model.shell_grid.get(),
+                           vs.classification ? nullptr : static_cast<const TransferFunction*>(classifier.get()),
+                           gradient_field.get(), shader.get(), preclassified != nullptr);
     pipeline = std::make_unique<SamplePipeline>(sampler, *classifier, gradient, preclassified.get(), shader.get(),
-                                                transform ? &*transform : nullptr, stages);
+                                                transform ? &*transform : nullptr, &view);
     // The macrocell grid of empty-space skipping, kept only if some macrocell is empty; for mip and
     // minip (the fixed step's SIMD path), the grid's value bounds (SegmentWalk.h, extremum mode).
     // The grid's bytes (MacrocellGrid::bytes_for, an upper bound; with the composite packets' radii)
@@ -309,6 +308,11 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
             *model.cartesian, *classifier, preclassified ? MacrocellGrid::Classification::Pre : MacrocellGrid::Classification::Post);
         if (macrocells->empty_count() == 0) macrocells.reset();
         else bytes += b;
+        // The composite packets' skipping radii, where the fixed-step composite's packets apply.
+        const bool fixed_composite = is_composite(scene.render.projection) && scene.render.integrator == IntegrationMethod::Fixed &&
+                                     (scene.render.reference_integrators() || scene.render.profile == ProfileId::Fast);
+        if (macrocells && fixed_composite && !view.packet_unavailable(true, scene.render.order))
+            describe_skipping(view, *macrocells, view_store);
     } else if (options.empty_space_skipping && extremum_skipping_applies(vs, scene.render, options, model.cartesian.get())) {
         bytes += grid_bytes(false);
         macrocells = std::make_unique<MacrocellGrid>(*model.cartesian, *classifier, MacrocellGrid::Classification::Post);
@@ -367,7 +371,17 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         world_box(transform ? &*transform : nullptr, volume.domain_min(), volume.domain_max(), view_lo, view_hi);
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
-    if (scene.render.profile == ProfileId::Fast) context->lanes = IntegrationContext::Lanes::Float;
+    if (scene.render.profile == ProfileId::Fast) {
+        context->lanes = IntegrationContext::Lanes::Float;
+        // The float lanes' voxels and rows (and the pre-integration table), where the packets apply; the
+        // integrator refuses the scene otherwise (FastProfile.h).
+        const bool composite = is_composite(scene.render.projection);
+        if (!view.packet_unavailable(composite, scene.render.order)) {
+            describe_float_lanes(view, composite, view_store);
+            if (composite && scene.render.profile_options.preintegration > 0)
+                make_preintegrated(view, step, scene.render.profile_options.preintegration, view_store);
+        }
+    }
     // render.profile: another renderer's discretisation (ProfileIntegrator.h); the reference's own integrators otherwise.
     if (scene.render.reference_integrators() || scene.render.profile == ProfileId::Fast) {
         integrator = make_integrator(*context);

@@ -27,6 +27,7 @@
 #include "core/sample/PreClassifiedVolume.h"
 #include "core/sample/ShellSampler.h"
 #include "core/sample/VolumeSampler.h"
+#include "core/sample/VolumeView.h"
 #include "core/scene/Scene.h"
 #include "geometry/BoundingGeometry.h"
 #include "geometry/ShellCoordinates.h"
@@ -104,6 +105,8 @@ struct PreparedVolume {
     const GradientSource* gradient = nullptr;       // null: no stage needs a gradient
     std::unique_ptr<PreClassifiedVolume> preclassified;
     std::unique_ptr<Shader> shader;
+    VolumeView view;             // the stages above as one description (VolumeView.h)
+    VolumeViewStore view_store;  // what the view holds of its own (float lanes, pre-integration, skipping radii)
     std::unique_ptr<SamplePipeline> pipeline;
     std::unique_ptr<MacrocellGrid> macrocells;      // null: no empty-space skipping
     BoundingGeometry geometry;

@@ -40,8 +40,8 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx)
     traits_.writes_error = true;
     if (r.early_termination)
         throw Error("render.integrator: \"adaptive\" integrates the whole ray; it cannot be combined with render.early_termination");
-    cartesian_ = ctx.pipeline.cartesian_sampler();
-    shell_grid_ = ctx.pipeline.stages().shell_grid;
+    cartesian_ = ctx.pipeline.view().cartesian;
+    shell_grid_ = ctx.pipeline.view().shell_grid;
     if (cartesian_) {
         cut_cells_ = true;
         const Interpolation interp = cartesian_->interpolation();
@@ -51,7 +51,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx)
     // Rows of a post-classified transfer function (nearest: the value is constant between cuts).
     const bool nearest = cartesian_ && cartesian_->interpolation() == Interpolation::Nearest;
     if (!ctx.pipeline.preclassified() && !nearest)
-        if (const TransferFunction* tf = ctx.pipeline.stages().transfer_function) {
+        if (const TransferFunction* tf = ctx.pipeline.view().transfer_function) {
             rows_ = tf;
             for (double x : tf->color_function().xs()) row_values_.push_back(x);
             for (double x : tf->opacity_function().xs()) row_values_.push_back(x);

@@ -49,11 +49,11 @@ void CompositeIntegrator::run(const RayBatch& b) const {
         return;
     }
     if (b.resuming()) {
-        if (packets) return composite_packet(*packet_, b.rays, b.intervals, nullptr, b.count, b.spans, b.states);
+        if (packets) return composite_packet(ctx_.pipeline.view(), *packet_, b.rays, b.intervals, nullptr, b.count, b.spans, b.states);
         for (int i = 0; i < b.count; ++i) resume(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
         return;
     }
-    if (packets) return composite_packet(*packet_, b.rays, b.intervals, b.out, b.count);
+    if (packets) return composite_packet(ctx_.pipeline.view(), *packet_, b.rays, b.intervals, b.out, b.count);
     NoRecording rec;
     for (int i = 0; i < b.count; ++i) b.out[i] = whole_ray(b.rays[i], b.intervals[i], rec);
 }

@@ -31,8 +31,6 @@
 
 namespace volref {
 
-struct FloatCopies;
-
 // The termination the scene asks for (render.early_termination: stop once A > threshold), as every
 // front-to-back integrator of the reference applies it (the composite and the several-volume mix).
 Termination early_termination(const RenderSpec& render);
@@ -67,9 +65,7 @@ private:
     Termination termination_;  // early_termination(render)
     // The lanes are float (the fast profile): the packet path is the only one, its state product_state.
     bool packets_only_ = false;
-    std::optional<PacketCompositeInputs> packet_;  // set when the SIMD path applies
-    std::unique_ptr<FloatCopies> fast_copies_;      // the fast profile's float tables and voxels
-    std::vector<std::int32_t> skip_radius_;         // per octant: the empty distance ahead, or minus the solid one (the packets' skipping)
+    std::optional<PacketRun> packet_;  // set when the SIMD path applies (the volume: ctx.pipeline.view())
 };
 
 }  // namespace volref

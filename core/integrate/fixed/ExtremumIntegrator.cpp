@@ -1,7 +1,6 @@
 #include "core/integrate/fixed/ExtremumIntegrator.h"
 
 #include "core/integrate/packet/FastProfile.h"
-#include "core/integrate/packet/PacketGrid.h"
 #include "core/integrate/march/March.h"
 #include "core/integrate/march/Accumulators.h"
 #include "core/integrate/march/SpanStates.h"
@@ -16,25 +15,12 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     packets_only_ = fast;
     traits_.resumable = true;
-    auto unavailable = [&](const char* reason) {
+    if (const char* reason = ctx.pipeline.view().packet_unavailable(false, ctx.render.order)) {
         if (fast) fast_profile_unavailable(reason);
-    };
-    if (const char* reason = packet_path_unavailable(ctx.pipeline, false, ctx.render.order)) {
-        unavailable(reason);
         return;
     }
-    const Volume& v = ctx.pipeline.cartesian_sampler()->volume();
-    PacketExtremumInputs in;
-    in.grid = PacketGrid::of(v);
-    in.step = ctx.step;
-    in.maximum = maximum;
-    in.macrocells = ctx.macrocells;  // skipping (PreparedVolume builds the grid for mip / minip)
-    if (fast) {
-        fast_copies_ = std::make_unique<FloatCopies>();
-        fast_voxels(v, *fast_copies_, &in.grid.voxels, &in.grid.voxel_type);
-        in.fast = true;
-    }
-    packet_ = in;
+    // Skipping: PreparedVolume builds the grid for mip / minip.
+    packet_ = PacketRun{.step = ctx.step, .macrocells = ctx.macrocells, .fast = fast};
 }
 
 ExtremumIntegrator::~ExtremumIntegrator() = default;
@@ -52,7 +38,7 @@ void ExtremumIntegrator::run(const RayBatch& b) const {
         // here, behind the state (extremum_state, march/SpanStates.h).
         RayExtremum e[kMaxPacketRays];
         if (packet_) {
-            extremum_packet(*packet_, b.rays, b.intervals, e, b.count, b.spans);
+            extremum_packet(ctx_.pipeline.view(), *packet_, maximum_, b.rays, b.intervals, e, b.count, b.spans);
         } else {
             NoRecording rec;
             for (int i = 0; i < b.count; ++i) {
@@ -70,7 +56,7 @@ void ExtremumIntegrator::run(const RayBatch& b) const {
     }
     if (packets) {
         RayExtremum e[kMaxPacketRays];
-        extremum_packet(*packet_, b.rays, b.intervals, e, b.count);
+        extremum_packet(ctx_.pipeline.view(), *packet_, maximum_, b.rays, b.intervals, e, b.count);
         for (int i = 0; i < b.count; ++i) b.out[i] = pixel(b.rays[i], e[i].any, e[i].t);
         return;
     }

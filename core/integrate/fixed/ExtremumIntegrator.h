@@ -13,8 +13,6 @@
 
 namespace volref {
 
-struct FloatCopies;
-
 class ExtremumIntegrator final : public Integrator {
 public:
     ExtremumIntegrator(const IntegrationContext& ctx, bool maximum);
@@ -34,8 +32,7 @@ private:
     PixelValue pixel(const Ray& ray, bool any, double t_best) const;
     bool maximum_;
     bool packets_only_ = false;  // float lanes (the fast profile): the packet path is the only one
-    std::optional<PacketExtremumInputs> packet_;
-    std::unique_ptr<FloatCopies> fast_copies_;  // the fast profile's float voxels, when needed
+    std::optional<PacketRun> packet_;  // set when the SIMD path applies (the volume: ctx.pipeline.view())
 };
 
 }  // namespace volref

@@ -67,7 +67,7 @@ std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const
 }
 
 FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
-    const VolumeSampler* s = ctx.pipeline.cartesian_sampler();
+    const VolumeSampler* s = ctx.pipeline.view().cartesian;
     if (s && s->interpolation() == Interpolation::Trilinear) trilinear_ = s;
     adaptive_ = ctx.render.integrator == IntegrationMethod::Adaptive;
     traits_.resumable = true;

@@ -13,25 +13,13 @@
 #include "core/sample/GradientField.h"
 #include "core/sample/PreClassifiedVolume.h"
 #include "core/sample/VolumeSampler.h"
+#include "core/sample/VolumeView.h"
 #include "transfer/Classifier.h"
 #include "geometry/VolumeTransform.h"
 #include "transfer/Shader.h"
 
 namespace volref {
 
-class GradientField;
-class ShellGrid;
-class TransferFunction;
-
-// The concrete stages behind the pipeline's interfaces, as the scene built them (PreparedVolume), for
-// the paths that read them as plain arrays (the SIMD packet kernels) or cut rays at their cells and
-// rows (the adaptive integrator). Null where the scene uses another kind of stage.
-struct PipelineStages {
-    const VolumeSampler* cartesian = nullptr;             // a Cartesian grid's sampler (null for shells)
-    const ShellGrid* shell_grid = nullptr;                 // a shell's beam-space grid
-    const TransferFunction* transfer_function = nullptr;  // null for Levoy's classifiers
-    const GradientField* grid_gradient = nullptr;          // the Cartesian grid's gradients, when used
-};
 
 struct PipelineSample {
     double value = 0.0;
@@ -45,12 +33,14 @@ public:
     // none) places a volume in the world: the rays given to this pipeline are then the volume's local
     // rays (VolumeTransform::local_ray: positions in its own space, t a world distance), and the
     // gradient (for classification and shading) and the view direction are turned back into world
-    // vectors, grad_world = A^-T grad_local, V = -A d_local.
+    // vectors, grad_world = A^-T grad_local, V = -A d_local. `view` (VolumeView.h; null: none, a
+    // pipeline of the stages alone) describes the same stages as plain data, for the SIMD packet kernels
+    // and for the paths that cut rays at a grid's cells and a transfer function's rows.
     SamplePipeline(const FieldSampler& sampler, const Classifier& classifier, const GradientSource* gradient,
                    const PreClassifiedVolume* preclassified, const Shader* shader,
-                   const VolumeTransform* transform = nullptr, const PipelineStages& stages = {})
+                   const VolumeTransform* transform = nullptr, const VolumeView* view = nullptr)
         : sampler_(sampler), classifier_(classifier), gradient_(gradient), pre_(preclassified), shader_(shader),
-          transform_(transform), stages_(stages) {}
+          transform_(transform), view_(view ? view : &kNoView) {}
 
     double value(const Ray& ray, double t) const { return sampler_.value(ray.at(t)); }
 
@@ -69,9 +59,9 @@ public:
 
     const Classifier& classifier() const { return classifier_; }
     const FieldSampler& sampler() const { return sampler_; }
-    // The Cartesian sampler, or null for other grids (the SIMD paths and macrocells need it).
-    const VolumeSampler* cartesian_sampler() const { return stages_.cartesian; }
-    const PipelineStages& stages() const { return stages_; }
+    // The volume's description (VolumeView.h): its Cartesian sampler or shell grid, transfer function
+    // and gradient field (null where the scene uses another kind, or the pipeline has no view).
+    const VolumeView& view() const { return *view_; }
     bool shaded() const { return shader_ != nullptr; }
     const Shader* shader() const { return shader_; }
     const GradientSource* gradient_source() const { return gradient_; }
@@ -131,7 +121,8 @@ private:
     const PreClassifiedVolume* pre_;
     const Shader* shader_;
     const VolumeTransform* transform_;
-    PipelineStages stages_;
+    const VolumeView* view_;
+    static inline const VolumeView kNoView{};
 };
 
 }  // namespace volref

@@ -34,15 +34,17 @@ std::vector<float> to_float(const double* p, std::size_t n) {
                 "render.profile \"reference\"");
 }
 
-void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, ScalarType* type) {
+namespace {
+
+void fast_voxels(const Volume& volume, VolumeViewStore& copies, GridView& grid) {
     const ScalarType t = volume.values.type();
     const std::size_t n = volume.values.size();
     const bool gathered32 = t == ScalarType::F32 || t == ScalarType::I32 || t == ScalarType::U32 ||
                             t == ScalarType::U16 || t == ScalarType::I16 || t == ScalarType::U8 || t == ScalarType::I8;
     constexpr std::uint64_t kLimit = (std::uint64_t(1) << 31) - 64;  // PacketTrilinear's 32-bit offsets
     if (gathered32 && std::endian::native == std::endian::little && std::uint64_t(volume.values.bytes()) < kLimit) {
-        *data = volume.values.raw();
-        *type = t;
+        grid.voxels = volume.values.raw();
+        grid.voxel_type = t;
         return;
     }
     if (std::uint64_t(n) * 4 >= kLimit)
@@ -56,46 +58,54 @@ void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, S
             fast_profile_unavailable("voxel " + std::to_string(i) + " (" + std::to_string(volume.values[i]) +
                                      ") is beyond float's range");
     }
-    *data = copies.voxels.data();
-    *type = ScalarType::F32;
+    grid.voxels = copies.voxels.data();
+    grid.voxel_type = ScalarType::F32;
 }
 
-void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies) {
-    const PacketTables<double>& td = in.tables_double;
-    copies.color_x = to_float(td.color_x, std::size_t(in.color_rows));
-    copies.color_y = to_float(td.color_y, std::size_t(in.color_rows) * 3);  // r, g, b per row
-    copies.opacity_x = to_float(td.opacity_x, std::size_t(in.opacity_rows));
-    copies.opacity_y = to_float(td.opacity_y, std::size_t(in.opacity_rows));
-    PacketTables<float>& tf = in.tables_float;
+}  // namespace
+
+void describe_float_lanes(VolumeView& view, bool composite, VolumeViewStore& copies) {
+    const Volume& volume = *view.volume;
+    if (!composite) return fast_voxels(volume, copies, view.grid_float);
+    const TransferRows<double>& td = view.rows;
+    copies.color_x = to_float(td.color_x, std::size_t(view.color_rows));
+    copies.color_y = to_float(td.color_y, std::size_t(view.color_rows) * 3);  // r, g, b per row
+    copies.opacity_x = to_float(td.opacity_x, std::size_t(view.opacity_rows));
+    copies.opacity_y = to_float(td.opacity_y, std::size_t(view.opacity_rows));
+    TransferRows<float>& tf = view.rows_float;
     tf.color_x = copies.color_x.data();
     tf.color_y = copies.color_y.data();
     tf.opacity_x = copies.opacity_x.data();
     tf.opacity_y = copies.opacity_y.data();
-    if (in.gradient_opacity_rows > 0) {
-        copies.gradient_opacity_x = to_float(td.gradient_opacity_x, std::size_t(in.gradient_opacity_rows));
-        copies.gradient_opacity_y = to_float(td.gradient_opacity_y, std::size_t(in.gradient_opacity_rows));
+    if (view.gradient_opacity_rows > 0) {
+        copies.gradient_opacity_x = to_float(td.gradient_opacity_x, std::size_t(view.gradient_opacity_rows));
+        copies.gradient_opacity_y = to_float(td.gradient_opacity_y, std::size_t(view.gradient_opacity_rows));
         tf.gradient_opacity_x = copies.gradient_opacity_x.data();
         tf.gradient_opacity_y = copies.gradient_opacity_y.data();
     }
-    fast_voxels(volume, copies, &in.grid.voxels, &in.grid.voxel_type);
-    if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
+    fast_voxels(volume, copies, view.grid_float);
+    if (view.gradient == VolumeView::Gradient::Cached) {
         // Held: the volume, its f64 gradient cache and any float voxels; allocated: the float cache.
         check_memory(volume.values.bytes() + 3 * volume.values.size() * (sizeof(double) + sizeof(float)) +
                          copies.voxels.size() * sizeof(float),
                      "render.profile: the fast profile's float gradient cache");
         for (int a = 0; a < 3; ++a) {
-            const VoxelArray& c = cached[a]->values;
-            copies.cached_gradient[a].resize(c.size());
-            for (std::size_t i = 0; i < c.size(); ++i) copies.cached_gradient[a][i] = float(c[i]);
+            const double* c = static_cast<const double*>(td.cached_gradient[a]);
+            copies.cached_gradient[a] = to_float(c, volume.values.size());
             tf.cached_gradient[a] = copies.cached_gradient[a].data();
         }
     }
-    in.fast = true;
-    in.termination.test_transmittance = true;
-    in.termination.transmittance_at_most = conventions::kFastTransmittanceCutoff;
 }
 
-void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, const Volume& volume, int n, FloatCopies& copies) {
+Termination fast_termination(Termination t) {
+    t.test_transmittance = true;
+    t.transmittance_at_most = conventions::kFastTransmittanceCutoff;
+    return t;
+}
+
+void make_preintegrated(VolumeView& in, double step, int n, VolumeViewStore& copies) {
+    const TransferFunction& tf = *in.transfer_function;
+    const Volume& volume = *in.volume;
     auto refuse = [](const std::string& why) {
         throw Error("render.profile_options.preintegration: pre-integrated segments " + why +
                     " (remove preintegration, or use render.profile \"reference\")");
@@ -114,7 +124,7 @@ void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, c
         }
     const std::size_t entries = (std::size_t(n) + 1) * (std::size_t(n) + 1) * 4;
     check_memory(entries * sizeof(float), "render.profile_options.preintegration: the pre-integration table");
-    copies.preintegration = build_preintegration_table(tf, lo, hi, in.step, n);
+    copies.preintegration = build_preintegration_table(tf, lo, hi, step, n);
     const PreIntegrationTable& t = copies.preintegration;
     in.preintegration = t.entries.data();
     in.pre_n = t.n;

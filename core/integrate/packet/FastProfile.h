@@ -10,42 +10,33 @@
 // Cartesian trilinear grids), and every pixel goes through them (RenderOptions::simd does not apply);
 // any other scene is an error naming render.profile, never a silent fallback to the reference.
 //
-// FloatCopies holds what the float kernels read and the scene does not already hold as 32-bit
-// values: the transfer-function rows (always), the voxels when they are f64 (procedural fields,
-// f64 files), and the cached gradient components.
+// The float lanes read the view's `_float` members (VolumeView.h): the transfer-function rows (always
+// copies), the voxels (the volume's own storage where it is a 32-bit-gathered type, else a copy: procedural
+// fields, f64 files) and the cached gradient components, the copies held by VolumeViewStore.
 #pragma once
 #include <string>
-#include <vector>
 
-#include "core/grid/Volume.h"
-#include "core/integrate/packet/PacketComposite.h"
-#include "transfer/PreIntegration.h"
+#include "core/integrate/march/Accumulators.h"
+#include "core/sample/VolumeView.h"
 
 namespace volref {
 
-struct FloatCopies {
-    std::vector<float> voxels;                      // empty when the volume's own storage serves
-    std::vector<float> color_x, color_y, opacity_x, opacity_y, gradient_opacity_x, gradient_opacity_y;
-    std::vector<float> cached_gradient[3];
-    PreIntegrationTable preintegration;  // render.profile_options.preintegration
-};
+// Fills view.grid_float (and, for the composite, view.rows_float and the float cached gradients) from the
+// view's double members, the copies in `store` (memory checked). The voxels: the volume's own storage
+// when it is a 32-bit-gathered type (f32, i32, u32, u16, i16, u8, i8) within 2^31 bytes on a
+// little-endian host, else a float copy. Throws Error naming render.profile when even the copy would not
+// fit 32-bit indices or a voxel is beyond float's range.
+void describe_float_lanes(VolumeView& view, bool composite, VolumeViewStore& store);
 
-// The voxels the float kernels gather: the volume's own storage when it is a 32-bit-gathered type
-// (f32, i32, u32, u16, i16, u8, i8) within 2^31 bytes on a little-endian host, else a float copy in
-// `copies` (memory checked). Sets *data and *type. Throws Error naming render.profile when even the
-// copy would not fit 32-bit indices.
-void fast_voxels(const Volume& volume, FloatCopies& copies, const void** data, ScalarType* type);
-
-// Fills in.tables_float (and the float voxels and cached gradients) from the double inputs; sets
-// in.fast and the transmittance cutoff of in.termination. `cached` are the cached gradient components (Cached) or null.
-void make_fast(PacketCompositeInputs& in, const Volume& volume, const Volume* const cached[3], FloatCopies& copies);
+// The fast profile's termination: `t` and a stop once the transmittance is at most kFastTransmittanceCutoff.
+Termination fast_termination(Termination t);
 
 // Pre-integrated segments (render.profile_options.preintegration = n > 0; transfer/PreIntegration.h):
 // builds the table over the coordinates the volume's values can take and the transfer function's rows,
-// for segments of the render's step, into `copies`, and points `in` at it. Refuses (an error naming
+// for segments of `step`, into `store`, and points the view at it. Refuses (an error naming
 // render.profile_options.preintegration) a shaded scene or gradient-magnitude opacity: the table
 // integrates a(x) and c(x) of the value alone.
-void make_preintegrated(PacketCompositeInputs& in, const TransferFunction& tf, const Volume& volume, int n, FloatCopies& copies);
+void make_preintegrated(VolumeView& view, double step, int n, VolumeViewStore& store);
 
 // "render.profile: \"fast\" ...: <reason>; use \"reference\"" (the one-line error of a scene the
 // fast path does not take).

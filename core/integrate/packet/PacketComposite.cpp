@@ -166,21 +166,21 @@ template <typename T>
 struct PacketGradient {
     using D = DT<T>;
     using V = VT<T>;
-    const PacketCompositeInputs& in;
+    const VolumeView& in;
     const PacketTrilinearT<T>& f;
     const PacketTrilinearT<T>* cached[3];
     const double* shift;  // the fast profile's local coordinates: the domain relative to this; else null
 
     HWY_INLINE void operator()(const V X[3], V fx, V g[3]) const {
         const D d;
-        if (in.gradient == PacketCompositeInputs::Gradient::Cached) {
+        if (in.gradient == VolumeView::Gradient::Cached) {
             for (int a = 0; a < 3; ++a) g[a] = (*cached[a])(X[0], X[1], X[2]);
             return;
         }
         // GradientField's differences: the same template (GradientDifference-inl.h) on lanes.
         auto field = [&](const V P[3]) HWY_ATTR { return f(P[0], P[1], P[2]); };
         auto at_x = [&]() HWY_ATTR { return fx; };
-        const bool central = in.gradient == PacketCompositeInputs::Gradient::Central;
+        const bool central = in.gradient == VolumeView::Gradient::Central;
         for (int a = 0; a < 3; ++a) {
             g[a] = hn::Zero(d);
             if (f.flat[a]) continue;
@@ -193,7 +193,7 @@ struct PacketGradient {
 };
 
 // The packet's shading coefficients as the shading template reads them (built once per packet).
-HWY_INLINE ShadingConstants shading_constants(const PacketCompositeInputs& in) {
+HWY_INLINE ShadingConstants shading_constants(const VolumeView& in) {
     ShadingConstants k;
     k.ka = in.ka;
     k.kd = in.kd;
@@ -209,12 +209,12 @@ HWY_INLINE ShadingConstants shading_constants(const PacketCompositeInputs& in) {
 // Shader::shade for a packet (the same template, transfer/Shading-inl.h): m = the material colour,
 // g = grad f, view = -direction, depth = t.
 template <typename T>
-HWY_INLINE void shade(const PacketCompositeInputs& in, const ShadingConstants& k, VT<T> m[3], const VT<T> g[3],
+HWY_INLINE void shade(const VolumeView& in, const ShadingConstants& k, VT<T> m[3], const VT<T> g[3],
                       const VT<T> view[3], VT<T> depth) {
     using L = SimdLanes<T>;
     using V = VT<T>;
     auto light_at = [&](int i, V* Ld, double* I) HWY_ATTR {
-        const PacketCompositeInputs::Light& light = in.lights[i];
+        const VolumeView::Light& light = in.lights[i];
         for (int c = 0; c < 3; ++c) {
             Ld[c] = light.headlight ? view[c] : L::splat(light.direction[c]);
             I[c] = light.color[c];
@@ -229,7 +229,7 @@ HWY_INLINE void shade(const PacketCompositeInputs& in, const ShadingConstants& k
 // The transfer function's coordinate of the values v: (v - lo) / width on a normalised domain, else v
 // (TransferFunction::coordinate).
 template <typename T>
-HWY_INLINE VT<T> transfer_coordinate(const PacketCompositeInputs& in, VT<T> v) {
+HWY_INLINE VT<T> transfer_coordinate(const VolumeView& in, VT<T> v) {
     const DT<T> d;
     return in.normalized ? hn::Mul(hn::Sub(v, hn::Set(d, T(in.lo))), hn::Set(d, T(in.inv_width))) : v;
 }
@@ -246,7 +246,7 @@ struct PreSample {
 };
 
 template <typename T, class Trilinear>
-HWY_INLINE PreSample<T> pre_sample(const PacketCompositeInputs& in, const Trilinear& trilinear, VT<T> Ox, VT<T> Oy, VT<T> Oz,
+HWY_INLINE PreSample<T> pre_sample(const VolumeView& in, const Trilinear& trilinear, VT<T> Ox, VT<T> Oy, VT<T> Oz,
                                    VT<T> Dx, VT<T> Dy, VT<T> Dz, VT<T> t, VT<T> seg, hn::Mask<DT<T>> alive, VT<T>& prev_end,
                                    VT<T>& prev_value) {
     using D = DT<T>;
@@ -293,8 +293,10 @@ HWY_INLINE PreSample<T> pre_sample(const PacketCompositeInputs& in, const Trilin
 template <typename T>
 struct CompositeShared {
     static constexpr bool kFast = std::is_same_v<T, float>;
-    const PacketCompositeInputs& in;
-    const PacketTables<T>& tab;
+    const VolumeView& in;
+    const PacketRun& run;
+    const TransferRows<T>& tab;
+    const GridView& grid;  // the lanes' voxels (VolumeView::grid_of)
     // Float lanes work in coordinates local to the volume (RayPacketT): positions relative to its origin.
     const double* local;
     double zero_origin[3] = {0.0, 0.0, 0.0};
@@ -311,13 +313,15 @@ struct CompositeShared {
     // float once (conventions section 9b: no division per step); d / l itself on double lanes.
     const T segment_scale, unit_distance;
 
-    explicit CompositeShared(const PacketCompositeInputs& inputs)
+    CompositeShared(const VolumeView& inputs, const PacketRun& settings)
         : in(inputs),
-          tab(inputs.tables<T>()),
-          local(kFast ? inputs.grid.origin : nullptr),
-          origin(kFast ? zero_origin : inputs.grid.origin),
+          run(settings),
+          tab(inputs.rows_of<T>()),
+          grid(inputs.grid_of<T>()),
+          local(kFast ? grid.origin : nullptr),
+          origin(kFast ? zero_origin : grid.origin),
           pre(kFast && inputs.preintegration != nullptr),
-          trilinear(inputs.grid.voxels, inputs.grid.voxel_type, inputs.grid.dims, origin, inputs.grid.inv_spacing),
+          trilinear(grid.voxels, grid.voxel_type, grid.dims, origin, grid.inv_spacing),
           gradient{inputs, trilinear, {&component[0], &component[1], &component[2]}, local},
           shading(shading_constants(inputs)),
           opacity_reg(DT<T>(), tab.opacity_x, tab.opacity_y, inputs.opacity_rows, 1),
@@ -325,21 +329,23 @@ struct CompositeShared {
           gradient_reg(DT<T>(), tab.gradient_opacity_x, tab.gradient_opacity_y, inputs.gradient_opacity_rows, 1),
           segment_scale(kFast ? T(1.0 / inputs.unit_distance) : T(1)),
           unit_distance(kFast ? T(1) : T(inputs.unit_distance)) {
-        if (in.skip_radius) {
+        if (skips()) {
             vskip.radius = in.skip_radius;
             for (int a = 0; a < 3; ++a) {
-                vskip.counts[a] = in.macrocells->counts()[a];
-                vskip.dims[a] = in.grid.dims[a];
+                vskip.counts[a] = run.macrocells->counts()[a];
+                vskip.dims[a] = grid.dims[a];
                 vskip.origin[a] = origin[a];
-                vskip.inv_spacing[a] = in.grid.inv_spacing[a];
+                vskip.inv_spacing[a] = grid.inv_spacing[a];
             }
-            vskip.end_margin = pre ? 0.5 * in.step : 0.0;
+            vskip.end_margin = pre ? 0.5 * run.step : 0.0;
         }
-        if (in.gradient == PacketCompositeInputs::Gradient::Cached)
+        if (in.gradient == VolumeView::Gradient::Cached)
             for (int a = 0; a < 3; ++a)
-                component[a] = PacketTrilinearT<T>(tab.cached_gradient[a], kFast ? ScalarType::F32 : ScalarType::F64, in.grid.dims,
-                                                   origin, in.grid.inv_spacing);
+                component[a] = PacketTrilinearT<T>(tab.cached_gradient[a], kFast ? ScalarType::F32 : ScalarType::F64, grid.dims,
+                                                   origin, grid.inv_spacing);
     }
+    // Skipping decided on the lanes: the run's macrocells with the view's radii.
+    bool skips() const { return run.macrocells && in.skip_radius; }
     CompositeShared(const CompositeShared&) = delete;
     CompositeShared& operator=(const CompositeShared&) = delete;
 };
@@ -373,8 +379,8 @@ public:
                    int count, const RaySpan* spans, RayState* states)
         : s_(shared),
           in_(shared.in),
-          packet_(rays, intervals, count, shared.in.step, shared.in.macrocells, nullptr, true, shared.local, spans,
-                  shared.in.skip_radius ? &shared.vskip : nullptr),
+          packet_(rays, intervals, count, shared.run.step, shared.run.macrocells, nullptr, true, shared.local, spans,
+                  shared.skips() ? &shared.vskip : nullptr),
           out_(out),
           count_(count),
           states_(states) {
@@ -425,7 +431,7 @@ public:
                 if (hn::AllFalse(d, p.visible)) continue;
                 const V alpha = segment_alpha<SL>(p.tau);
                 acc_.add(p.visible, hn::FirstN(d, 0), p.tau, alpha, p.colour);  // never solid: a < 1
-                retire(acc_.stops(p.visible, in_.termination));
+                retire(acc_.stops(p.visible, s_.run.termination));
             }
         }
     }
@@ -443,7 +449,7 @@ public:
         const bool have_next = fetch(steps_[current_ ^ 1]);
         const M alive = hn::AndNot(done_, cur.alive);
         const V v = cur.v, t = cur.t;
-        const PacketTables<T>& tab = s_.tab;
+        const TransferRows<T>& tab = s_.tab;
         // Transfer function.
         const V x = transfer_coordinate<T>(in_, v);
         const TableLookup<T> ot = locate_rows(d, tab.opacity_x, in_.opacity_rows, x, s_.opacity_reg);
@@ -472,7 +478,7 @@ public:
                 shade<T>(in_, s_.shading, m, g, view_, kFast ? hn::Add(t, t_ref_) : t);  // depth: the world t
             }
             acc_.add(o.visible, o.solid, o.tau, o.alpha, m);
-            retire(hn::Or(o.solid, acc_.stops(o.partial, in_.termination)));
+            retire(hn::Or(o.solid, acc_.stops(o.partial, s_.run.termination)));
         }
         current_ ^= 1;  // the step fetched ahead is the current one
         have_ = have_next;
@@ -545,7 +551,7 @@ private:
     }
 
     const CompositeShared<T>& s_;
-    const PacketCompositeInputs& in_;
+    const VolumeView& in_;
     RayPacketT<T> packet_;
     PixelValue* out_;
     int count_;
@@ -572,20 +578,20 @@ private:
 // Measured (the variants: docs/performance.md, "What did not help"): 2-5% on the fast
 // profile's frame, nothing on the reference's (double lanes, which do not take it), nothing more from
 // the second sample as well.
-HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+HWY_INLINE void prefetch_first_samples(const GridView& grid, double step, const Ray* rays, const std::vector<Interval>* intervals,
                                        int count) {
-    const auto* voxels = static_cast<const unsigned char*>(in.grid.voxels);
+    const auto* voxels = static_cast<const unsigned char*>(grid.voxels);
     if (!voxels) return;
-    const std::int64_t bytes = std::int64_t(scalar_type_size(in.grid.voxel_type));
-    const std::int64_t stride[3] = {bytes, bytes * in.grid.dims[0], bytes * in.grid.dims[0] * in.grid.dims[1]};
+    const std::int64_t bytes = std::int64_t(scalar_type_size(grid.voxel_type));
+    const std::int64_t stride[3] = {bytes, bytes * grid.dims[0], bytes * grid.dims[0] * grid.dims[1]};
     for (int i = 0; i < count; ++i) {
         if (intervals[i].empty()) continue;
         const Interval& iv = intervals[i].front();
-        const double t = 0.5 * (iv.t0 + std::min(iv.t0 + in.step, iv.t1));
+        const double t = 0.5 * (iv.t0 + std::min(iv.t0 + step, iv.t1));
         std::int64_t offset = 0;
         for (int a = 0; a < 3; ++a) {
-            const double u = (rays[i].origin[a] + t * rays[i].direction[a] - in.grid.origin[a]) * in.grid.inv_spacing[a];
-            const double top = double(std::max<std::int64_t>(in.grid.dims[a] - 2, 0));
+            const double u = (rays[i].origin[a] + t * rays[i].direction[a] - grid.origin[a]) * grid.inv_spacing[a];
+            const double top = double(std::max<std::int64_t>(grid.dims[a] - 2, 0));
             offset += std::int64_t(u > 0.0 ? std::min(u, top) : 0.0) * stride[a];  // (NaN: 0)
         }
         const unsigned char* q = voxels + offset;
@@ -606,10 +612,10 @@ HWY_INLINE void prefetch_first_samples(const PacketCompositeInputs& in, const Ra
 template <typename T>
 constexpr int kInFlight = std::is_same_v<T, float> ? 2 : 1;
 template <typename T>
-void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void composite_all(const VolumeView& in, const PacketRun& run, const Ray* rays, const std::vector<Interval>* intervals,
                    PixelValue* out, int count, const RaySpan* spans, RayState* states) {
     const int L = int(hn::Lanes(DT<T>()));
-    const CompositeShared<T> shared(in);
+    const CompositeShared<T> shared(in, run);
     const int packets = (count + L - 1) / L;
     auto make = [&](std::optional<CompositeLanes<T>>& slot, int p) HWY_ATTR {
         const int first = p * L;
@@ -625,7 +631,7 @@ void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::
         }
         return;
     }
-    if (std::is_same_v<T, float> && !spans) prefetch_first_samples(in, rays, intervals, count);
+    if (std::is_same_v<T, float> && !spans) prefetch_first_samples(shared.grid, run.step, rays, intervals, count);
     std::optional<CompositeLanes<T>> slot[kInFlight<T>];
     int next = 0;
     for (auto& s : slot)
@@ -644,12 +650,12 @@ void composite_all(const PacketCompositeInputs& in, const Ray* rays, const std::
             }
 }
 
-void CompositePacket(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void CompositePacket(const VolumeView& in, const PacketRun& run, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count, const RaySpan* spans, RayState* states) {
-    if (in.fast)
-        composite_all<float>(in, rays, intervals, out, count, spans, states);
+    if (run.fast)
+        composite_all<float>(in, run, rays, intervals, out, count, spans, states);
     else
-        composite_all<double>(in, rays, intervals, out, count, spans, states);
+        composite_all<double>(in, run, rays, intervals, out, count, spans, states);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -660,9 +666,9 @@ HWY_AFTER_NAMESPACE();
 namespace volref {
 HWY_EXPORT(CompositePacket);
 
-void composite_packet(const PacketCompositeInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void composite_packet(const VolumeView& in, const PacketRun& run, const Ray* rays, const std::vector<Interval>* intervals,
                       PixelValue* out, int count, const RaySpan* spans, RayState* states) {
-    HWY_DYNAMIC_DISPATCH(CompositePacket)(in, rays, intervals, out, count, spans, states);
+    HWY_DYNAMIC_DISPATCH(CompositePacket)(in, run, rays, intervals, out, count, spans, states);
 }
 }  // namespace volref
 #endif

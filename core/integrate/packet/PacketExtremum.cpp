@@ -17,7 +17,7 @@ namespace {
 using namespace packet;
 
 template <typename T>
-void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void extremum_lanes(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count, const RaySpan* spans) {
     using D = hn::ScalableTag<T>;
     using V = hn::Vec<D>;
@@ -32,20 +32,21 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
     // origin, t relative to each lane's first entry (added back to the extremum's t below).
     constexpr bool kFast = std::is_same_v<T, float>;
     const double zero_origin[3] = {0.0, 0.0, 0.0};
-    const double* origin = kFast ? zero_origin : in.grid.origin;
-    RayPacketT<T> packet(rays, intervals, count, in.step, in.macrocells, in.macrocells ? extremum : nullptr, in.maximum,
-                         kFast ? in.grid.origin : nullptr, spans);
+    const GridView& grid = view.grid_of<T>();
+    const double* origin = kFast ? zero_origin : grid.origin;
+    RayPacketT<T> packet(rays, intervals, count, run.step, run.macrocells, run.macrocells ? extremum : nullptr, maximum,
+                         kFast ? grid.origin : nullptr, spans);
     const V Ox = hn::Load(d, packet.ox), Oy = hn::Load(d, packet.oy), Oz = hn::Load(d, packet.oz);
     const V Dx = hn::Load(d, packet.dx), Dy = hn::Load(d, packet.dy), Dz = hn::Load(d, packet.dz);
-    const PacketTrilinearT<T> trilinear(in.grid.voxels, in.grid.voxel_type, in.grid.dims, origin, in.grid.inv_spacing);
+    const PacketTrilinearT<T> trilinear(grid.voxels, grid.voxel_type, grid.dims, origin, grid.inv_spacing);
     const V nan = hn::Set(d, std::numeric_limits<T>::quiet_NaN());
-    Extremum<SimdLanes<T>> acc(in.maximum);
+    Extremum<SimdLanes<T>> acc(maximum);
     while (packet.next()) {
         const V t = hn::Load(d, packet.tm);
         const M alive = hn::Gt(hn::Load(d, packet.live), hn::Zero(d));
         const V v = trilinear(hn::Add(Ox, hn::Mul(t, Dx)), hn::Add(Oy, hn::Mul(t, Dy)), hn::Add(Oz, hn::Mul(t, Dz)));
         acc.add(alive, v, t);
-        if (in.macrocells) {
+        if (run.macrocells) {
             hn::Store(hn::IfThenElse(acc.any(), acc.value(), nan), d, lane_best);
             for (std::size_t l = 0; l < kLanes; ++l) extremum[l] = double(lane_best[l]);
         }
@@ -58,22 +59,22 @@ void extremum_lanes(const PacketExtremumInputs& in, const Ray* rays, const std::
 }
 
 template <typename T>
-void extremum_all(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void extremum_all(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                   RayExtremum* out, int count, const RaySpan* spans) {
     const int L = int(hn::Lanes(hn::ScalableTag<T>()));
     for (int first = 0; first < count; first += L)
-        extremum_lanes<T>(in, rays + first, intervals + first, out + first, std::min(L, count - first),
+        extremum_lanes<T>(view, run, maximum, rays + first, intervals + first, out + first, std::min(L, count - first),
                           spans ? spans + first : nullptr);
 }
 
 }  // namespace
 
-void ExtremumPacket(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void ExtremumPacket(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count, const RaySpan* spans) {
-    if (in.fast)
-        extremum_all<float>(in, rays, intervals, out, count, spans);
+    if (run.fast)
+        extremum_all<float>(view, run, maximum, rays, intervals, out, count, spans);
     else
-        extremum_all<double>(in, rays, intervals, out, count, spans);
+        extremum_all<double>(view, run, maximum, rays, intervals, out, count, spans);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -84,9 +85,9 @@ HWY_AFTER_NAMESPACE();
 namespace volref {
 HWY_EXPORT(ExtremumPacket);
 
-void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+void extremum_packet(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                      RayExtremum* out, int count, const RaySpan* spans) {
-    HWY_DYNAMIC_DISPATCH(ExtremumPacket)(in, rays, intervals, out, count, spans);
+    HWY_DYNAMIC_DISPATCH(ExtremumPacket)(view, run, maximum, rays, intervals, out, count, spans);
 }
 }  // namespace volref
 #endif

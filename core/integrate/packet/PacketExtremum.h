@@ -10,23 +10,11 @@
 #include "core/camera/Ray.h"
 #include "core/grid/VoxelArray.h"
 #include "core/integrate/march/RaySpan.h"
-#include "core/integrate/packet/PacketGrid.h"
+#include "core/integrate/packet/PacketRun.h"
+#include "core/sample/VolumeView.h"
 #include "geometry/RayIntervals.h"
 
 namespace volref {
-
-class MacrocellGrid;
-
-struct PacketExtremumInputs {
-    PacketGrid grid;  // the volume's values, dims, origin and 1 / spacing (PacketGrid.h)
-    double step = 1.0;
-    bool maximum = true;
-    // Skipping (null: none): macrocells whose values cannot beat a ray's extremum so far are passed
-    // over (SegmentWalk.h, extremum mode); the result is bitwise the same.
-    const MacrocellGrid* macrocells = nullptr;
-    // The fast profile (FastProfile.h): float lanes; the voxels a 32-bit-gathered type.
-    bool fast = false;
-};
 
 struct RayExtremum {
     bool any = false;      // the ray had at least one sample
@@ -34,8 +22,12 @@ struct RayExtremum {
     double t = 0.0;        // the midpoint where it was first reached
 };
 
-// `spans` (march/RaySpan.h; null: the whole rays): each lane's extremum over the samples its span owns.
-void extremum_packet(const PacketExtremumInputs& in, const Ray* rays, const std::vector<Interval>* intervals,
+// The maximum (mip) or minimum (minip) of the volume `view` describes (VolumeView.h) along each ray, with
+// `run`'s step, skipping (null: none; macrocells whose values cannot beat a ray's extremum so far are
+// passed over, SegmentWalk.h's extremum mode: the result is bitwise the same) and lanes (the fast
+// profile's float lanes read the view's float voxels). `spans` (march/RaySpan.h; null: the whole rays):
+// each lane's extremum over the samples its span owns.
+void extremum_packet(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                      RayExtremum* out, int count, const RaySpan* spans = nullptr);
 
 }  // namespace volref

@@ -34,7 +34,7 @@ void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, con
     if (r.order != CompositeOrder::FrontToBack)
         throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
-    if (!pipeline.cartesian_sampler() && p.grids == Profile::Grids::Cartesian)
+    if (!pipeline.view().cartesian && p.grids == Profile::Grids::Cartesian)
         throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
     if (p.grids == Profile::Grids::CartesianAndShells && pipeline.shaded() && r.projection == Projection::Composite)
         throw Error(where + "does not shade (remove volume.shading)");
@@ -49,13 +49,13 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
     check_profile_applies(p_, ctx.pipeline, ctx.render);
     if (p_.renderer != Profile::Renderer::RayCaster)
         throw Error(std::string("render.profile: \"") + p_.name + "\" is an image-space renderer, not a ray integrator");
-    const VolumeSampler* cartesian = ctx.pipeline.cartesian_sampler();
+    const VolumeSampler* cartesian = ctx.pipeline.view().cartesian;
     const double inf = std::numeric_limits<double>::infinity();
     domain_lo_ = cartesian ? volume.domain_min() : glm::dvec3(-inf);  // shells: the intervals stay inside
     domain_hi_ = cartesian ? volume.domain_max() : glm::dvec3(inf);
     step_ = ctx.step;
     if (p_.seed_shell_reads && !cartesian) {
-        shell_ = ctx.pipeline.stages().shell_grid;
+        shell_ = ctx.pipeline.view().shell_grid;
         volume_ = &volume;
         if (!shell_) throw Error(std::string("render.profile: \"") + p_.name + "\" needs the shell's grid");
     }
@@ -81,7 +81,7 @@ ProfileIntegrator::ProfileIntegrator(const IntegrationContext& ctx, const Profil
                 throw Error(key + ": the texture unit filters trilinearly (volume.interpolation \"trilinear\", one Cartesian grid)");
         }
         if (band_ && p_.table_entries <= 1) {
-            transfer_ = ctx.pipeline.stages().transfer_function;
+            transfer_ = ctx.pipeline.view().transfer_function;
             if (!transfer_) throw Error(key + ": the band needs a transfer function (volume.transfer)");
         }
     }

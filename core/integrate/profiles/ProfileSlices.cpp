@@ -84,7 +84,7 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
     if (band_) throw Error("render.profile_options.texture_band: not derived for placement \"slices\" (framebuffer_band is its band)");
     if (texture_unit_ != ProfileOptions::TextureUnit::Exact)
         throw Error("render.profile.texture_unit: placement \"slices\" filters its texels exactly");
-    if (!ctx_.pipeline.cartesian_sampler() || !frame.camera) fail("placement", "\"slices\" needs a Cartesian grid (box or mesh bounds)");
+    if (!ctx_.pipeline.view().cartesian || !frame.camera) fail("placement", "\"slices\" needs a Cartesian grid (box or mesh bounds)");
     if (p_.texture_filter == Profile::TextureFilter::Fixed8) {
         if (p_.texel_format != Profile::TexelFormat::Unorm8) fail("texture_filter", "\"fixed8\" filters 8-bit texels (texture_format \"unorm8\")");
         if (p_.classify != Profile::SliceClassify::Post) fail("texture_filter", "\"fixed8\" filters the value texture (classify \"post\")");
@@ -101,7 +101,7 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
         window_width_ = p_.texture_window_given.y - p_.texture_window_given.x;
     } else if (p_.texture_window == Profile::TextureWindow::TransferRows) {
         double lo = 0.0, hi = 0.0;
-        if (const TransferFunction* tf = ctx_.pipeline.stages().transfer_function; tf && transfer_rows(*tf, lo, hi)) {
+        if (const TransferFunction* tf = ctx_.pipeline.view().transfer_function; tf && transfer_rows(*tf, lo, hi)) {
             window_lo_ = lo;
             window_width_ = hi - lo;
         }

@@ -52,7 +52,7 @@ VtkJsIntegrator::VtkJsIntegrator(const IntegrationContext& ctx, const Volume& vo
     const Projection proj = ctx.render.projection;
     if (!is_composite(proj) && !is_extremum(proj))
         throw Error(kWhere + "mirrors the composite, mip and minip projections only");
-    if (!ctx.pipeline.cartesian_sampler()) throw Error(kWhere + "needs a Cartesian grid");
+    if (!ctx.pipeline.view().cartesian) throw Error(kWhere + "needs a Cartesian grid");
     if (spec.bounds.type != BoundsSpec::Type::Box || spec.bounds.min || spec.bounds.max || spec.crop ||
         !spec.clip_planes.empty())
         throw Error(kWhere + "casts rays through the whole texel box (remove volume.bounds, crop and clip_planes)");

@@ -17,26 +17,67 @@ namespace {
 
 using namespace segment_walk;
 
-// The composite sample at segment s's midpoint. With Rec::kOn the same computation also fills the
-// stages of record r and starts it (the transmittance in front of the sample: the accumulator's).
-template <class Rec, class Record, class Acc>
-PipelineSample composite_sample(const SamplePipeline& pipeline, const Ray& ray, const Segment& s, Rec& rec, Record& r,
-                                const Acc& acc) {
-    if constexpr (Rec::kOn) {
-        rec.begin(r, s.t0, s.t1);
-        r.composited = true;
-        r.transmittance_before = acc.transmittance();
-        return pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
-    } else {
-        return pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+// The scalar stages' composite sample at segment s's midpoint, as composite_step (Accumulators-inl.h)
+// reads it: opacity() is the whole pipeline sample (value, classification, shading where the opacity is
+// positive, the non-finite rule: SamplePipeline.h), colour() its colour. With Rec::kOn the same
+// computation also fills the stages of record r and starts it (the transmittance in front of the
+// sample: the accumulator's).
+template <class Rec, class Acc>
+struct PipelineCompositeSample {
+    const SamplePipeline& pipeline;
+    const Ray& ray;
+    const Segment& s;
+    Rec& rec;
+    std::conditional_t<Rec::kOn, SampleRecord, char>& r;
+    const Acc& acc;
+    PipelineSample p;
+    double opacity() {
+        if constexpr (Rec::kOn) {
+            rec.begin(r, s.t0, s.t1);
+            r.composited = true;
+            r.transmittance_before = acc.transmittance();
+            p = pipeline.sample_detailed(ray, s.midpoint(), SamplePipeline::Use::Composite, r.sample);
+        } else {
+            p = pipeline.sample(ray, s.midpoint(), SamplePipeline::Use::Composite);
+        }
+        return p.opacity;
     }
-}
+    void colour(double c[3]) const {
+        c[0] = p.color.r;
+        c[1] = p.color.g;
+        c[2] = p.color.b;
+    }
+};
 
-// A composited sample's optical depth (infinite when opaque) and alpha, for its record.
-void record_opacity(SampleRecord& r, const SampleOpacity<Scalar>& o) {
-    r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
-    r.alpha = o.alpha;
-}
+// A trace's records of one composite step (composite_step's hooks): what the sample did to the
+// accumulator. Front to back, a transparent sample reports the partial alpha and an opaque one
+// transmittance 0; back to front, every sample reports the accumulator as it stands.
+template <class Rec, bool kFrontToBack>
+struct CompositeRecords {
+    Rec& rec;
+    std::conditional_t<Rec::kOn, SampleRecord, char>& r;
+    template <class Acc>
+    void transparent(const Acc& acc) {
+        if constexpr (Rec::kOn) {  // nothing changes
+            r.transmittance_after = acc.transmittance();
+            double a;
+            if constexpr (kFrontToBack) a = acc.partial_alpha();
+            else a = acc.alpha();
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), a);
+            rec.recorder.record(r);
+        }
+    }
+    template <class Acc>
+    void composited(const SampleOpacity<Scalar>& o, const Acc& acc) {
+        if constexpr (Rec::kOn) {
+            r.tau = o.solid ? std::numeric_limits<double>::infinity() : o.tau;
+            r.alpha = o.alpha;
+            r.transmittance_after = kFrontToBack && o.solid ? 0.0 : acc.transmittance();
+            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
+            rec.recorder.record(r);
+        }
+    }
+};
 
 }  // namespace
 
@@ -113,38 +154,19 @@ Termination early_termination(const RenderSpec& render) {
     return t;
 }
 
-// With Rec::kOn the loops below also fill one SampleRecord per visited segment; every statement of
-// the plain loop is unchanged (the records only read its state). The compositing is the
-// accumulators' (march/Accumulators.h).
+// The one step of both orders is composite_step's (march/Accumulators-inl.h); with Rec::kOn it also
+// fills one SampleRecord per visited segment (the records only read its state).
 template <class Rec>
 bool CompositeIntegrator::front_to_back(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                                         FrontToBack<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    const Termination& stop = termination_;
     bool stopped = false;
     march(intervals, {.step = ctx_.step, .span = span, .skip = ctx_.macrocells, .ray = &ray}, [&](const MarchSample& m) {
-        const Segment& s = m.s;
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
-        const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
-        if (!(p.opacity > 0.0)) {
-            if constexpr (Rec::kOn) {  // nothing changes
-                r.transmittance_after = acc.transmittance();
-                r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.partial_alpha());
-                rec.recorder.record(r);
-            }
-            return true;
-        }
-        const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
-        const double c[3] = {p.color.r, p.color.g, p.color.b};
-        acc.add(true, o.solid, o.tau, o.alpha, c);
-        if constexpr (Rec::kOn) {
-            record_opacity(r, o);
-            r.transmittance_after = o.solid ? 0.0 : acc.transmittance();
-            r.accumulated = glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha());
-            rec.recorder.record(r);
-        }
-        stopped = o.solid || acc.stops(o.partial, stop);  // opaque: nothing behind is visible
-        return !stopped;
+        PipelineCompositeSample<Rec, FrontToBack<Scalar>> sample{ctx_.pipeline, ray, m.s, rec, r, acc, {}};
+        CompositeRecords<Rec, true> records{rec, r};
+        stopped = composite_step<Scalar>(acc, sample, true, m.s.length(), l, &termination_, records);
+        return !stopped;  // opaque or terminated: nothing behind is visible
     });
     return stopped;
 }
@@ -153,23 +175,12 @@ template <class Rec>
 void CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                                         BackToFront<Scalar>& acc, Rec& rec) const {
     const double l = ctx_.pipeline.classifier().unit_distance();
-    [[maybe_unused]] auto accumulated = [&] { return glm::dvec4(acc.color(0), acc.color(1), acc.color(2), acc.alpha()); };
     const MarchOptions o{.step = ctx_.step, .span = span, .order = MarchOrder::BackToFront, .skip = ctx_.macrocells, .ray = &ray};
     march(intervals, o, [&](const MarchSample& m) {
-        const Segment& s = m.s;
         [[maybe_unused]] std::conditional_t<Rec::kOn, SampleRecord, char> r{};
-        const PipelineSample p = composite_sample(ctx_.pipeline, ray, s, rec, r, acc);
-        if (p.opacity > 0.0) {
-            const SampleOpacity<Scalar> o = sample_opacity<Scalar>(true, p.opacity, s.length(), l);
-            const double c[3] = {p.color.r, p.color.g, p.color.b};
-            acc.add(true, o.solid, o.tau, o.alpha, c);
-            if constexpr (Rec::kOn) record_opacity(r, o);
-        }
-        if constexpr (Rec::kOn) {
-            r.transmittance_after = acc.transmittance();
-            r.accumulated = accumulated();
-            rec.recorder.record(r);
-        }
+        PipelineCompositeSample<Rec, BackToFront<Scalar>> sample{ctx_.pipeline, ray, m.s, rec, r, acc, {}};
+        CompositeRecords<Rec, false> records{rec, r};
+        composite_step<Scalar>(acc, sample, true, m.s.length(), l, nullptr, records);
         return true;
     });
 }

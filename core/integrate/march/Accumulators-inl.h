@@ -212,3 +212,41 @@ private:
     V best_ = L::splat(0.0), t_best_ = L::splat(0.0);
     M seen_ = L::no_lanes();
 };
+
+// The hooks of a composite step that reports nothing (the render); a trace's hooks fill its records.
+struct NoCompositeHooks {
+    template <class Acc>
+    void transparent(const Acc&) const {}
+    template <class O, class Acc>
+    void composited(const O&, const Acc&) const {}
+};
+
+// One sample of emission-absorption compositing on the lanes `alive`: the one sequence every
+// reference composite path takes once its sample's value is fetched, on any lanes and either order.
+//   classify    a = sample.opacity()            the transfer function's opacity per unit distance l
+//   correct     sample_opacity(alive, a, d, l)  visible, solid, tau, alpha for the length d
+//   shade       sample.colour(c)                the colour (shaded where the scene shades), taken only
+//                                               when some live lane is visible
+//   accumulate  acc.add(visible, solid, tau, alpha, c)
+//   retire      the lanes that became opaque or reached `stop` (front to back; `stop` null: none)
+// `on` observes the step: on.transparent(acc) when no live lane is visible (nothing changes),
+// on.composited(o, acc) after accumulating. Returns the lanes to retire.
+template <class L, class Acc, class Sample, class Hooks>
+inline typename L::M composite_step(Acc& acc, Sample& sample, typename L::M alive, typename L::V d, typename L::V l,
+                                    const ::volref::Termination* stop, Hooks& on) {
+    using V = typename L::V;
+    const V a = sample.opacity();
+    if (L::none(L::and_(alive, L::gt(a, L::splat(0.0))))) {
+        on.transparent(acc);
+        return L::no_lanes();
+    }
+    const SampleOpacity<L> o = sample_opacity<L>(alive, a, d, l);
+    V c[3];
+    sample.colour(c);
+    acc.add(o.visible, o.solid, o.tau, o.alpha, c);
+    on.composited(o, acc);
+    if constexpr (requires { acc.stops(o.partial, *stop); }) {
+        if (stop) return L::or_(o.solid, acc.stops(o.partial, *stop));
+    }
+    return L::no_lanes();
+}

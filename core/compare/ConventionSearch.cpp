@@ -10,7 +10,9 @@
 #include "core/film/Background.h"
 #include "core/integrate/profiles/Profile.h"
 #include "core/render/Renderer.h"
+#include "core/scene/ProfileRuleTable.h"
 #include "core/scene/SceneLoader.h"
+#include "core/scene/SceneNames.h"
 #include "core/scene/SceneWriter.h"
 
 namespace volref::compare {
@@ -31,10 +33,20 @@ double srgb_encode(double x) {
     return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
 }
 
+// Whether `key` is counted and described as part of another rule (ProfileRule::Search::joined:
+// placement "from-entry" and its first sample are one rule).
+bool joined_to_another(const std::string& key) {
+    for (const ProfileRule& rule : profile_rule_table())
+        for (std::string_view j : rule.search.joined)
+            if (j == key) return true;
+    return false;
+}
+
 // The number of rules a candidate changes, counting a non-identity image model as one.
 int rule_count(const SearchCandidate& c) {
     int n = int(c.rules.size());
-    if (c.rules.contains("first")) --n;  // placement "from-entry" and its first sample are one rule
+    for (auto it = c.rules.begin(); it != c.rules.end(); ++it)
+        if (joined_to_another(it.key())) --n;
     return n + (c.image_model == "identity" ? 0 : 1);
 }
 
@@ -116,8 +128,23 @@ bool ranks_before(const SearchCandidate& a, const SearchCandidate& b, long allow
     return rule_count(a) < rule_count(b);
 }
 
-// The rule a candidate object changes ("placement" for {"placement", "first"}).
-std::string dimension(const json& rules) { return rules.contains("placement") ? "placement" : rules.begin().key(); }
+// The rule a candidate object changes: its first key in the rule table's order ("placement" for
+// {"placement", "first"}; "slices.orientation" for itself).
+std::string dimension(const json& rules) {
+    for (const ProfileRule& rule : profile_rule_table())
+        for (auto it = rules.begin(); it != rules.end(); ++it)
+            if (it.key() == rule.key || it.key().rfind(std::string(rule.key) + ".", 0) == 0) return it.key();
+    return rules.begin().key();
+}
+
+// The table's rules the search tries, in its order (ProfileRule::Search::rank).
+std::vector<const ProfileRule*> searched_rules() {
+    std::vector<const ProfileRule*> rules;
+    for (const ProfileRule& rule : profile_rule_table())
+        if (rule.search.dimensions) rules.push_back(&rule);
+    std::sort(rules.begin(), rules.end(), [](const ProfileRule* a, const ProfileRule* b) { return a->search.rank < b->search.rank; });
+    return rules;
+}
 
 }  // namespace
 
@@ -127,10 +154,17 @@ std::string SearchCandidate::describe() const {
         if (!s.empty()) s += ", ";
         s += key + " " + (value.is_string() ? value.get<std::string>() : value.is_number() ? number_text(value.get<double>()) : value.dump());
     };
-    if (rules.contains("placement")) add("placement", rules["placement"]);  // then its first sample
-    if (rules.contains("first")) add("first", rules["first"]);
+    // A rule with joined keys first, then those keys (placement, then its first sample), then the others.
+    std::vector<std::string> done;
+    for (const ProfileRule& rule : profile_rule_table()) {
+        if (rule.search.joined.empty()) continue;
+        done.emplace_back(rule.key);
+        for (std::string_view k : rule.search.joined) done.emplace_back(k);
+    }
+    for (const std::string& k : done)
+        if (rules.contains(k)) add(k, rules[k]);
     for (auto it = rules.begin(); it != rules.end(); ++it)
-        if (it.key() != "placement" && it.key() != "first") add(it.key(), it.value());
+        if (std::find(done.begin(), done.end(), it.key()) == done.end()) add(it.key(), it.value());
     if (image_model != "identity") s += (s.empty() ? "" : " with ") + std::string("image model ") + image_model;
     return s.empty() ? "the scene's own profile" : s;
 }
@@ -191,60 +225,14 @@ std::vector<double> apply_image_model(const std::string& model, const Image& r) 
 
 std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
     const RenderSpec& r = scene.render;
-    const bool composite = is_composite(r.projection);
-    const bool shaded = composite && scene.volume().shading.has_value();
-    const bool box = scene.volume().bounds.type == BoundsSpec::Type::Box && !scene.volume().bounds.min && !scene.volume().bounds.max;
+    // A slicer (placement "slices") tries its surfaces, fragments and frame buffer; a ray caster the
+    // rules its scene reads.
+    const bool slicer = !r.reference_integrators() && r.profile != ProfileId::Fast &&
+                        resolve_profile(r).placement == Profile::Placement::Slices;
     std::vector<std::vector<json>> d;
-    // A slicer (placement "slices"): its surfaces, fragments and frame buffer; the rules of
-    // "slices" are tried one key at a time ("slices.KEY", merged into the object by with_rules).
-    if (!r.reference_integrators() && r.profile != ProfileId::Fast &&
-        resolve_profile(r).placement == Profile::Placement::Slices) {
-        const bool perspective = scene.camera.type != CameraSpec::Type::Orthographic;
-        std::vector<json> orientation{{{"slices.orientation", "viewport"}}, {{"slices.orientation", "axis"}}};
-        if (perspective) orientation.push_back({{"slices.orientation", "spherical"}});
-        d.push_back(orientation);
-        if (scene.camera.near) d.push_back({{{"slices.range", "object"}}, {{"slices.range", "view_volume"}}});
-        d.push_back({{{"slices.first", "bound"}}, {{"slices.first", "half"}}});
-        d.push_back({{{"slices.spacing", r.step / 2.0}}, {{"slices.spacing", r.step}}, {{"slices.spacing", 2.0 * r.step}},
-                     {{"slices.count", 128}}, {{"slices.count", 256}}});
-        d.push_back({{{"framebuffer", "rgba8"}}, {{"framebuffer", "rgba16f"}}, {{"framebuffer", "rgba32f"}}, {{"framebuffer", "double"}}});
-        d.push_back({{{"correction", "none"}}, {{"correction", "exact"}}});
-        d.push_back({{{"framebuffer_rounding", "nearest"}}, {{"framebuffer_rounding", "truncate"}}});
-        d.push_back({{{"blend_products", "exact"}}, {{"blend_products", "rounded"}}});
-        d.push_back({{{"blend_alpha", "src-alpha"}}, {{"blend_alpha", "one"}}});
-        d.push_back({{{"table_lookup", "nearest"}}, {{"table_lookup", "linear"}}, {{"table_lookup", "texture"}}});
-        d.push_back({{{"texture_format", "unorm8"}}, {{"texture_format", "unorm16"}}, {{"texture_format", "float"}}});
-        d.push_back({{{"table_format", "unorm8"}}, {{"table_format", "float"}}});
-        d.push_back({{{"classify", "post"}}, {{"classify", "pre-unweighted"}}});
-        d.push_back({{{"texture", "3d"}}, {{"texture", "2d"}}});
-        return d;
-    }
-    // (from-entry with each step count: step_count alone cannot be set over midpoints)
-    d.push_back({{{"placement", "midpoints"}},
-                 {{"placement", "from-entry"}, {"first", 0.0}},
-                 {{"placement", "from-entry"}, {"first", 0.5}},
-                 {{"placement", "from-entry"}, {"first", 1.0}},
-                 {{"placement", "from-entry"}, {"first", 0.0}, {"step_count", "before-exit"}},
-                 {{"placement", "from-entry"}, {"first", 0.5}, {"step_count", "before-exit"}},
-                 {{"placement", "from-entry"}, {"first", 1.0}, {"step_count", "before-exit"}}});
-    d.push_back({{{"step_count", "through-exit"}}, {{"step_count", "before-exit"}}});
-    if (box) d.push_back({{{"ray_box", "domain"}}, {{"ray_box", "texel"}}});
-    d.push_back({{{"table", 0}}, {{"table", 256}}, {{"table", 1024}}});
-    if (r.step_units == StepUnits::Voxel) d.push_back({{{"step_voxel", "spacing"}}, {{"step_voxel", "extent-over-samples"}}});
-    if (composite) {
-        d.push_back({{{"correction", "pow"}}, {{"correction", "exact"}}, {{"correction", "none"}}, {{"correction", "extinction"}}});
-        d.push_back({{{"termination", "none"}},
-                     {{"termination", {{"alpha_above", 1.0 - 1.0 / 255.0}}}},
-                     {{"termination", {{"alpha_at_least", 0.999}}}},
-                     {{"termination", {{"alpha_above", 0.99}}}},
-                     {{"termination", {{"alpha_above", 0.95}}}}});
-    }
-    if (shaded) {
-        d.push_back({{{"normal", "-gradient"}}, {{"normal", "+gradient"}}});
-        d.push_back({{{"gradient", "central"}}, {{"gradient", "forward"}}, {{"gradient", "central-in-domain"}}});
-        d.push_back({{{"clamp_shaded", false}}, {{"clamp_shaded", true}}});
-        d.push_back({{{"gradient_offset", 0.5}}, {{"gradient_offset", 1.0}}, {{"gradient_offset", 2.0}}});
-        d.push_back({{{"gradient_offset_texture", 0.1}}});  // seed 002's +-0.1 of the domain's extent
+    for (const ProfileRule* rule : searched_rules()) {
+        if (!slicer && !read_in_scene(*rule, scene)) continue;
+        for (std::vector<json>& values : rule->search.dimensions(scene, slicer)) d.push_back(std::move(values));
     }
     return d;
 }
@@ -252,25 +240,32 @@ std::vector<std::vector<json>> candidate_rules(const Scene& scene) {
 Scene with_rules(const Scene& scene, const json& rules) {
     json merged = profile_rules_object(scene.render.profile_rules);
     for (auto it = rules.begin(); it != rules.end(); ++it) {
-        if (it.key().rfind("slices.", 0) == 0) {  // one key of the slicer's "slices" object, over the scene's
-            if (!merged.contains("slices")) merged["slices"] = profile_rules_json(resolve_profile(scene.render)).at("slices");
-            const std::string key = it.key().substr(7);
-            if (key == "spacing" || key == "count" || key == "period")
-                for (const char* other : {"spacing", "count", "period"}) merged["slices"].erase(other);
-            merged["slices"][key] = it.value();
+        // "KEY.PART": one part of a rule's object (slices.orientation), over the scene's resolved object.
+        const std::size_t dot = it.key().find('.');
+        const ProfileRule* whole = dot == std::string::npos ? nullptr : find_profile_rule(std::string_view(it.key()).substr(0, dot));
+        if (whole && whole->search.set_part) {
+            const std::string key(whole->key);
+            if (!merged.contains(key)) merged[key] = profile_rules_json(resolve_profile(scene.render)).at(key);
+            whole->search.set_part(merged[key], it.key().substr(dot + 1), it.value());
             continue;
         }
         merged[it.key()] = it.value();
     }
-    // A placement other than from-entry has no first sample's offset; midpoints no step count.
-    if (rules.contains("placement")) {
-        if (merged["placement"] != "from-entry") merged.erase("first");
-        if (merged["placement"] == "midpoints") merged.erase("step_count");
+    // A candidate that sets a rule drops the rules it carries that the new placement does not read
+    // (other than from-entry: no first sample's offset; midpoints: no step count).
+    const auto placement = merged.contains("placement") && merged["placement"].is_string()
+                               ? scene_names::value_of(scene_names::kPlacements, merged["placement"].get<std::string>())
+                               : std::nullopt;
+    for (const ProfileRule& rule : profile_rule_table()) {
+        if (!rules.contains(std::string(rule.key)) || !placement) continue;
+        for (std::string_view k : rule.search.carried)
+            if (const ProfileRule* carried = find_profile_rule(k); carried && !carried->read_under(*placement)) merged.erase(std::string(k));
     }
     Scene s = scene;
     s.render.profile_rules = parse_profile_rules(merged, scene.render.profile, "--fit");
     // The rules that are render.profile_options too (SceneLoader's read_render does the same).
-    if (s.render.profile_rules.texture_unit) s.render.profile_options.texture_unit = *s.render.profile_rules.texture_unit;
+    for (const ProfileRule& rule : profile_rule_table())
+        if (!rule.option.empty() && rule.is_set(s.render.profile_rules)) rule.to_options(s.render.profile_rules, s.render.profile_options);
     return s;
 }
 
@@ -382,7 +377,8 @@ SearchResult search_conventions(const ComparedImage& g, const Scene& scene, cons
             for (const json& v : values) {
                 json rules = best.rules;
                 rules.erase(dim);
-                if (dim == "placement") rules.erase("first"), rules.erase("step_count");
+                if (const ProfileRule* rule = find_profile_rule(dim))  // with the keys its candidates carry
+                    for (std::string_view k : rule->search.carried) rules.erase(std::string(k));
                 rules.update(v);
                 if (rules == best.rules) continue;
                 SearchCandidate c;

@@ -21,6 +21,7 @@
 #include "core/grid/Volume.h"
 #include "core/io/VolumeReader.h"
 #include "core/render/PreparedScene.h"
+#include "core/scene/ProfileRuleTable.h"
 #include "core/scene/SceneLoader.h"
 #include "core/scene/SceneNames.h"
 
@@ -188,8 +189,14 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
         return trilinear(c, vec3("--point", o.one("--point")));
     }
     if (t == "composite") {
-        const Options o(t, args, {"--samples", "--order", "--unit-distance", "--step", "--framebuffer", "--blend", "--blend-alpha",
-                                  "--rounding", "--products"});
+        // The frame buffer's rules are options too (ProfileRule::explain: --framebuffer, --blend, ...).
+        std::vector<const ProfileRule*> fb_rules;
+        for (const ProfileRule& rule : profile_rule_table())
+            if (!rule.explain.option.empty()) fb_rules.push_back(&rule);
+        std::sort(fb_rules.begin(), fb_rules.end(), [](const ProfileRule* a, const ProfileRule* b) { return a->explain.rank < b->explain.rank; });
+        std::set<std::string> allowed{"--samples", "--order", "--unit-distance", "--step"};
+        for (const ProfileRule* rule : fb_rules) allowed.emplace(rule->explain.option);
+        const Options o(t, args, allowed);
         std::vector<CompositeSample> samples;
         for (const std::string& s : o.all("--samples")) {
             const auto v = parse_list("--samples", s, 4, 4, "samples r,g,b,a");
@@ -204,25 +211,22 @@ Explanation from_arguments(const std::string& t, const std::vector<std::string>&
             order = *named;
         }
         if (o.has("--framebuffer")) {  // a slicer's blends, each stored in the frame buffer's format
-            auto choice = [&](const std::string& key, const auto& table, auto fallback) {
-                if (!o.has(key)) return fallback;
-                const std::string v = o.one(key);
-                const auto named = scene_names::value_of(table, v);
-                if (!named) throw Error(key + ": expected " + scene_names::listing(table) + ", got \"" + v + "\"");
-                return *named;
-            };
-            FrameBufferRules f;
-            f.format = choice("--framebuffer", scene_names::kFrameBuffers, f.format);
-            f.blend = choice("--blend", scene_names::kBlends, f.blend);
-            f.blend_alpha = choice("--blend-alpha", scene_names::kBlendAlphas, f.blend_alpha);
-            f.rounding = choice("--rounding", scene_names::kRoundings, f.rounding);
-            f.products = choice("--products", scene_names::kBlendProducts, f.products);
+            ProfileRules given;
+            for (const ProfileRule* rule : fb_rules) {
+                const std::string option(rule->explain.option);
+                if (!o.has(option)) continue;
+                const std::string v = o.one(option);
+                if (!rule->set_by_name(v, given)) throw Error(option + ": expected " + rule->names() + ", got \"" + v + "\"");
+            }
+            ProfileRuleValues fb;  // the rules not given: a frame buffer's defaults
+            for (const ProfileRule* rule : fb_rules) rule->apply(given, fb);
+            const FrameBufferRules f{fb.framebuffer, fb.framebuffer_rounding, fb.blend_products, fb.blend, fb.blend_alpha};
             if (!o.has("--order")) order = CompositeOrder::BackToFront;
             if (o.has("--unit-distance") || o.has("--step")) throw Error("--framebuffer: the samples' alphas are blended as given (no --unit-distance or --step)");
             return composite_framebuffer(samples, order, f);
         }
-        for (const char* k : {"--blend", "--blend-alpha", "--rounding", "--products"})
-            if (o.has(k)) throw Error(std::string(k) + ": applies with --framebuffer");
+        for (const ProfileRule* rule : fb_rules)
+            if (o.has(std::string(rule->explain.option))) throw Error(std::string(rule->explain.option) + ": applies with --framebuffer");
         return composite(samples, order, number_or(o, "--unit-distance", 1.0), number_or(o, "--step", 1.0));
     }
     if (t == "opacity-correction") {

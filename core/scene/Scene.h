@@ -276,36 +276,23 @@ struct ProfileOptions {
     std::optional<VolPackSpec> volpack;
 };
 
-// render.profile written as an object: a preset (`base`) and the rules the scene sets over it.
-// Each rule is one field of Profile (core/integrate/profiles/Profile.h, which has its formula;
-// docs/conventions.md section 9, "Profiles as data"); a rule the scene does not set is the base's.
-struct ProfileRules {
-    // Where the samples of an interval [t0, t1] lie: segment midpoints (the reference), from the entry
-    // t0 + (first + k) h, or from the exit t1 - k h.
-    // Slices: a slicer's sampling surfaces (`slices` below, conventions section 9, "Slice-order
-    // renderers").
+// render.profile's rules (docs/conventions.md section 9, "Profiles as data") in three structs:
+// ProfileRuleTypes, the rules' enumerations; ProfileRuleValues, the value of every rule in a resolved
+// profile (Profile, core/integrate/profiles/Profile.h, extends it with what is not a rule: the renderer,
+// the projections' own conventions, termination); and ProfileRules, the rules a scene sets over its
+// preset (render.profile written as an object). Each rule is one entry of the rule table
+// (core/scene/ProfileRuleTable.h): its key, how it is read and written, how it sets ProfileRuleValues,
+// the values the convention search tries and the placements and scenes that read it.
+struct ProfileRuleTypes {
     enum class Placement { Midpoints, FromEntry, FromExit, Slices };
-    // From the entry or the exit: how many samples. ThroughExit: n = max(1, floor(L / h + 1 - first))
-    // (samples up to and at t1, at least one); BeforeExit: n = max(0, ceil(L / h - first)) (t < t1).
     enum class StepCount { ThroughExit, BeforeExit };
-    // The box rays are clipped to: the grid's domain, the texel box (the domain grown by half a spacing
-    // on every side, as a texture's [0, 1] spans it) or a given box; reads outside the domain are clamped.
     enum class RayBox { Domain, Texel, Given };
-    // What render.step_units "voxel" means: the spacing, or the extent over the sample count.
     enum class VoxelLength { Spacing, ExtentOverSamples };
-    // How an opacity a (per unit distance l) becomes a sample's alpha: 1 - (1 - a)^(d / l) on the table's
-    // entries before filtering (Power) or on the filtered opacity (Exact), a itself (None), or
-    // 1 - exp(-a d density_scale) (Extinction).
     enum class Correction { Power, None, Extinction, Exact };
-    // Front-to-back transmittance by optical depth (the reference), by product, by opacity sum (GPU
-    // shaders), or seed 001's back-to-front lerp.
     enum class Compositing { OpticalDepth, Product, OpacitySum, Lerp };
     enum class Stop { None, AlphaAbove, AlphaAtLeast, TransmittanceAtMost };
     enum class TableCoordinate { DataRange, DataRangeTimesTransferScale };
     enum class Arithmetic { Double, Float32 };
-    // Gradients per axis a at offset o_a: central (f(x + o) - f(x - o)) / 2o of the field clamped to the
-    // domain (GPU shaders), forward (f(x + o) - f(x)) / o, or central with the stencil kept inside the
-    // domain, one-sided at its boundary (the reference's GradientField, conventions section 2).
     enum class Gradient { Central, Forward, CentralInDomain };
 
     // The slicer's surfaces (placement "slices"; conventions section 9, "Slice-order renderers").
@@ -332,15 +319,108 @@ struct ProfileRules {
     enum class SliceClassify { Post, PreUnweighted };
     enum class FrameBuffer { Double, Rgba32f, Rgba16f, Rgba8 };
     enum class Rounding { Nearest, Truncate };
-    // Llvmpipe: each product (t + (t >> 8) + 128) >> 8, t = q_s f_s (Mesa's llvmpipe, measured by
-    // tests/gpu/slicing/gl_probe: one less than round(t / 255) for 24 pairs of codes >= 152).
     enum class BlendProducts { Exact, Rounded, Llvmpipe };
-    // Exact: trilinear in double of the stored texels; Fixed8: llvmpipe's 8-bit filter (unorm8 texels):
-    // weights of 1/256, each lerp v0 + ((w (v1 - v0) + 128) >> 8) in codes, x, then y, then z.
     enum class TextureFilter { Exact, Fixed8 };
     enum class Blend { SrcAlpha, Premultiplied, Max };
     enum class BlendAlpha { SrcAlpha, One };
+};
 
+// The value of every rule in a resolved profile, each with its formula; the defaults are the values a
+// preset does not set (core/integrate/profiles/Profile.cpp has the presets).
+struct ProfileRuleValues : ProfileRuleTypes {
+    // --- sample placement -------------------------------------------------------------------------
+    // Where the samples of one interval [t0, t1] (length L, step h) lie.
+    // Midpoints (the reference): segments of h, sampled at their midpoints, weighted by their lengths.
+    // FromEntry: t0 + (first + k) h for k = 0 .. n-1, n by `step_count`. Positions past t1 read the
+    //   texture clamped to the domain.
+    // FromExit: seed 001 (cuda-curvilinear): `for (s = outAbs; s >= inAbs; s -= step)` over one
+    //   span [inAbs, outAbs] = [the first interval's t0, the last one's t1]: t1 - k h for k = 0 .. n - 1
+    //   (first = 0), back to front; samples in the gaps between intervals read the field as value() says.
+    // Slices: a slicer's sampling surfaces (`slices` below).
+    Placement placement = Placement::Midpoints;
+    double first = 0.0;  // FromEntry: the first sample's distance from the entry, in steps
+    // FromEntry, FromExit: ThroughExit: n = max(1, floor(L / h + 1 - first)) (at least one sample, even
+    // when the chord is shorter than first * h; VTK's GPU shader samples before it tests the exit);
+    // BeforeExit: n = max(0, ceil(L / h - first)) (a shader's `while (t < t_exit)`).
+    StepCount step_count = StepCount::ThroughExit;
+    // The box rays are clipped to (PreparedVolume): the domain [origin, origin + (n - 1) spacing], the
+    // texel box (the domain grown by spacing / 2 on every side: a texture's [0, 1]), or `box`; reads
+    // outside the domain are clamped.
+    RayBox ray_box = RayBox::Domain;
+    std::array<glm::dvec3, 2> box{};  // RayBox::Given: min, max in the volume's space
+    // What render.step_units "voxel" means: the grid spacing (the reference), or size / n (the extent
+    // over the sample count: the step is multiplied by (n - 1) / n, n the dims of the grid's axis of
+    // smallest spacing (Cartesian) or the largest dims (shells)).
+    VoxelLength voxel_length = VoxelLength::Spacing;
+
+    // --- classification ---------------------------------------------------------------------------
+    // The transfer function read exactly (table_entries 0) or through 1-D tables of `table_entries`
+    // entries built at min + j (max - min) / (N - 1) over the volume's data range [min, max] and read
+    // with linear filtering at texel position u N - 0.5 (clamped to the edge texels, as an OpenGL
+    // texture with GL_LINEAR and CLAMP_TO_EDGE does), u by the table coordinate rule.
+    int table_entries = 0;
+    // DataRange: u = s = (v - min) / (max - min); DataRangeTimesTransferScale:
+    // u = clamp(s * render.profile_options.transfer_scale, 0, 1).
+    TableCoordinate table_coordinate = TableCoordinate::DataRange;
+
+    // --- opacity correction -----------------------------------------------------------------------
+    // How a transfer-function opacity a (per unit distance l) becomes the alpha of one sample.
+    // Power:      alpha = 1 - (1 - a)^(d / l) (d the length the sample stands for), applied to the table
+    //             entries with a > floor before filtering (VTK GPU), or to a when there is no table;
+    // Exact:      the same formula applied to the sample's own (filtered) opacity a, a > floor;
+    // None:       alpha = a (per-sample opacity, a textbook shader);
+    // Extinction: alpha = 1 - exp(-a d density_scale) (OSPRay: a is an extinction coefficient).
+    Correction correction = Correction::Power;
+    double correction_floor = 0.0;  // Power: entries with a <= floor are left as they are
+    double density_scale = 1.0;     // Extinction
+
+    // --- compositing (march/Accumulators.h; the stopping rule is Profile::termination) --------------
+    // Front to back, premultiplied, C += T alpha c with the transmittance T kept by the rule
+    // (march/Accumulators.h, TransmittanceRule): OpticalDepth (tau += -log1p(-alpha), T = exp(-tau): the
+    // reference), Product (T *= 1 - alpha), OpacitySum (A += (1 - A) alpha, T = 1 - A: GPU shaders).
+    // Lerp: seed 001: back to front, sum = lerp(sum, (c, a), a density) on R, G, B, A (density:
+    // render.profile_options.density); no termination.
+    Compositing compositing = Compositing::OpacitySum;
+
+    // --- gradients and shading --------------------------------------------------------------------
+    // Central differences (f(x + o) - f(x - o)) / 2o of the field clamped to the domain at
+    // o = +-gradient_offset voxels per axis (GPU shaders), or forward differences (f(x + o) - f(x)) / o
+    // (Gradient::Forward), or central with the stencil kept inside the domain, one-sided at its
+    // boundary (Gradient::CentralInDomain: the reference's GradientField, conventions section 2).
+    // normal_along_gradient: the renderer's normal is +grad f (VTK's GLSL) rather than this contract's
+    // -grad f. clamp_shaded: the shaded colour is clamped to [0, 1] before compositing.
+    double gradient_offset = 1.0;          // voxels
+    double gradient_offset_texture = 0.0;  // > 0: the offset is this fraction of the domain's extent per axis
+    Gradient gradient = Gradient::Central;
+    bool normal_along_gradient = false;
+    bool clamp_shaded = false;
+
+    // --- slicers (placement Slices; core/integrate/profiles/Slices.h, FrameBuffer.h) ----------------
+    // The sampling surfaces, what a slice fragment computes and the frame buffer that blends them
+    // (conventions section 9, "Slice-order renderers"); read only under placement Slices.
+    Slices slices{};
+    Texture texture = Texture::Texture3d;
+    TexelFormat texel_format = TexelFormat::Float;
+    TextureWindow texture_window = TextureWindow::TransferRows;
+    glm::dvec2 texture_window_given{0.0, 1.0};  // TextureWindow::Given: [lo, hi], lo < hi
+    TableLookup table_lookup = TableLookup::Texture;
+    TableFormat table_format = TableFormat::Float;
+    SliceClassify classify = SliceClassify::Post;
+    FrameBuffer framebuffer = FrameBuffer::Double;
+    Rounding framebuffer_rounding = Rounding::Nearest;
+    // Llvmpipe: each product (t + (t >> 8) + 128) >> 8, t = q_s f_s (Mesa's llvmpipe, measured by
+    // tests/gpu/slicing/gl_probe: one less than round(t / 255) for 24 pairs of codes >= 152).
+    BlendProducts blend_products = BlendProducts::Exact;
+    Blend blend = Blend::SrcAlpha;
+    BlendAlpha blend_alpha = BlendAlpha::SrcAlpha;
+    // Exact: trilinear in double of the stored texels; Fixed8: llvmpipe's 8-bit filter (unorm8 texels):
+    // weights of 1/256, each lerp v0 + ((w (v1 - v0) + 128) >> 8) in codes, x, then y, then z.
+    TextureFilter texture_filter = TextureFilter::Exact;
+};
+
+// render.profile written as an object: a preset (`base`) and the rules the scene sets over it, each
+// absent where the scene leaves the base's value (ProfileRuleValues has each rule's formula).
+struct ProfileRules : ProfileRuleTypes {
     std::optional<Placement> placement;
     std::optional<Slices> slices;
     std::optional<Texture> texture;
@@ -365,6 +445,9 @@ struct ProfileRules {
     std::optional<double> correction_floor;  // Power: entries with a <= floor are not corrected
     std::optional<double> density_scale;     // Extinction
     std::optional<Compositing> compositing;
+    // When a front-to-back ray stops (Profile::termination): never, or after the sample at which
+    // A > termination_value (AlphaAbove), A >= termination_value (AlphaAtLeast) or
+    // T <= termination_value (TransmittanceAtMost).
     std::optional<Stop> termination;
     double termination_value = 1.0;          // the threshold of `termination`
     std::optional<int> table_entries;        // 0: the transfer function read exactly
@@ -376,7 +459,8 @@ struct ProfileRules {
     std::optional<double> gradient_offset;      // voxels
     std::optional<double> gradient_offset_texture;  // a fraction of the domain's extent per axis
     std::optional<bool> clamp_shaded;
-    // The keys the scene set, in the order written (messages, `volref compare --fit`, the resolved scene).
+    // The keys the scene set, in the rule table's order (messages, `volref compare --fit`, the resolved
+    // scene).
     std::vector<std::string> keys;
     bool empty() const { return keys.empty(); }
 };

@@ -21,6 +21,7 @@
 #include "core/Error.h"
 #include "core/InputFile.h"
 #include "core/scene/JsonReader.h"
+#include "core/scene/ProfileRuleTable.h"
 #include "core/scene/SceneNames.h"
 
 namespace volref {
@@ -785,129 +786,20 @@ ProfileId read_profile_id(Reader& r, std::string_view key) {
     return r.template choice<ProfileId>(key, ProfileId::Reference, names::kProfiles);
 }
 
-// render.profile as an object: each rule of Profile.h by its key (scene-format.md,
-// "render.profile"); the renderers that are not rule-driven (vtk-cpu, vtk-js, fast) take none.
-// The slicers' rules (conventions section 9, "Slice-order renderers"): `slices` and what a
-// slice fragment and the frame buffer compute.
-void read_slice_rules(ObjectReader& r, ProfileRules& out) {
-    using P = ProfileRules;
-    using S = P::Slices;
-    if (const Json* v = r.find("slices")) {
-        ObjectReader sr(*v, r.path("slices"), r.context());
-        sr.allow({"orientation", "range", "spacing", "count", "period", "max_count", "first", "order"});
-        S sl;
-        sl.orientation = sr.choice<S::Orientation>("orientation", S::Orientation::Viewport, names::kSliceOrientations);
-        sl.range = sr.choice<S::Range>("range", S::Range::Object, names::kSliceRanges);
-        sl.spacing = sr.optional_number("spacing", Range::positive());
-        if (sr.has("count")) sl.count = sr.integer("count", 1, Range::closed(1, 1LL << 32));
-        if (const Json* p = sr.find("period")) {
-            const std::vector<double> c = read_numbers(*p, sr.path("period"), r.context(), 3, Range::positive());
-            sl.period = glm::dvec3(c[0], c[1], c[2]);
-        }
-        if (int(sl.spacing.has_value()) + int(sl.count.has_value()) + int(sl.period.has_value()) > 1)
-            sr.fail(sl.count && sl.period ? "period" : sl.count ? "count" : "period", "set one of spacing, count and period");
-        if (sr.has("max_count")) sl.max_count = sr.integer("max_count", 1, Range::closed(1, 1LL << 32));
-        sl.first = sr.choice<S::First>("first", S::First::Bound, names::kSliceFirsts);
-        sl.order = sr.choice<S::Order>("order", S::Order::BackToFront, names::kSliceOrders);
-        out.slices = sl;
-    }
-    out.texture = r.optional_choice<P::Texture>("texture", names::kTextures);
-    out.texture_format = r.optional_choice<P::TexelFormat>("texture_format", names::kTexelFormats);
-    if (const Json* w = r.find("texture_window")) {
-        if (w->is_array()) {
-            const std::vector<double> c = read_numbers(*w, r.path("texture_window"), r.context(), 2);
-            if (!(c[0] < c[1])) r.fail("texture_window", "expected [lo, hi] with lo < hi");
-            out.texture_window = P::TextureWindow::Given;
-            out.texture_window_given = glm::dvec2(c[0], c[1]);
-        } else {
-            out.texture_window = r.choice<P::TextureWindow>("texture_window", P::TextureWindow::TransferRows, names::kTextureWindows);
-        }
-    }
-    out.table_lookup = r.optional_choice<P::TableLookup>("table_lookup", names::kTableLookups);
-    out.table_format = r.optional_choice<P::TableFormat>("table_format", names::kTableFormats);
-    out.classify = r.optional_choice<P::SliceClassify>("classify", names::kSliceClassifies);
-    out.framebuffer = r.optional_choice<P::FrameBuffer>("framebuffer", names::kFrameBuffers);
-    out.framebuffer_rounding = r.optional_choice<P::Rounding>("framebuffer_rounding", names::kRoundings);
-    out.blend_products = r.optional_choice<P::BlendProducts>("blend_products", names::kBlendProducts);
-    out.blend = r.optional_choice<P::Blend>("blend", names::kBlends);
-    out.blend_alpha = r.optional_choice<P::BlendAlpha>("blend_alpha", names::kBlendAlphas);
-    out.texture_filter = r.optional_choice<P::TextureFilter>("texture_filter", names::kTextureFilters);
-}
-
+// render.profile as an object: each rule of the rule table by its key (ProfileRuleTable.h,
+// scene-format.md "render.profile"), read in the table's order; the renderers that are not rule-driven
+// (vtk-cpu, vtk-js, fast, volpack) take none.
 ProfileRules read_profile_rules(ObjectReader& r, ProfileId base) {
-    using P = ProfileRules;
-    static constexpr std::string_view kKeys[] = {
-        "placement", "first",      "step_count",  "ray_box",  "step_voxel", "correction",    "correction_floor",
-        "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
-        "normal",    "gradient",   "gradient_offset", "gradient_offset_texture", "clamp_shaded",
-        // the slicers' rules
-        "slices", "texture", "texture_format", "texture_window", "table_lookup", "table_format", "classify",
-        "framebuffer", "framebuffer_rounding", "blend_products", "blend", "blend_alpha", "texture_filter"};  // jitter "off": nothing to apply
-    r.allow({"base", "placement", "first", "step_count", "ray_box", "step_voxel", "correction", "correction_floor",
-             "density_scale", "compositing", "termination", "table", "table_coordinate", "texture_unit", "arithmetic",
-             "normal", "gradient", "gradient_offset", "gradient_offset_texture", "clamp_shaded", "jitter", "slices", "texture",
-             "texture_format", "texture_window", "table_lookup", "table_format", "classify", "framebuffer", "framebuffer_rounding",
-             "blend_products", "blend", "blend_alpha", "texture_filter"});
-    P out;
-    for (std::string_view k : kKeys)
-        if (r.has(k)) out.keys.emplace_back(k);
+    r.find("base");  // the keys the object may have, in the order the unknown-key message lists them
+    for (const ProfileRule& rule : profile_rule_table()) r.find(rule.key);
+    r.finish();
+    ProfileRules out;
+    for (const ProfileRule& rule : profile_rule_table())
+        if (!rule.only_value && r.has(rule.key)) out.keys.emplace_back(rule.key);  // jitter "off": nothing to apply
     if (!out.keys.empty() && (base == ProfileId::VtkCpu || base == ProfileId::VtkJs || base == ProfileId::Fast || base == ProfileId::VolPack))
         r.fail(out.keys.front(), std::string("the \"") + std::string(names::name_of(names::kProfiles, base)) +
                                      "\" profile is its own renderer, not a set of rules (use render.profile_options, or base \"reference\")");
-    out.placement = r.optional_choice<P::Placement>("placement", names::kPlacements);
-    out.first = r.optional_number("first", Range::closed(0.0, 1e6));
-    out.step_count = r.optional_choice<P::StepCount>("step_count", names::kStepCounts);
-    if (const Json* b = r.find("ray_box")) {
-        if (b->is_object()) {
-            ObjectReader br(*b, r.path("ray_box"), r.context());
-            br.allow({"min", "max"});
-            const glm::dvec3 lo = read_vec3(br.required("min"), br.path("min"), r.context());
-            const glm::dvec3 hi = read_vec3(br.required("max"), br.path("max"), r.context());
-            if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) br.fail("max", "must exceed min on every axis");
-            out.ray_box = P::RayBox::Given;
-            out.box = std::array<glm::dvec3, 2>{lo, hi};
-        } else {
-            out.ray_box = r.choice<P::RayBox>("ray_box", P::RayBox::Domain, names::kRayBoxes);
-        }
-    }
-    out.step_voxel = r.optional_choice<P::VoxelLength>("step_voxel", names::kVoxelLengths);
-    out.correction = r.optional_choice<P::Correction>("correction", names::kCorrections);
-    out.correction_floor = r.optional_number("correction_floor", Range::closed(0.0, 1.0));
-    out.density_scale = r.optional_number("density_scale", Range::non_negative());
-    out.compositing = r.optional_choice<P::Compositing>("compositing", names::kCompositings);
-    if (const Json* t = r.find("termination")) {  // "none" or {"alpha_above" | "alpha_at_least" | "transmittance_at_most": x}
-        if (t->is_object()) {
-            ObjectReader tr(*t, r.path("termination"), r.context());
-            tr.allow({"alpha_above", "alpha_at_least", "transmittance_at_most"});
-            int n = 0;
-            for (const auto& stop : names::kStops)
-                if (tr.has(stop.name)) {
-                    out.termination = stop.value;
-                    out.termination_value = tr.number(stop.name, 1.0, Range::closed(0.0, 1.0));
-                    ++n;
-                }
-            if (n != 1) tr.fail_here("expected one of alpha_above, alpha_at_least, transmittance_at_most");
-        } else {
-            out.termination = r.choice<P::Stop>("termination", P::Stop::None, {{"none", P::Stop::None}});
-        }
-    }
-    if (r.has("table")) out.table_entries = int(r.integer("table", 0, Range::closed(0, 1 << 20)));
-    if (out.table_entries == 1) r.fail("table", "expected 0 (the transfer function read exactly) or at least 2 entries");
-    out.table_coordinate = r.optional_choice<P::TableCoordinate>("table_coordinate", names::kTableCoordinates);
-    // The canonical names only: "hardware" is render.profile_options' deprecated alias, not a rule's.
-    out.texture_unit = r.optional_choice<ProfileOptions::TextureUnit>(
-        "texture_unit", std::span<const json_reader::Choice<ProfileOptions::TextureUnit>>(names::kTextureUnits).first(2));
-    out.arithmetic = r.optional_choice<P::Arithmetic>("arithmetic", names::kArithmetics);
-    out.normal_along_gradient = r.optional_choice<bool>("normal", names::kNormals);
-    out.gradient = r.optional_choice<P::Gradient>("gradient", names::kRuleGradients);
-    out.gradient_offset = r.optional_number("gradient_offset", Range::positive());
-    out.gradient_offset_texture = r.optional_number("gradient_offset_texture", Range::left_open(0.0, 1.0));
-    if (out.gradient_offset && out.gradient_offset_texture)
-        r.fail("gradient_offset_texture", "also set as gradient_offset (voxels): set one");
-    if (r.has("clamp_shaded")) out.clamp_shaded = r.boolean("clamp_shaded", false);
-    // volref never jitters (every pixel its own deterministic ray): "off" is the only value.
-    r.choice<bool>("jitter", false, {{"off", false}});
-    read_slice_rules(r, out);
+    for (const ProfileRule& rule : profile_rule_table()) rule.read(r, out);
     return out;
 }
 
@@ -1127,19 +1019,14 @@ RenderSpec read_render(const Json& v, const std::string& path, const Context& ct
         s.profile_options.iso_threshold = po.number("iso_threshold", 0.0);
         s.profile_options.brightness = po.number("brightness", 1.0, Range::non_negative());
     }
-    // The rules that are render.profile_options too: set in one place only.
-    const ProfileRules& pr = s.profile_rules;
+    // The rules that are render.profile_options too (texture_unit, arithmetic): set in one place only.
     const Json* po_json = r.find("profile_options");
-    if (pr.texture_unit) {
-        if (po_json && po_json->contains("texture_unit"))
-            r.fail("profile.texture_unit", "also set by render.profile_options.texture_unit (set it in one place)");
-        s.profile_options.texture_unit = *pr.texture_unit;
-    }
-    if (pr.arithmetic) {
-        if (po_json && po_json->contains("kernel"))
-            r.fail("profile.arithmetic", "also set by render.profile_options.kernel (set it in one place)");
-        s.profile_options.kernel = *pr.arithmetic == ProfileRules::Arithmetic::Float32 ? ProfileOptions::Kernel::Float32
-                                                                                      : ProfileOptions::Kernel::Double;
+    for (const ProfileRule& rule : profile_rule_table()) {
+        if (rule.option.empty() || !rule.is_set(s.profile_rules)) continue;
+        if (po_json && po_json->contains(std::string(rule.option)))
+            r.fail("profile." + std::string(rule.key),
+                   "also set by render.profile_options." + std::string(rule.option) + " (set it in one place)");
+        rule.to_options(s.profile_rules, s.profile_options);
     }
     s.gain = r.number("gain", 1.0, Range::positive());
     if (is_first_hit(s.projection) && !s.isovalue) r.fail("isovalue", "required by projection first-hit");

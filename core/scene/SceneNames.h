@@ -87,7 +87,7 @@ inline constexpr Choice<ProfileOptions::Kernel> kKernels[] = {{"float32", Profil
 inline constexpr Choice<bool> kTextureFormats[] = {{"float", false}, {"unorm16", true}};  // data_unorm16
 inline constexpr Choice<bool> kVtkJsRayBoxes[] = {{"texel", false}, {"domain", true}};   // ray_box_domain
 
-// render.profile's rules (ProfileRules).
+// render.profile's rules (ProfileRules; each rule's entry in ProfileRuleTable.cpp names its table).
 using Rules = ProfileRules;
 inline constexpr Choice<Rules::Placement> kPlacements[] = {{"midpoints", Rules::Placement::Midpoints},
                                                            {"from-entry", Rules::Placement::FromEntry},
@@ -172,19 +172,28 @@ const char* name_of(const Choice<E> (&table)[N], E value) {
 }
 
 // The value named `name` in `table` (aliases included), or nothing.
-template <class E, std::size_t N>
-std::optional<E> value_of(const Choice<E> (&table)[N], std::string_view name) {
+template <class E>
+std::optional<E> value_of(std::span<const Choice<E>> table, std::string_view name) {
     for (const Choice<E>& c : table)
         if (c.name == name) return c.value;
     return std::nullopt;
 }
+template <class E, std::size_t N>
+std::optional<E> value_of(const Choice<E> (&table)[N], std::string_view name) {
+    return value_of(std::span<const Choice<E>>(table), name);
+}
 
 // The table's names for a message: "a, b or c" (aliases included).
+template <class E>
+std::string listing(std::span<const Choice<E>> table) {
+    std::string s;
+    const std::size_t n = table.size();
+    for (std::size_t i = 0; i < n; ++i) s += std::string(i == 0 ? "" : i + 1 == n ? " or " : ", ") + std::string(table[i].name);
+    return s;
+}
 template <class E, std::size_t N>
 std::string listing(const Choice<E> (&table)[N]) {
-    std::string s;
-    for (std::size_t i = 0; i < N; ++i) s += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(table[i].name);
-    return s;
+    return listing(std::span<const Choice<E>>(table));
 }
 
 }  // namespace volref::scene_names

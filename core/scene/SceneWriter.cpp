@@ -1,5 +1,6 @@
 #include "core/scene/SceneWriter.h"
 
+#include "core/scene/ProfileRuleTable.h"
 #include "core/scene/SceneNames.h"
 
 namespace volref {
@@ -227,13 +228,13 @@ json profile_options_json(const RenderSpec& r) {
         j = {{"density", o.density}, {"transfer_scale", o.transfer_scale}, {"iso_threshold", o.iso_threshold}, {"brightness", o.brightness}};
     if (r.profile == ProfileId::GlslBasic) j = {{"intensity", o.intensity}};
     if (r.profile == ProfileId::CudaCurvilinear || r.profile == ProfileId::GlslBasic || r.profile == ProfileId::VtkGpu) {
-        // listed when not the defaults; a texture unit set as a rule is the rule's
-        if (o.texture_unit == ProfileOptions::TextureUnit::H100 && !rules.texture_unit)
+        // listed when not the defaults; an option set as a rule is the rule's (ProfileRuleTable.h)
+        if (o.texture_unit == ProfileOptions::TextureUnit::H100 && !option_set_as_rule(rules, "texture_unit"))
             j["texture_unit"] = name_of(names::kTextureUnits, o.texture_unit);
         if (o.texture_band) j["texture_band"] = true;
         if (o.data_unorm16) j["texture_format"] = name_of(names::kTextureFormats, o.data_unorm16);
     }
-    if (r.profile == ProfileId::CudaCurvilinear && o.kernel == ProfileOptions::Kernel::Double && !rules.arithmetic)
+    if (r.profile == ProfileId::CudaCurvilinear && o.kernel == ProfileOptions::Kernel::Double && !option_set_as_rule(rules, "kernel"))
         j["kernel"] = name_of(names::kKernels, o.kernel);
     if (r.profile == ProfileId::CudaCurvilinear && o.tricubic) j["tricubic"] = true;
     if (r.profile == ProfileId::Fast && o.preintegration > 0) j["preintegration"] = o.preintegration;
@@ -342,63 +343,8 @@ json scene_json(const Scene& scene) {
 }
 
 nlohmann::json profile_rules_object(const ProfileRules& r) {
-    using P = ProfileRules;
     nlohmann::json j = nlohmann::json::object();
-    if (r.placement) j["placement"] = name_of(names::kPlacements, *r.placement);
-    if (r.first) j["first"] = *r.first;
-    if (r.step_count) j["step_count"] = name_of(names::kStepCounts, *r.step_count);
-    if (r.ray_box == P::RayBox::Given && r.box)
-        j["ray_box"] = {{"min", {(*r.box)[0].x, (*r.box)[0].y, (*r.box)[0].z}}, {"max", {(*r.box)[1].x, (*r.box)[1].y, (*r.box)[1].z}}};
-    else if (r.ray_box)
-        j["ray_box"] = name_of(names::kRayBoxes, *r.ray_box);
-    if (r.step_voxel) j["step_voxel"] = name_of(names::kVoxelLengths, *r.step_voxel);
-    if (r.correction) j["correction"] = name_of(names::kCorrections, *r.correction);
-    if (r.correction_floor) j["correction_floor"] = *r.correction_floor;
-    if (r.density_scale) j["density_scale"] = *r.density_scale;
-    if (r.compositing) j["compositing"] = name_of(names::kCompositings, *r.compositing);
-    if (r.termination) {
-        if (*r.termination == P::Stop::None)
-            j["termination"] = "none";
-        else
-            j["termination"] = {{name_of(names::kStops, *r.termination), r.termination_value}};
-    }
-    if (r.table_entries) j["table"] = *r.table_entries;
-    if (r.table_coordinate) j["table_coordinate"] = name_of(names::kTableCoordinates, *r.table_coordinate);
-    if (r.texture_unit) j["texture_unit"] = name_of(names::kTextureUnits, *r.texture_unit);
-    if (r.arithmetic) j["arithmetic"] = name_of(names::kArithmetics, *r.arithmetic);
-    if (r.normal_along_gradient) j["normal"] = name_of(names::kNormals, *r.normal_along_gradient);
-    if (r.gradient) j["gradient"] = name_of(names::kRuleGradients, *r.gradient);
-    if (r.gradient_offset) j["gradient_offset"] = *r.gradient_offset;
-    if (r.gradient_offset_texture) j["gradient_offset_texture"] = *r.gradient_offset_texture;
-    if (r.clamp_shaded) j["clamp_shaded"] = *r.clamp_shaded;
-    if (r.slices) {  // the slicers' rules
-        const P::Slices& s = *r.slices;
-        nlohmann::json o;
-        o["orientation"] = name_of(names::kSliceOrientations, s.orientation);
-        o["range"] = name_of(names::kSliceRanges, s.range);
-        if (s.spacing) o["spacing"] = *s.spacing;
-        if (s.count) o["count"] = *s.count;
-        if (s.period) o["period"] = {s.period->x, s.period->y, s.period->z};
-        if (s.max_count) o["max_count"] = *s.max_count;
-        o["first"] = name_of(names::kSliceFirsts, s.first);
-        o["order"] = name_of(names::kSliceOrders, s.order);
-        j["slices"] = o;
-    }
-    if (r.texture) j["texture"] = name_of(names::kTextures, *r.texture);
-    if (r.texture_format) j["texture_format"] = name_of(names::kTexelFormats, *r.texture_format);
-    if (r.texture_window == P::TextureWindow::Given)
-        j["texture_window"] = {r.texture_window_given.x, r.texture_window_given.y};
-    else if (r.texture_window)
-        j["texture_window"] = name_of(names::kTextureWindows, *r.texture_window);
-    if (r.table_lookup) j["table_lookup"] = name_of(names::kTableLookups, *r.table_lookup);
-    if (r.table_format) j["table_format"] = name_of(names::kTableFormats, *r.table_format);
-    if (r.classify) j["classify"] = name_of(names::kSliceClassifies, *r.classify);
-    if (r.framebuffer) j["framebuffer"] = name_of(names::kFrameBuffers, *r.framebuffer);
-    if (r.framebuffer_rounding) j["framebuffer_rounding"] = name_of(names::kRoundings, *r.framebuffer_rounding);
-    if (r.blend_products) j["blend_products"] = name_of(names::kBlendProducts, *r.blend_products);
-    if (r.blend) j["blend"] = name_of(names::kBlends, *r.blend);
-    if (r.blend_alpha) j["blend_alpha"] = name_of(names::kBlendAlphas, *r.blend_alpha);
-    if (r.texture_filter) j["texture_filter"] = name_of(names::kTextureFilters, *r.texture_filter);
+    for (const ProfileRule& rule : profile_rule_table()) rule.write(r, j);  // each rule that is set
     return j;
 }
 

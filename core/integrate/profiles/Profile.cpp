@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/scene/ProfileRuleTable.h"
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneWriter.h"
 
@@ -199,6 +200,36 @@ namespace {
 
 std::string preset_name(ProfileId id) { return scene_names::name_of(scene_names::kProfiles, id); }
 
+// The rule "termination" as Profile::termination, the accumulators' Termination (march/Accumulators.h),
+// and back: the one rule whose resolved form is not a scene type (ProfileRuleTable.h).
+Termination termination_of(ProfileRules::Stop stop, double value) {
+    Termination t;
+    switch (stop) {
+        case ProfileRules::Stop::None: break;
+        case ProfileRules::Stop::AlphaAbove:
+            t.test_alpha_above = true;
+            t.alpha_above = value;
+            break;
+        case ProfileRules::Stop::AlphaAtLeast:
+            t.test_alpha_at_least = true;
+            t.alpha_at_least = value;
+            break;
+        case ProfileRules::Stop::TransmittanceAtMost:
+            t.test_transmittance = true;
+            t.transmittance_at_most = value;
+            break;
+    }
+    return t;
+}
+
+void capture_termination(const Termination& t, ProfileRules& r) {
+    r.termination = t.test_alpha_above      ? ProfileRules::Stop::AlphaAbove
+                    : t.test_alpha_at_least ? ProfileRules::Stop::AlphaAtLeast
+                    : t.test_transmittance  ? ProfileRules::Stop::TransmittanceAtMost
+                                            : ProfileRules::Stop::None;
+    r.termination_value = t.test_alpha_above ? t.alpha_above : t.test_alpha_at_least ? t.alpha_at_least : t.transmittance_at_most;
+}
+
 }  // namespace
 
 Profile resolve_profile(const RenderSpec& render) {
@@ -212,63 +243,9 @@ Profile resolve_profile(const RenderSpec& render) {
     const ProfileRules& r = render.profile_rules;
     if (r.empty()) return p;
     p.name = std::string("custom (base ") + preset_name(render.profile) + ")";
-    if (r.placement) p.placement = *r.placement;
-    if (r.first) p.first = *r.first;
-    if (r.step_count) p.step_count = *r.step_count;
-    if (r.ray_box) p.ray_box = *r.ray_box;
-    if (r.box) p.box = *r.box;
-    if (r.step_voxel) p.voxel_length = *r.step_voxel;
-    if (r.correction) p.correction = *r.correction;
-    if (r.correction_floor) p.correction_floor = *r.correction_floor;
-    if (r.density_scale) p.density_scale = *r.density_scale;
-    if (r.compositing) p.compositing = *r.compositing;
-    if (r.termination) {
-        p.termination = Termination{};
-        switch (*r.termination) {
-            case ProfileRules::Stop::None: break;
-            case ProfileRules::Stop::AlphaAbove:
-                p.termination.test_alpha_above = true;
-                p.termination.alpha_above = r.termination_value;
-                break;
-            case ProfileRules::Stop::AlphaAtLeast:
-                p.termination.test_alpha_at_least = true;
-                p.termination.alpha_at_least = r.termination_value;
-                break;
-            case ProfileRules::Stop::TransmittanceAtMost:
-                p.termination.test_transmittance = true;
-                p.termination.transmittance_at_most = r.termination_value;
-                break;
-        }
-    }
-    if (r.table_entries) p.table_entries = *r.table_entries;
-    if (r.table_coordinate) p.table_coordinate = *r.table_coordinate;
-    if (r.normal_along_gradient) p.normal_along_gradient = *r.normal_along_gradient;
-    if (r.gradient) p.gradient = *r.gradient;
-    if (r.gradient_offset) {
-        p.gradient_offset = *r.gradient_offset;
-        p.gradient_offset_texture = 0.0;
-    }
-    if (r.gradient_offset_texture) {
-        p.gradient_offset_texture = *r.gradient_offset_texture;
-        p.gradient_offset = 0.0;
-    }
-    if (r.clamp_shaded) p.clamp_shaded = *r.clamp_shaded;
-    if (r.slices) p.slices = *r.slices;
-    if (r.texture) p.texture = *r.texture;
-    if (r.texture_format) p.texel_format = *r.texture_format;
-    if (r.texture_window) {
-        p.texture_window = *r.texture_window;
-        p.texture_window_given = r.texture_window_given;
-    }
-    if (r.table_lookup) p.table_lookup = *r.table_lookup;
-    if (r.table_format) p.table_format = *r.table_format;
-    if (r.classify) p.classify = *r.classify;
-    if (r.framebuffer) p.framebuffer = *r.framebuffer;
-    if (r.framebuffer_rounding) p.framebuffer_rounding = *r.framebuffer_rounding;
-    if (r.blend_products) p.blend_products = *r.blend_products;
-    if (r.blend) p.blend = *r.blend;
-    if (r.blend_alpha) p.blend_alpha = *r.blend_alpha;
-    if (r.texture_filter) p.texture_filter = *r.texture_filter;
+    for (const ProfileRule& rule : profile_rule_table())
+        if (rule.apply) rule.apply(r, p);
+    if (r.termination) p.termination = termination_of(*r.termination, r.termination_value);
     return p;
 }
 
@@ -276,59 +253,24 @@ nlohmann::json profile_rules_json(const Profile& p) {
     nlohmann::json j;
     j["base"] = preset_name(p.id);
     if (p.renderer != Profile::Renderer::RayCaster || p.id == ProfileId::Fast) return j;
-    // Every rule set, written by the scene reader's own inverse (SceneLoader.h, profile_rules_object).
+    // Every rule the profile's placement reads, written by the scene writer's own inverse of the
+    // loader (SceneWriter.h, profile_rules_object).
     ProfileRules r;
-    r.placement = p.placement;
-    if (p.placement == Profile::Placement::FromEntry) r.first = p.first;  // the rules a placement reads
-    if (p.placement == Profile::Placement::FromEntry || p.placement == Profile::Placement::FromExit) r.step_count = p.step_count;
-    r.ray_box = p.ray_box;
-    if (p.ray_box == Profile::RayBox::Given) r.box = p.box;
-    r.step_voxel = p.voxel_length;
-    r.correction = p.correction;
-    r.correction_floor = p.correction_floor;
-    r.density_scale = p.density_scale;
-    const bool slicer = p.placement == Profile::Placement::Slices;  // its compositing is the frame buffer's blend
-    if (!slicer) r.compositing = p.compositing;
-    const Termination& t = p.termination;
-    if (!slicer) r.termination = t.test_alpha_above ? ProfileRules::Stop::AlphaAbove
-                    : t.test_alpha_at_least ? ProfileRules::Stop::AlphaAtLeast
-                    : t.test_transmittance ? ProfileRules::Stop::TransmittanceAtMost
-                                           : ProfileRules::Stop::None;
-    r.termination_value = t.test_alpha_above ? t.alpha_above : t.test_alpha_at_least ? t.alpha_at_least : t.transmittance_at_most;
-    r.table_entries = p.table_entries;
-    r.table_coordinate = p.table_coordinate;
-    r.normal_along_gradient = p.normal_along_gradient;
-    r.gradient = p.gradient;
-    if (p.gradient_offset_texture > 0.0) r.gradient_offset_texture = p.gradient_offset_texture;
-    else r.gradient_offset = p.gradient_offset;
-    r.clamp_shaded = p.clamp_shaded;
-    if (p.placement == Profile::Placement::Slices) {  // the rules a slicer reads
-        r.slices = p.slices;
-        r.texture = p.texture;
-        r.texture_format = p.texel_format;
-        r.texture_window = p.texture_window;
-        r.texture_window_given = p.texture_window_given;
-        r.table_lookup = p.table_lookup;
-        r.table_format = p.table_format;
-        r.classify = p.classify;
-        r.framebuffer = p.framebuffer;
-        r.framebuffer_rounding = p.framebuffer_rounding;
-        r.blend_products = p.blend_products;
-        r.blend = p.blend;
-        r.blend_alpha = p.blend_alpha;
-        r.texture_filter = p.texture_filter;
-    }
+    for (const ProfileRule& rule : profile_rule_table())
+        if (rule.capture && rule.read_under(p.placement)) rule.capture(p, r);
+    if (find_profile_rule("termination")->read_under(p.placement)) capture_termination(p.termination, r);
     j.update(profile_rules_object(r));
-    j["jitter"] = "off";
+    for (const ProfileRule& rule : profile_rule_table())
+        if (rule.only_value) j[std::string(rule.key)] = rule.only_value;  // jitter "off"
     return j;
 }
 
 nlohmann::json resolved_profile_json(const RenderSpec& render) {
     nlohmann::json j = profile_rules_json(resolve_profile(render));
-    const ProfileRules& rules = render.profile_rules;
-    // The two rules that are render.profile_options too (the base's options otherwise).
-    if (rules.texture_unit) j["texture_unit"] = scene_names::name_of(scene_names::kTextureUnits, *rules.texture_unit);
-    if (rules.arithmetic) j["arithmetic"] = scene_names::name_of(scene_names::kArithmetics, *rules.arithmetic);
+    // The rules that are render.profile_options too, where the scene set them as rules (the base's
+    // options otherwise).
+    for (const ProfileRule& rule : profile_rule_table())
+        if (!rule.option.empty()) rule.write(render.profile_rules, j);
     return j;
 }
 

@@ -140,21 +140,32 @@ protected:
     // it has no traced loop).
     [[noreturn]] static void not_resumable();
     [[noreturn]] static void not_traced();
+    [[noreturn]] static void packets_not_traced();  // the fast profile's (its packets are its only path)
 
     const IntegrationContext& ctx_;
     IntegratorTraits traits_;
 };
 
-// An integrator whose one loop, Derived::integrate_impl<Rec>(ray, intervals, rec), serves both the
-// render (NoRecording) and `volref trace` (Recording, SampleRecorder.h): the same statements, so the
-// traced pixel is the rendered one bit for bit. A resumable Derived also has
-// integrate_span_impl(ray, intervals, span, state). Derived befriends this class.
+// The shape of every fixed-step integrator: one loop, Derived::integrate_impl(ray, intervals, rec),
+// serves both the render (NoRecording) and `volref trace` (Recording, SampleRecorder.h): the same
+// statements, so the traced pixel is the rendered one bit for bit. Derived may also have
+//   integrate_impl for NoRecording only: there is no traced loop (a trace is an error);
+//   integrate_span_impl(ray, intervals, span, state): resumable (else spans are an error);
+//   integrate_packets(batch) and has_packet_path(): a SIMD path, taken for batches that ask for it
+//   (RayBatch::simd) and, where packets_only_ (float lanes: the fast profile), for every batch.
+// Derived befriends this class.
 template <class Derived>
 class OneLoopIntegrator : public Integrator {
 public:
     using Integrator::Integrator;
     void run(const RayBatch& b) const override {
         const Derived& self = static_cast<const Derived&>(*this);
+        if constexpr (requires { self.integrate_packets(b); }) {
+            if (packets_only_ || (b.simd && !b.recorder && self.has_packet_path())) {
+                if (b.recorder) packets_not_traced();
+                return self.integrate_packets(b);
+            }
+        }
         for (int i = 0; i < b.count; ++i) {
             if (b.resuming()) {
                 if constexpr (requires { self.integrate_span_impl(b.rays[i], b.intervals[i], b.spans[i], b.states[i]); })
@@ -163,13 +174,20 @@ public:
                     not_resumable();
             } else if (b.recorder) {
                 Recording rec{*b.recorder};
-                b.out[i] = self.integrate_impl(b.rays[i], b.intervals[i], rec);
+                if constexpr (requires { self.integrate_impl(b.rays[i], b.intervals[i], rec); })
+                    b.out[i] = self.integrate_impl(b.rays[i], b.intervals[i], rec);
+                else
+                    not_traced();
             } else {
                 NoRecording rec;
                 b.out[i] = self.integrate_impl(b.rays[i], b.intervals[i], rec);
             }
         }
     }
+
+protected:
+    // The lanes are float (the fast profile): the packet path is the only one.
+    bool packets_only_ = false;
 };
 
 std::unique_ptr<Integrator> make_integrator(const IntegrationContext& ctx);

@@ -30,7 +30,7 @@ namespace gk = gauss_kronrod;
 using adaptive_detail::rounding_bound;
 
 AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx)
-    : Integrator(ctx), kind_(accumulation(ctx.render.projection)), maximum_(takes_maximum(ctx.render.projection)),
+    : OneLoopIntegrator(ctx), kind_(accumulation(ctx.render.projection)), maximum_(takes_maximum(ctx.render.projection)),
       mean_(takes_mean(ctx.render.projection)) {
     const RenderSpec& r = ctx.render;
     // Resumable for the accumulations whose parts are independent (extremum, line integral): each
@@ -72,21 +72,15 @@ AdaptiveIntegrator::AdaptiveIntegrator(const IntegrationContext& ctx)
 
 double AdaptiveIntegrator::safety() const { return weak_ ? conventions::kAdaptiveWeakSafety : 1.0; }
 
-void AdaptiveIntegrator::run(const RayBatch& b) const {
-    if (b.recorder) not_traced();
-    for (int i = 0; i < b.count; ++i) {
-        if (b.resuming()) {
-            resume(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
-            continue;
-        }
-        switch (kind_) {
-            case Accumulation::Composite: b.out[i] = composite(b.rays[i], b.intervals[i]); break;
-            case Accumulation::LineIntegral: b.out[i] = line_integral(b.rays[i], b.intervals[i]); break;
-            case Accumulation::Extremum: b.out[i] = extremum(b.rays[i], b.intervals[i]); break;
-            case Accumulation::FirstHit:  // FirstHitIntegrator
-                throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
-        }
+// Every ray by its pieces; there is no traced loop.
+PixelValue AdaptiveIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, NoRecording&) const {
+    switch (kind_) {
+        case Accumulation::Composite: return composite(ray, intervals);
+        case Accumulation::LineIntegral: return line_integral(ray, intervals);
+        case Accumulation::Extremum: return extremum(ray, intervals);
+        case Accumulation::FirstHit: break;  // FirstHitIntegrator
     }
+    throw Error("render.integrator: internal: the adaptive integrator has no first-hit path");
 }
 
 // The part of `iv` whose pieces a span can own: [t0 - m, t1 + m] of the span with m two of the ray's
@@ -509,8 +503,8 @@ glm::dvec4 AdaptiveIntegrator::extremum_rgba(const Ray& ray, double t) const {
     return glm::dvec4(p.opacity * p.color, p.opacity);
 }
 
-void AdaptiveIntegrator::resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                RayState& state) const {
+void AdaptiveIntegrator::integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                             RayState& state) const {
     RayState part;
     switch (kind_) {
         case Accumulation::Extremum: {

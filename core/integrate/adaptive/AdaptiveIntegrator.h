@@ -64,14 +64,13 @@ class ShellGrid;
 class TransferFunction;
 class VolumeSampler;
 
-class AdaptiveIntegrator final : public Integrator {
+class AdaptiveIntegrator final : public OneLoopIntegrator<AdaptiveIntegrator> {
 public:
     // Throws volref::Error (naming render.integrator) for what it does not integrate.
     explicit AdaptiveIntegrator(const IntegrationContext& ctx);
-    // Whole rays and spans (RayBatch), every ray by its pieces; the error channel always. Resumable for
-    // mip, minip, average and x-ray: the pieces whose midpoints a span owns. Not the composite, whose
-    // state (AdaptiveComposite) volref-mpi hands on itself. There is no traced loop.
-    void run(const RayBatch& batch) const override;
+    // Whole rays and spans (RayBatch, OneLoopIntegrator), every ray by its pieces; the error channel
+    // always. Resumable for mip, minip, average and x-ray: the pieces whose midpoints a span owns. Not
+    // the composite, whose state (AdaptiveComposite) volref-mpi hands on itself. There is no traced loop.
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
@@ -125,7 +124,9 @@ public:
     double line_budget(double length) const;
 
 private:
-    void resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
+    friend class OneLoopIntegrator<AdaptiveIntegrator>;
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, NoRecording& rec) const;
+    void integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     PixelValue composite(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue line_integral(const Ray& ray, const std::vector<Interval>& intervals) const;
     PixelValue extremum(const Ray& ray, const std::vector<Interval>& intervals) const;

@@ -81,26 +81,12 @@ struct CompositeRecords {
 
 }  // namespace
 
-void CompositeIntegrator::run(const RayBatch& b) const {
-    const bool packets = packet_ && (b.simd || packets_only_);
-    if (b.recorder) {
-        if (packets_only_) fast_profile_not_traced();
-        Recording rec{*b.recorder};
-        b.out[0] = whole_ray(b.rays[0], b.intervals[0], rec);
-        return;
-    }
-    if (b.resuming()) {
-        if (packets) return composite_packet(ctx_.pipeline.view(), *packet_, b.rays, b.intervals, nullptr, b.count, b.spans, b.states);
-        for (int i = 0; i < b.count; ++i) resume(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
-        return;
-    }
-    if (packets) return composite_packet(ctx_.pipeline.view(), *packet_, b.rays, b.intervals, b.out, b.count);
-    NoRecording rec;
-    for (int i = 0; i < b.count; ++i) b.out[i] = whole_ray(b.rays[i], b.intervals[i], rec);
+void CompositeIntegrator::integrate_packets(const RayBatch& b) const {
+    composite_packet(ctx_.pipeline.view(), *packet_, b.rays, b.intervals, b.resuming() ? nullptr : b.out, b.count, b.spans, b.states);
 }
 
 template <class Rec>
-PixelValue CompositeIntegrator::whole_ray(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
+PixelValue CompositeIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const {
     PixelValue out;
     if (ctx_.render.order == CompositeOrder::FrontToBack) {
         FrontToBack<Scalar> acc;
@@ -116,8 +102,8 @@ PixelValue CompositeIntegrator::whole_ray(const Ray& ray, const std::vector<Inte
 
 // Front to back: the state is FrontToBack's, resumed (composite_state, march/SpanStates.h). Back to
 // front: the span's part from a fresh BackToFront, put behind the state.
-void CompositeIntegrator::resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                 RayState& state) const {
+void CompositeIntegrator::integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                              RayState& state) const {
     if (state.stopped != 0.0) return;
     NoRecording rec;
     if (ctx_.render.order == CompositeOrder::FrontToBack) {
@@ -184,5 +170,10 @@ void CompositeIntegrator::back_to_front(const Ray& ray, const std::vector<Interv
         return true;
     });
 }
+
+// The two loops OneLoopIntegrator calls (its run() is instantiated where the class is constructed,
+// which does not see this definition).
+template PixelValue CompositeIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, NoRecording&) const;
+template PixelValue CompositeIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, Recording&) const;
 
 }  // namespace volref

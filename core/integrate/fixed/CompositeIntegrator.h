@@ -35,27 +35,28 @@ namespace volref {
 // front-to-back integrator of the reference applies it (the composite and the several-volume mix).
 Termination early_termination(const RenderSpec& render);
 
-class CompositeIntegrator final : public Integrator {
+class CompositeIntegrator final : public OneLoopIntegrator<CompositeIntegrator> {
 public:
     explicit CompositeIntegrator(const IntegrationContext& ctx);
     ~CompositeIntegrator() override;
-    // Whole rays, spans and traces (RayBatch): the SIMD path (PacketComposite.h) where the scene allows
-    // it and the batch asks for it, else the scalar loops below; the fast profile (FastProfile.h) has
-    // only its packet path. Resuming: front to back continues FrontToBack's state (composite_state,
-    // SpanStates.h); back to front puts each span's part behind the state; the fast profile continues
-    // its float transmittance product (product_state).
-    void run(const RayBatch& batch) const override;
+    // Whole rays, spans and traces (RayBatch, OneLoopIntegrator): the SIMD path (PacketComposite.h)
+    // where the scene allows it and the batch asks for it, else the scalar loops below; the fast
+    // profile (FastProfile.h) has only its packet path. Resuming: front to back continues FrontToBack's
+    // state (composite_state, SpanStates.h); back to front puts each span's part behind the state; the
+    // fast profile continues its float transmittance product (product_state).
     bool has_packet_path() const { return packet_.has_value(); }
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
 private:
+    friend class OneLoopIntegrator<CompositeIntegrator>;
     // Rec: NoRecording (the render) or Recording (trace); SampleRecorder.h. The one loop of each
     // order, over the samples `span` owns, continuing `acc`; front_to_back returns true once the ray
     // stops (opaque or terminated early).
     template <class Rec>
-    PixelValue whole_ray(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
-    void resume(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, Rec& rec) const;
+    void integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
+    void integrate_packets(const RayBatch& batch) const;
     template <class Rec>
     bool front_to_back(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                        FrontToBack<Scalar>& acc, Rec& rec) const;
@@ -63,8 +64,6 @@ private:
     void back_to_front(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
                        BackToFront<Scalar>& acc, Rec& rec) const;
     Termination termination_;  // early_termination(render)
-    // The lanes are float (the fast profile): the packet path is the only one, its state product_state.
-    bool packets_only_ = false;
     std::optional<PacketRun> packet_;  // set when the SIMD path applies (the volume: ctx.pipeline.view())
 };
 

@@ -10,7 +10,7 @@
 namespace volref {
 
 CompositeIntegrator::CompositeIntegrator(const IntegrationContext& ctx)
-    : Integrator(ctx), termination_(early_termination(ctx.render)) {
+    : OneLoopIntegrator(ctx), termination_(early_termination(ctx.render)) {
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     packets_only_ = fast;
     // The spans resume in ray order where a ray can stop early (the termination the path applies).

@@ -11,7 +11,7 @@
 
 namespace volref {
 
-ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : Integrator(ctx), maximum_(maximum) {
+ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maximum) : OneLoopIntegrator(ctx), maximum_(maximum) {
     const bool fast = ctx.lanes == IntegrationContext::Lanes::Float;
     packets_only_ = fast;
     traits_.resumable = true;
@@ -25,43 +25,29 @@ ExtremumIntegrator::ExtremumIntegrator(const IntegrationContext& ctx, bool maxim
 
 ExtremumIntegrator::~ExtremumIntegrator() = default;
 
-void ExtremumIntegrator::run(const RayBatch& b) const {
-    const bool packets = packet_ && (b.simd || packets_only_);
-    if (b.recorder) {
-        if (packets_only_) fast_profile_not_traced();
-        Recording rec{*b.recorder};
-        b.out[0] = integrate_impl(b.rays[0], b.intervals[0], rec);
-        return;
+// The packets' extrema (bitwise the scalar loop's), classified here: the pixels, or each span's
+// extremum behind its state (extremum_state, march/SpanStates.h).
+void ExtremumIntegrator::integrate_packets(const RayBatch& b) const {
+    RayExtremum e[kMaxPacketRays];
+    extremum_packet(ctx_.pipeline.view(), *packet_, maximum_, b.rays, b.intervals, e, b.count, b.spans);
+    for (int i = 0; i < b.count; ++i) {
+        if (!b.resuming()) b.out[i] = pixel(b.rays[i], e[i].any, e[i].t);
+        else if (e[i].any) merge_extremum(b.rays[i], e[i].value, e[i].t, b.states[i]);
     }
-    if (b.resuming()) {
-        // A span's extremum (the packet path wherever it applies: bitwise the scalar one), classified
-        // here, behind the state (extremum_state, march/SpanStates.h).
-        RayExtremum e[kMaxPacketRays];
-        if (packet_) {
-            extremum_packet(ctx_.pipeline.view(), *packet_, maximum_, b.rays, b.intervals, e, b.count, b.spans);
-        } else {
-            NoRecording rec;
-            for (int i = 0; i < b.count; ++i) {
-                const Extremum<Scalar> acc = extremum(b.rays[i], b.intervals[i], b.spans[i], rec);
-                e[i] = RayExtremum{acc.any(), acc.value(), acc.where()};
-            }
-        }
-        for (int i = 0; i < b.count; ++i) {
-            if (!e[i].any) continue;
-            RayState part;
-            extremum_state::save(e[i].value, e[i].t, pixel(b.rays[i], true, e[i].t).rgba, part);
-            extremum_state::merge(b.states[i], part, maximum_);
-        }
-        return;
-    }
-    if (packets) {
-        RayExtremum e[kMaxPacketRays];
-        extremum_packet(ctx_.pipeline.view(), *packet_, maximum_, b.rays, b.intervals, e, b.count);
-        for (int i = 0; i < b.count; ++i) b.out[i] = pixel(b.rays[i], e[i].any, e[i].t);
-        return;
-    }
+}
+
+void ExtremumIntegrator::integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                             RayState& state) const {
     NoRecording rec;
-    for (int i = 0; i < b.count; ++i) b.out[i] = integrate_impl(b.rays[i], b.intervals[i], rec);
+    const Extremum<Scalar> acc = extremum(ray, intervals, span, rec);
+    if (acc.any()) merge_extremum(ray, acc.value(), acc.where(), state);
+}
+
+// A span's extremum `value` at t, classified by the span that took it, behind `state`.
+void ExtremumIntegrator::merge_extremum(const Ray& ray, double value, double t, RayState& state) const {
+    RayState part;
+    extremum_state::save(value, t, pixel(ray, true, t).rgba, part);
+    extremum_state::merge(state, part, maximum_);
 }
 
 // With Rec::kOn each sample is also classified (unshaded, for the record) and the record carries the
@@ -119,5 +105,9 @@ PixelValue ExtremumIntegrator::pixel(const Ray& ray, bool any, double t_best) co
     }
     return out;
 }
+
+// The two loops OneLoopIntegrator calls (its run() is instantiated where the class is constructed).
+template PixelValue ExtremumIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, NoRecording&) const;
+template PixelValue ExtremumIntegrator::integrate_impl(const Ray&, const std::vector<Interval>&, Recording&) const;
 
 }  // namespace volref

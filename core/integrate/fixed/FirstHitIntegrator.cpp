@@ -66,7 +66,7 @@ std::optional<double> first_crossing_in_cell(const VolumeSampler& sampler, const
     return std::nullopt;
 }
 
-FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrator(ctx) {
+FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : OneLoopIntegrator(ctx) {
     const VolumeSampler* s = ctx.pipeline.view().cartesian;
     if (s && s->interpolation() == Interpolation::Trilinear) trilinear_ = s;
     adaptive_ = ctx.render.integrator == IntegrationMethod::Adaptive;
@@ -79,23 +79,16 @@ FirstHitIntegrator::FirstHitIntegrator(const IntegrationContext& ctx) : Integrat
 }
 
 // A whole ray is its one span, finished; there is no traced loop.
-void FirstHitIntegrator::run(const RayBatch& b) const {
-    if (b.recorder) not_traced();
-    for (int i = 0; i < b.count; ++i) {
-        if (b.resuming()) {
-            search(b.rays[i], b.intervals[i], b.spans[i], b.states[i]);
-        } else {
-            RayState state;
-            search(b.rays[i], b.intervals[i], RaySpan{}, state);
-            b.out[i] = finish(b.rays[i], b.intervals[i], state);
-        }
-    }
+PixelValue FirstHitIntegrator::integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, NoRecording&) const {
+    RayState state;
+    integrate_span_impl(ray, intervals, RaySpan{}, state);
+    return finish(ray, intervals, state);
 }
 
 // The one search: the brackets (segments) or cell pieces whose midpoints `span` owns, front to back;
 // a hit is classified here and stops the ray (hit_state, march/SpanStates.h).
-void FirstHitIntegrator::search(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
-                                RayState& state) const {
+void FirstHitIntegrator::integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span,
+                                             RayState& state) const {
     if (state.stopped != 0.0) return;
     const double iso = *ctx_.render.isovalue;
     auto g = [&](double t) { return ctx_.field(ray, t) - iso; };

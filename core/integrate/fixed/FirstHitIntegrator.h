@@ -24,17 +24,18 @@ namespace volref {
 
 class VolumeSampler;
 
-class FirstHitIntegrator final : public Integrator {
+class FirstHitIntegrator final : public OneLoopIntegrator<FirstHitIntegrator> {
 public:
     explicit FirstHitIntegrator(const IntegrationContext& ctx);
-    // Whole rays and spans (RayBatch): the search over a span's brackets or pieces; a hit stops the ray.
-    // The depth channel always, the error channel with render.integrator "adaptive".
-    void run(const RayBatch& batch) const override;
+    // Whole rays and spans (RayBatch, OneLoopIntegrator): the search over a span's brackets or pieces; a
+    // hit stops the ray. The depth channel always, the error channel with render.integrator "adaptive".
     void merge_spans(RayState& front, const RayState& back) const override;
     PixelValue finish(const Ray& ray, const std::vector<Interval>& intervals, const RayState& state) const override;
 
 private:
-    void search(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
+    friend class OneLoopIntegrator<FirstHitIntegrator>;
+    PixelValue integrate_impl(const Ray& ray, const std::vector<Interval>& intervals, NoRecording& rec) const;
+    void integrate_span_impl(const Ray& ray, const std::vector<Interval>& intervals, const RaySpan& span, RayState& state) const;
     const VolumeSampler* trilinear_ = nullptr;  // Cartesian trilinear sampler, else null
     bool adaptive_ = false;
 };

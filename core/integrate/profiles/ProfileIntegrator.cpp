@@ -29,14 +29,14 @@ namespace volref {
 
 void check_profile_applies(const Profile& p, const SamplePipeline& pipeline, const RenderSpec& r) {
     const std::string where = std::string("render.profile: \"") + p.name + "\" ";
-    if (r.projection == Projection::FirstHit) throw Error(where + "does not render the first-hit projection");
+    if (is_first_hit(r.projection)) throw Error(where + "does not render the first-hit projection");
     if (r.integrator != IntegrationMethod::Fixed) throw Error(where + "needs render.integrator \"fixed\"");
     if (r.order != CompositeOrder::FrontToBack)
         throw Error(where + "composites in its own order (remove render.order \"back-to-front\")");
     if (r.early_termination) throw Error(where + "has its own termination rule (remove render.early_termination)");
     if (!pipeline.view().cartesian && p.grids == Profile::Grids::Cartesian)
         throw Error(where + "needs a Cartesian grid (box or mesh bounds)");
-    if (p.grids == Profile::Grids::CartesianAndShells && pipeline.shaded() && r.projection == Projection::Composite)
+    if (p.grids == Profile::Grids::CartesianAndShells && pipeline.shaded() && is_composite(r.projection))
         throw Error(where + "does not shade (remove volume.shading)");
     if (pipeline.preclassified()) throw Error(where + "classifies after interpolation (volume.classify \"post\")");
     if (pipeline.classifier().needs_gradient())
@@ -170,7 +170,7 @@ void ProfileIntegrator::check_rules(const RenderSpec& render, bool cartesian) co
     if (r.ray_box && *r.ray_box != ProfileRules::RayBox::Domain && !cartesian) fail("ray_box", "a texel or given box needs a Cartesian grid");
     const Termination& t = p_.termination;
     const bool stops = t.test_alpha_above || t.test_alpha_at_least || t.test_transmittance;
-    const bool composite = render.projection == Projection::Composite;
+    const bool composite = is_composite(render.projection);
     if (composite && p_.compositing == Profile::Compositing::Lerp) {
         if (r.termination && *r.termination != ProfileRules::Stop::None)
             fail("termination", "lerp compositing runs back to front and has no termination");

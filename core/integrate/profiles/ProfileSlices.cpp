@@ -78,7 +78,7 @@ void ProfileIntegrator::prepare_slices(const Volume& volume, const SliceFrame& f
         fail(r.placement ? "placement" : "base", "a slicer composites its slices (projection \"composite\") or takes their maximum (\"mip\" with blend \"max\")");
     if (proj == Projection::Mip && p_.blend != Profile::Blend::Max) fail("blend", "the mip projection of a slicer is GL_MAX (blend \"max\")");
     if (proj == Projection::Composite && p_.blend == Profile::Blend::Max) fail("blend", "\"max\" is the mip projection's (render.projection \"mip\")");
-    if (ctx_.pipeline.shaded() && proj == Projection::Composite) fail("placement", "\"slices\" does not shade (remove volume.shading)");
+    if (ctx_.pipeline.shaded() && is_composite(proj)) fail("placement", "\"slices\" does not shade (remove volume.shading)");
     if (p_.slices.order == ProfileRules::Slices::Order::FrontToBack && p_.blend == Profile::Blend::SrcAlpha)
         fail("slices", "front to back blends the premultiplied fragment under the frame buffer (blend \"premultiplied\")");
     if (band_) throw Error("render.profile_options.texture_band: not derived for placement \"slices\" (framebuffer_band is its band)");

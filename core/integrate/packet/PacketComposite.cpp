@@ -663,10 +663,7 @@ void composite_all(const VolumeView& in, const PacketRun& run, const Ray* rays, 
 
 void CompositePacket(const VolumeView& in, const PacketRun& run, const Ray* rays, const std::vector<Interval>* intervals,
                      PixelValue* out, int count, const RaySpan* spans, RayState* states) {
-    if (run.fast)
-        composite_all<float>(in, run, rays, intervals, out, count, spans, states);
-    else
-        composite_all<double>(in, run, rays, intervals, out, count, spans, states);
+    on_lanes(run.fast, [&]<typename T>() HWY_ATTR { composite_all<T>(in, run, rays, intervals, out, count, spans, states); });
 }
 
 }  // namespace HWY_NAMESPACE

@@ -71,10 +71,7 @@ void extremum_all(const VolumeView& view, const PacketRun& run, bool maximum, co
 
 void ExtremumPacket(const VolumeView& view, const PacketRun& run, bool maximum, const Ray* rays, const std::vector<Interval>* intervals,
                     RayExtremum* out, int count, const RaySpan* spans) {
-    if (run.fast)
-        extremum_all<float>(view, run, maximum, rays, intervals, out, count, spans);
-    else
-        extremum_all<double>(view, run, maximum, rays, intervals, out, count, spans);
+    on_lanes(run.fast, [&]<typename T>() HWY_ATTR { extremum_all<T>(view, run, maximum, rays, intervals, out, count, spans); });
 }
 
 }  // namespace HWY_NAMESPACE

@@ -51,6 +51,14 @@ HWY_INLINE hn::Vec<DT> to_lanes(DT d, V32 v) {
 // The lane operations of core/Lanes.h on Highway vectors (core/SimdLanes-inl.h).
 using ::volref::HWY_NAMESPACE::SimdLanes;
 
+// Calls kernel.template operator()<T>() with T the packets' lane type: float for the fast profile
+// (`fast`), double for the reference.
+template <class Kernel>
+HWY_INLINE void on_lanes(bool fast, const Kernel& kernel) {
+    if (fast) kernel.template operator()<float>();
+    else kernel.template operator()<double>();
+}
+
 // The optical model and the accumulators, compiled for this target.
 #include "transfer/OpacityCorrection-inl.h"
 #include "core/integrate/march/Accumulators-inl.h"

@@ -9,7 +9,7 @@
 
 #include "core/grid/VoxelArray.h"
 #include "core/integrate/march/March.h"
-#include "core/render/Renderer.h"
+#include "core/render/PixelBlocks.h"
 
 namespace volref::mpi {
 
@@ -18,7 +18,7 @@ WorkBins count_work(const Frame& f) {
     constexpr int kProbeBlocks = 2;    // packets: every 2nd block of pixels on both axes
     constexpr std::int64_t kWorkBins = 16;
     WorkBins bins(f.lattice, kWorkBins);
-    const PreparedVolume& first = *f.members[0].prepared;
+    const PreparedVolume& first = f.volume(0);
     const GridBox& g = f.members[0].grid;
     MarchOptions o;
     o.step = first.step;
@@ -41,40 +41,38 @@ WorkBins count_work(const Frame& f) {
         for (int y = kProbe / 2; y < f.height(); y += kProbe)
             for (int x0 = kProbe / 2; x0 < f.width(); x0 += kProbe * kMaxPacketRays) {
                 int n = 0;
-                for (int x = x0; x < f.width() && n < kMaxPacketRays; x += kProbe) world[n++] = f.camera->pixel_ray(x, y);
-                f.volume_intervals(0, world, n, rays, intervals);
+                for (int x = x0; x < f.width() && n < kMaxPacketRays; x += kProbe) world[n++] = f.camera().pixel_ray(x, y);
+                first.intervals(world, n, rays, intervals);
                 for (int i = 0; i < n; ++i) walk(i, [&](const glm::dvec3& u) { bins.work[bins.bin_of(f.lattice, u)] += 1.0; });
             }
         return bins;
     }
-    // The fixed step: packets of kWorkPacketLanes rays with a span, from blocks as the render makes them
-    // (main.cpp integrate_parts), costed by add_packet_work (Bricks.h).
+    // The fixed step: packets of kWorkPacketLanes rays with a span, from every kProbeBlocks-th block of the
+    // render's (PixelBlocks.h; main.cpp integrate_parts), costed by add_packet_work (Bricks.h).
     const std::int64_t voxel_bytes = f.scene.render.profile == ProfileId::Fast
                                          ? std::int64_t(sizeof(float))
                                          : std::int64_t(scalar_type_size(first.model.volume().values.type()));
     std::vector<LaneSample> lanes[kWorkPacketLanes];
-    for (int by = 0; by < f.height(); by += kPixelBlockHeight * kProbeBlocks)
-        for (int bx = 0; bx < f.width(); bx += kPixelBlockWidth * kProbeBlocks) {
-            int n = 0;
-            for (int y = by; y < std::min(by + kPixelBlockHeight, f.height()); ++y)
-                for (int x = bx; x < std::min(bx + kPixelBlockWidth, f.width()); ++x) world[n++] = f.camera->pixel_ray(x, y);
-            f.volume_intervals(0, world, n, rays, intervals);
-            int count = 0;
-            for (int i = 0; i < n; ++i) {
-                const bool owned = walk(i, [&](const glm::dvec3& u) {
-                    const std::int64_t c[3] = {std::int64_t(std::floor(u.x)), std::int64_t(std::floor(u.y)), std::int64_t(std::floor(u.z))};
-                    const std::int64_t voxel = c[0] + g.dims[0] * (c[1] + g.dims[1] * c[2]);
-                    lanes[count].push_back({bins.bin_of(f.lattice, u), voxel * voxel_bytes / kWorkLineBytes});
-                });
-                if (owned && ++count == kWorkPacketLanes) {
-                    add_packet_work(lanes, count, bins.work);
-                    for (auto& l : lanes) l.clear();
-                    count = 0;
-                }
+    for_each_block(PixelRect{0, 0, f.width(), f.height()}, [&](const PixelBlock& b) {
+        const int n = b.count;
+        for (int i = 0; i < n; ++i) world[i] = f.camera().pixel_ray(b.x[i], b.y[i]);
+        first.intervals(world, n, rays, intervals);
+        int count = 0;
+        for (int i = 0; i < n; ++i) {
+            const bool owned = walk(i, [&](const glm::dvec3& u) {
+                const std::int64_t c[3] = {std::int64_t(std::floor(u.x)), std::int64_t(std::floor(u.y)), std::int64_t(std::floor(u.z))};
+                const std::int64_t voxel = c[0] + g.dims[0] * (c[1] + g.dims[1] * c[2]);
+                lanes[count].push_back({bins.bin_of(f.lattice, u), voxel * voxel_bytes / kWorkLineBytes});
+            });
+            if (owned && ++count == kWorkPacketLanes) {
+                add_packet_work(lanes, count, bins.work);
+                for (auto& l : lanes) l.clear();
+                count = 0;
             }
-            if (count > 0) add_packet_work(lanes, count, bins.work);
-            for (auto& l : lanes) l.clear();
         }
+        if (count > 0) add_packet_work(lanes, count, bins.work);
+        for (auto& l : lanes) l.clear();
+    }, kProbeBlocks);
     return bins;
 }
 

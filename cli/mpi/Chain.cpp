@@ -16,7 +16,7 @@
 
 #include "core/integrate/adaptive/AdaptiveIntegrator.h"
 #include "core/integrate/march/SpanStates.h"
-#include "core/render/Renderer.h"
+#include "core/render/PixelBlocks.h"
 
 namespace volref::mpi {
 
@@ -125,27 +125,24 @@ private:
 // 2 ranks on the adaptive scene: the rank behind waited 0.52 s of a 1.5 s chain for states its front
 // rank had finished; with the sender's progress 0.11 s, a handshake per block; see performance.md).
 // A block is a tile of kChainTile x kChainTile pixels (fewer at the image's edges), its pixels in
-// `volref render`'s order (Renderer.h): kPixelBlockWidth x kPixelBlockHeight blocks in row order, row
-// order inside each, so that a batch of kMaxPacketRays of them (fixed_chain) makes the render's packets
-// (4 x 4 on 16 float lanes) and not rows of 16 x 1: with blocks of 256 pixels in rows the fast profile's
-// chained frame was 1.15x slower at one rank (docs/performance.md, "volref-mpi on
+// `volref render`'s order (PixelBlocks.h for_each_block: kPixelBlockWidth x kPixelBlockHeight blocks in
+// row order, row order inside each), so that a batch of kMaxPacketRays of them (fixed_chain) makes the
+// render's packets (4 x 4 on 16 float lanes) and not rows of 16 x 1: with blocks of 256 pixels in rows
+// the fast profile's chained frame was 1.15x slower at one rank (docs/performance.md, "volref-mpi on
 // the resumable march").
 constexpr int kChainTile = 16;
 constexpr std::size_t kChainBlock = std::size_t(kChainTile) * kChainTile;
 static_assert(kChainTile % kPixelBlockWidth == 0 && kChainTile % kPixelBlockHeight == 0);
-// The chain's blocks in the order every rank takes them, each block's pixels in order.
+// The chain's blocks (its tiles, in row order) in the order every rank takes them, each block's pixels
+// in order.
 std::vector<std::vector<std::size_t>> chain_blocks(const Frame& frame) {
-    const int W = frame.width(), H = frame.height();
-    std::vector<std::vector<std::size_t>> blocks;
-    for (int ty = 0; ty < H; ty += kChainTile)
-        for (int tx = 0; tx < W; tx += kChainTile) {
-            std::vector<std::size_t>& b = blocks.emplace_back();
-            for (int by = ty; by < std::min(ty + kChainTile, H); by += kPixelBlockHeight)
-                for (int bx = tx; bx < std::min(tx + kChainTile, W); bx += kPixelBlockWidth)
-                    for (int y = by; y < std::min({by + kPixelBlockHeight, ty + kChainTile, H}); ++y)
-                        for (int x = bx; x < std::min({bx + kPixelBlockWidth, tx + kChainTile, W}); ++x)
-                            b.push_back(std::size_t(y) * std::size_t(W) + std::size_t(x));
-        }
+    const TileGrid tiles(frame.width(), frame.height(), kChainTile);
+    std::vector<std::vector<std::size_t>> blocks(std::size_t(tiles.count()));
+    for (int t = 0; t < tiles.count(); ++t)
+        for_each_block(tiles.tile(t), [&](const PixelBlock& b) {
+            for (int i = 0; i < b.count; ++i)
+                blocks[std::size_t(t)].push_back(std::size_t(b.y[i]) * std::size_t(frame.width()) + std::size_t(b.x[i]));
+        });
     return blocks;
 }
 // Pixels a thread between two of MPI's progress calls (about 2 ms of the adaptive scene's work).
@@ -313,13 +310,13 @@ bool fixed_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
     PartBuffer& state = buf.state;  // fresh states (all zero)
-    const PreparedVolume& first = *frame.members[0].prepared;
+    const PreparedVolume& first = frame.volume(0);
     auto one = [&](std::size_t px, PixelRays& scratch) {
         double* s = &state[px * S];
         scratch.of(frame, px);
         RayState st = RayState::read(s);
         const RaySpan span = frame.span(scratch.rays[0]);
-        if (frame.mixed()) frame.multi->composite_span(scratch.rays.data(), scratch.intervals.data(), span, st);
+        if (frame.mixed()) frame.multi().composite_span(scratch.rays.data(), scratch.intervals.data(), span, st);
         else first.integrator->integrate_span(scratch.rays[0], scratch.intervals[0], span, st);
         st.write(s);
     };
@@ -336,7 +333,7 @@ bool fixed_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
         RaySpan spans[kMaxPacketRays];
         RayState states[kMaxPacketRays];
         std::size_t at[kMaxPacketRays];
-        for (std::size_t i = 0; i < n; ++i) world[i] = frame.camera->pixel_ray(int(px[i] % W), int(px[i] / W)), at[i] = px[i];
+        for (std::size_t i = 0; i < n; ++i) world[i] = frame.camera().pixel_ray(int(px[i] % W), int(px[i] / W)), at[i] = px[i];
         const int count = frame.owned_rays(world, int(n), rays, intervals, spans, at, [&](std::size_t p) {
             return RayState::read(&state[p * S]).stopped != 0.0;
         });
@@ -387,7 +384,7 @@ bool adaptive_pieces(const Frame& frame, const AdaptiveIntegrator* one, std::vec
         } else {
             const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
             for (std::size_t i = 0; i < ps.size(); ++i) {
-                frame.multi->adaptive_cuts(scratch.rays.data(), ps[i], all, cut);
+                frame.multi().adaptive_cuts(scratch.rays.data(), ps[i], all, cut);
                 for (std::size_t q = 0; q + 1 < all.size(); ++q) keep(all[q], all[q + 1], i);
             }
         }
@@ -412,7 +409,7 @@ bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
     const std::size_t P = frame.pixels(), V = frame.volumes(), S = std::size_t(Composite::kStateSize);
     // The volume's adaptive integrator (one volume): made from its context, as the mix makes its own.
     std::unique_ptr<AdaptiveIntegrator> made;
-    if (V == 1) made = std::make_unique<AdaptiveIntegrator>(*frame.members[0].prepared->context);
+    if (V == 1) made = std::make_unique<AdaptiveIntegrator>(*frame.volume(0).context);
     const AdaptiveIntegrator* one = made.get();
     std::vector<std::vector<std::array<double, 3>>> pieces(P);  // [a, b, union piece]
     std::vector<double> key, total(P, 0.0);
@@ -420,7 +417,7 @@ bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
     const RankOrder order = rank_order(frame, key);
     bytes = P * sizeof(double) * std::size_t(frame.size);
     const double tolerance = frame.scene.render.tolerance;
-    const double safety = V == 1 ? one->safety() : frame.multi->adaptive_safety();
+    const double safety = V == 1 ? one->safety() : frame.multi().adaptive_safety();
     const AdaptiveIntegrator::OneVolume none{one, nullptr};  // (a medium never sampled)
     PartBuffer& state = buf.state;
     const Composite fresh(none, tolerance, safety, 1.0);
@@ -442,7 +439,7 @@ bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
             return;
         }
         const auto ps = MultiVolumeIntegrator::pieces(scratch.intervals.data(), V);
-        MultiVolumeIntegrator::AdaptiveMix medium = frame.multi->adaptive_mix(rays.data());
+        MultiVolumeIntegrator::AdaptiveMix medium = frame.multi().adaptive_mix(rays.data());
         MixComposite st(medium, tolerance, safety, total[px]);
         st.load(s);
         std::vector<MultiVolumeIntegrator::MixTerm> opaque;
@@ -450,7 +447,7 @@ bool adaptive_chain(const Frame& frame, ChainBuffers& buf, std::size_t& bytes) {
             if (st.is_opaque()) break;
             const std::vector<int>& present = ps[std::size_t(piece[2])].present;
             medium.present = &present;
-            frame.multi->adaptive_piece(rays.data(), present, piece[0], piece[1], st, opaque);
+            frame.multi().adaptive_piece(rays.data(), present, piece[0], piece[1], st, opaque);
         }
         st.save(s);
         leaves[px] = st.leaves();
@@ -512,7 +509,7 @@ bool chained(const Frame& frame) {
     if (!is_composite(frame.scene.render.projection)) return false;
     if (frame.adaptive()) return true;
     if (frame.size == 1) return false;  // one span a pixel: nothing to hand on, the parts' path (as volref render)
-    return frame.mixed() ? frame.multi->composite_spans_in_order() : frame.members[0].prepared->integrator->spans_in_order();
+    return frame.mixed() ? frame.multi().composite_spans_in_order() : frame.volume(0).integrator->spans_in_order();
 }
 
 ChainBuffers fresh_chain(const Frame& frame) {

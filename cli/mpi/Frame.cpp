@@ -7,8 +7,6 @@
 
 #include "core/integrate/march/SpanStates.h"
 #include "geometry/BoxIntersection.h"
-#include "geometry/ClipPlanes.h"
-#include "geometry/CropRegions.h"
 
 namespace volref::mpi {
 
@@ -36,22 +34,8 @@ bool any_error(const std::string& mine, int rank, int size) {
 }
 
 void Frame::pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* intervals) const {
-    const Ray world = camera->pixel_ray(x, y);
-    for (std::size_t k = 0; k < volumes(); ++k) volume_intervals(k, &world, 1, &rays[k], &intervals[k]);
-}
-
-void Frame::volume_intervals(std::size_t k, const Ray* world, int count, Ray* local, std::vector<Interval>* out) const {
-    const VolumeSpec& vs = scene.volumes[k];
-    for (int i = 0; i < count; ++i) local[i] = local_ray(k, world[i]);
-    geometry.intervals(local, count, members[k].geometry_id, out);
-    for (int i = 0; i < count; ++i) {
-        if (vs.crop) crop_intervals(local[i], *vs.crop, out[i]);
-        if (!vs.clip_planes.empty()) clip_intervals(world[i], vs.clip_planes, out[i]);
-    }
-}
-
-Ray Frame::local_ray(std::size_t k, const Ray& world) const {
-    return members[k].transform ? members[k].transform->local_ray(world) : world;
+    const Ray world = prepared->pixel_ray(x, y);
+    for (std::size_t k = 0; k < volumes(); ++k) volume(k).intervals(&world, 1, &rays[k], &intervals[k]);
 }
 
 bool Frame::meets_brick_box(const Ray& lattice_ray) const {
@@ -66,7 +50,7 @@ RaySpan Frame::span(const Ray& lattice_ray) const {
 
 bool Frame::meets_brick(const Ray* world, int count) const {
     for (int i = 0; i < count; ++i)
-        if (meets_brick_box(local_ray(0, world[i]))) return true;
+        if (meets_brick_box(volume(0).volume_ray(world[i]))) return true;
     return false;
 }
 
@@ -74,19 +58,19 @@ bool Frame::meets_brick(const Ray* world, int count) const {
 // several-volume mix, whose state is composite_state's (march/SpanStates.h).
 void Frame::merge(std::size_t slot, RayState& front, const RayState& back) const {
     if (mixed()) composite_state::merge(front, back);
-    else members[slot].prepared->integrator->merge_spans(front, back);
+    else volume(slot).integrator->merge_spans(front, back);
 }
 
 PixelValue Frame::finish(std::size_t slot, const Ray* rays, const std::vector<Interval>* intervals,
                          const RayState& state) const {
-    if (!mixed()) return members[slot].prepared->integrator->finish(rays[slot], intervals[slot], state);
+    if (!mixed()) return volume(slot).integrator->finish(rays[slot], intervals[slot], state);
     PixelValue v;
     v.rgba = composite_state::rgba(state);
     return v;
 }
 
 void Frame::write_pixel(const PixelValue* values, const std::vector<Interval>* intervals, double* out) const {
-    const PixelValue v = slots() > 1 ? multi->combine(values, intervals) : values[0];
+    const PixelValue v = slots() > 1 ? multi().combine(values, intervals) : values[0];
     for (int c = 0; c < 4; ++c) out[c] = v.rgba[c];
     if (first_hit()) out[4] = v.depth;
     if (adaptive()) out[channels() - 1] = v.error;

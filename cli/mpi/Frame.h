@@ -1,7 +1,8 @@
 // What one volref-mpi rank builds for a frame (cli/mpi/main.cpp's set-up) and what its stages share:
-// the scene, this rank's brick of every volume with its pipeline and integrator, the camera, the
-// bounding geometry, and the per-pixel queries (rays, intervals, the span this rank owns) and per-slot
-// rules (how parts merge, what pixel they give). docs/architecture.md, "volref-mpi".
+// the scene, this rank's brick of every volume, the PreparedScene `volref render` builds (on the
+// bricks: every volume's pipeline, integrator and bounds, the camera, the several-volume mix), and the
+// per-pixel queries (rays, intervals, the span this rank owns) and per-slot rules (how parts merge,
+// what pixel they give). docs/architecture.md, "volref-mpi".
 #pragma once
 #include <array>
 #include <cstdint>
@@ -15,9 +16,9 @@
 #include "core/camera/Camera.h"
 #include "core/integrate/march/RaySpan.h"
 #include "core/integrate/mix/MultiVolumeIntegrator.h"
+#include "core/render/PreparedScene.h"
 #include "core/render/PreparedVolume.h"
 #include "core/scene/Scene.h"
-#include "geometry/BoundingGeometry.h"
 #include "geometry/VolumeTransform.h"
 #include "cli/mpi/BrickReader.h"
 #include "cli/mpi/Bricks.h"
@@ -25,16 +26,15 @@
 
 namespace volref::mpi {
 
-// One volume of the scene on this rank: its whole grid, the voxels of its brick, its pipeline on them.
+// One volume of the scene on this rank: its whole grid and the voxels of its brick (read_bricks; then
+// handed to the PreparedScene as the volume's data).
 struct Member {
     GridBox grid;
     VolumeLayout header;  // file sources
     int ghost = 1;
     std::array<std::int64_t, 3> vlo{0, 0, 0}, vhi{0, 0, 0};
     Volume brick;
-    std::unique_ptr<PreparedVolume> prepared;
-    int geometry_id = 0;
-    std::optional<VolumeTransform> transform;  // its own space to world (`transform`), if any
+    std::optional<VolumeTransform> transform;  // the grid's space to world (`transform`), if any: grid.to_world
 };
 
 // One pixel's part in a slot: the ray-order key (the t0 of the span it covers; +inf: this rank owns
@@ -53,9 +53,12 @@ struct Frame {
     std::vector<Brick> bricks;
     int rank = 0, size = 1;
     int threads = 0;
-    std::unique_ptr<Camera> camera;
-    BoundingGeometry geometry;
-    std::unique_ptr<MultiVolumeIntegrator> multi;  // several volumes
+    // `volref render`'s PreparedScene over this rank's bricks, each volume bounded by its whole domain
+    // (WholeDomain): the rays, intervals, camera and mix of the single-process render.
+    std::unique_ptr<PreparedScene> prepared;
+    const PreparedVolume& volume(std::size_t k) const { return *prepared->volumes[k]; }
+    const Camera& camera() const { return *prepared->camera; }
+    const MultiVolumeIntegrator& multi() const { return *prepared->multi; }  // several volumes
 
     int width() const { return scene.image.width; }
     int height() const { return scene.image.height; }
@@ -71,21 +74,20 @@ struct Frame {
     int channels() const { return 4 + (first_hit() ? 1 : 0) + (adaptive() ? 1 : 0); }
 
     // Pixel (x, y)'s ray in every volume's own space (rays[k], the same t) and every volume's intervals
-    // (bounds AND domain and crop on the volume's ray, clip planes on the world ray: conventions §4).
+    // (PreparedVolume::intervals: bounds AND domain and crop on the volume's ray, clip planes on the
+    // world ray: conventions §4).
     void pixel_intervals(int x, int y, Ray* rays, std::vector<Interval>* intervals) const;
-    // Volume k's rays and intervals of `count` world rays (<= kMaxPacketRays; Embree packets).
-    void volume_intervals(std::size_t k, const Ray* world, int count, Ray* local, std::vector<Interval>* out) const;
     // The span of the ray this rank owns (`rays[0]`, the first volume's ray: the lattice's space);
     // empty ([+inf, +inf)) when the ray misses the brick's box (padded: every sample a rank owns lies in it).
     RaySpan span(const Ray& lattice_ray) const;
-    // The first volume's rays of `count` world rays (Embree packets, volume_intervals) that this rank owns
-    // a span of and `skip(at[i])` does not refuse, moved to the front in order with their intervals, spans
-    // and `at` (the caller's index of each ray, e.g. its pixel); returns how many. The SIMD packets'
-    // input (integrate_parts, the fixed-step chain).
+    // The first volume's rays of `count` world rays (PreparedVolume::intervals, Embree packets) that this
+    // rank owns a span of and `skip(at[i])` does not refuse, moved to the front in order with their
+    // intervals, spans and `at` (the caller's index of each ray, e.g. its pixel); returns how many. The
+    // SIMD packets' input (integrate_parts, the fixed-step chain).
     template <class Skip>
     int owned_rays(const Ray* world, int count, Ray* rays, std::vector<Interval>* intervals, RaySpan* spans,
                    std::size_t* at, Skip&& skip) const {
-        volume_intervals(0, world, count, rays, intervals);
+        volume(0).intervals(world, count, rays, intervals);
         int owned = 0;
         for (int i = 0; i < count; ++i) {
             const RaySpan s = span(rays[i]);
@@ -100,8 +102,6 @@ struct Frame {
     // Whether any of `count` world rays meets this rank's brick (span()'s first test, on the first
     // volume's rays): a block of rays that all miss it has no span, and is skipped before its intervals.
     bool meets_brick(const Ray* world, int count) const;
-    // Volume k's ray in its own space (its transform's, else the world ray), as volume_intervals gives it.
-    Ray local_ray(std::size_t k, const Ray& world) const;
     // Whether the lattice ray meets this rank's padded brick box (span()'s and meets_brick()'s test).
     bool meets_brick_box(const Ray& lattice_ray) const;
     glm::dvec3 brick_lo{0.0}, brick_hi{0.0};  // this rank's brick's box in the first volume's space, padded

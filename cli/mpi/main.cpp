@@ -2,15 +2,16 @@
 //
 // Space split into bricks over the MPI ranks (cli/mpi/Bricks.h: a k-d split of the first volume's
 // lattice, extended over every volume); each rank holds its brick of every volume plus a ghost layer
-// (read as a sub-box of the file, or generated) and builds `volref render`'s pipeline and integrator
-// on it. A rank owns the span of every ray inside its brick (Bricks.h owned_span: the samples whose
-// position lies in the brick) and integrates it through the integrator's resumable march
-// (Integrator::integrate_span, core/integrate/march/RaySpan.h: the single-process sample lattice, SIMD
-// packets, empty-space skipping); the parts are merged in ray order (Compositing.h: binary swap or
-// direct send), or, where a span depends on what lies in front (early termination, the adaptive
-// composite), the states are handed from rank to rank (Chain.h). Errors of any rank reach rank 0,
-// which prints the one line `volref render` prints (the lowest rank's); every rank exits 1; no file
-// is written. docs/conventions.md §14, docs/architecture.md "volref-mpi", docs/performance.md.
+// (read as a sub-box of the file, or generated) and builds `volref render`'s PreparedScene (pipelines,
+// integrators, camera, mix) on them. A rank owns the span of every ray inside its brick (Bricks.h
+// owned_span: the samples whose position lies in the brick) and integrates it through the integrator's
+// resumable march (Integrator::integrate_span, core/integrate/march/RaySpan.h: the single-process
+// sample lattice, SIMD packets, empty-space skipping); the parts are merged in ray order
+// (Compositing.h: binary swap or direct send), or, where a span depends on what lies in front (early
+// termination, the adaptive composite), the states are handed from rank to rank (Chain.h). Errors of
+// any rank reach rank 0, which prints the one line `volref render` prints (the lowest rank's); every
+// rank exits 1; no file is written. docs/conventions.md §14, docs/architecture.md "volref-mpi",
+// docs/performance.md.
 #include <mpi.h>
 
 #include <algorithm>
@@ -24,8 +25,6 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include "core/Error.h"
@@ -136,9 +135,9 @@ void read_bricks(const Args& args, Frame& f, const std::vector<Brick>* bricks) {
     }
 }
 
-// Set-up, second half: every volume's pipeline and integrator on this rank's brick (the whole
-// volume's data range agreed first: Volume::whole_range), the bounding geometry, the several-volume
-// mix, the camera, and the memory the image's parts will take.
+// Set-up, second half: `volref render`'s PreparedScene on this rank's bricks (the whole volume's data
+// range agreed first: Volume::whole_range; each volume bounded by its whole domain: WholeDomain), and
+// the memory the image's parts will take.
 void prepare(const Args& args, Frame& f, bool swap) {
     for (Member& m : f.members) {
         const auto r = m.brick.value_range();
@@ -147,42 +146,25 @@ void prepare(const Args& args, Frame& f, bool swap) {
         MPI_Allreduce(&hi, &ghi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         m.brick.whole_range = std::array<double, 2>{glo, ghi};
     }
-    RenderOptions options;
-    options.threads = args.threads;
-    std::size_t held = 0;
-    glm::dvec3 view_lo(std::numeric_limits<double>::infinity()), view_hi(-std::numeric_limits<double>::infinity());
+    // The bricks in memory (VolumeSourceSpec::memory): complete, with their own origin (the lower
+    // corner, ghosts included) and the volume's spacing; the scene's file then only names them. The
+    // rays are bounded, and the default camera frames, by the whole volumes' domains.
+    std::vector<WholeDomain> whole;
     for (std::size_t k = 0; k < f.members.size(); ++k) {
         Member& m = f.members[k];
-        // The brick in memory (VolumeSourceSpec::memory): complete, with its own origin (its lower
-        // corner, ghosts included) and the volume's spacing; the scene's file then only names it.
         f.scene.volumes[k].source.memory = std::make_shared<const Volume>(std::move(m.brick));
-        m.prepared = std::make_unique<PreparedVolume>(f.scene, k, options, held);
-        held += m.prepared->bytes;
-        if (!m.prepared->integrator->resumable() && !(f.adaptive() && is_composite(f.scene.render.projection)))
+        const glm::dvec3 last(double(m.grid.dims[0] - 1), double(m.grid.dims[1] - 1), double(m.grid.dims[2] - 1));
+        whole.push_back({m.grid.origin, m.grid.origin + last * m.grid.spacing});
+    }
+    RenderOptions options;
+    options.threads = args.threads;
+    f.prepared = std::make_unique<PreparedScene>(f.scene, options, whole);
+    std::size_t held = 0;
+    for (const auto& v : f.prepared->volumes) {
+        held += v->bytes;
+        if (!v->integrator->resumable() && !(f.adaptive() && is_composite(f.scene.render.projection)))
             throw Error("render: volref-mpi cannot integrate this projection or integrator in parts yet");
-        // The whole volume's box (bounds AND domain): the intervals and the default camera of the
-        // single-process render.
-        const VolumeSpec& vs = f.scene.volumes[k];
-        const glm::dvec3 domain_lo = m.grid.origin;
-        const glm::dvec3 domain_hi =
-            m.grid.origin + glm::dvec3(double(m.grid.dims[0] - 1), double(m.grid.dims[1] - 1), double(m.grid.dims[2] - 1)) * m.grid.spacing;
-        glm::dvec3 lo, hi, world_lo, world_hi;  // the shape AND domain's box, and its world box
-        m.geometry_id = add_cartesian_bounds(f.geometry, vs, volume_key(f.scene, k), domain_lo, domain_hi, lo, hi);
-        world_box(m.transform ? &*m.transform : nullptr, lo, hi, world_lo, world_hi);
-        view_lo = glm::min(view_lo, world_lo);
-        view_hi = glm::max(view_hi, world_hi);
     }
-    f.geometry.commit();
-    if (f.members.size() > 1) {  // the single-process render's mix (composite) and combination (others)
-        std::vector<MultiVolumeIntegrator::Member> list;
-        double step = std::numeric_limits<double>::infinity();
-        for (const Member& m : f.members) {
-            list.push_back({m.prepared->pipeline.get(), m.prepared->integrator.get(), m.prepared->context.get()});
-            step = std::min(step, m.prepared->step);
-        }
-        f.multi = std::make_unique<MultiVolumeIntegrator>(std::move(list), f.scene.render, step);
-    }
-    f.camera = std::make_unique<Camera>(f.scene.camera, f.width(), f.height(), view_lo, view_hi);
     // The brick's box in the first volume's space, padded: the rays worth a span (the span is exact).
     const Brick& brick = f.bricks[std::size_t(f.rank)];
     const GridBox& g = f.members[0].grid;
@@ -226,7 +208,7 @@ PartBuffer fresh_parts(const Frame& f) {
 // the volume allows; several volumes: the mix, or each volume's own integrator).
 void integrate_parts(const Frame& f, PartBuffer& part) {
     const std::size_t V = f.volumes(), slots = f.slots(), W = std::size_t(f.width());
-    const PreparedVolume& first = *f.members[0].prepared;
+    const PreparedVolume& first = f.volume(0);
     auto store = [&](std::size_t px, std::size_t slot, double key, const RayState& st) {
         double* p = &part[(px * slots + slot) * kPart];
         p[0] = key;
@@ -240,26 +222,25 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
         if (!(span.t0 < span.t1)) return;
         RayState st;
         if (f.mixed()) {
-            f.multi->composite_span(rays.data(), intervals.data(), span, st);
+            f.multi().composite_span(rays.data(), intervals.data(), span, st);
             return store(px, 0, span.t0, st);
         }
         for (std::size_t k = 0; k < V; ++k) {
             if (intervals[k].empty()) continue;
             st = RayState{};
-            f.members[k].prepared->integrator->integrate_span(rays[k], intervals[k], span, st);
+            f.volume(k).integrator->integrate_span(rays[k], intervals[k], span, st);
             store(px, k, span.t0, st);
         }
     };
-    static_assert(kPixelBlockWidth * kPixelBlockHeight <= kMaxPacketRays);
-    // `volref render`'s order (Renderer.h): tiles of tile_side() pixels, one task each, of kPixelBlockWidth x
-    // kPixelBlockHeight blocks (the packets of one call to the integrator). The tiles keep neighbouring
-    // rays' voxels in cache: rows of blocks across the image made one rank's frame 1.37x `volref
-    // render`'s on a 256^3 volume (64 MiB).
+    static_assert(kPixelBlockPixels <= kMaxPacketRays);
+    // `volref render`'s order (PixelBlocks.h): tiles of tile_side() pixels, one task each, of blocks of
+    // pixels (the packets of one call to the integrator). The tiles keep neighbouring rays' voxels in
+    // cache: rows of blocks across the image made one rank's frame 1.37x `volref render`'s on a 256^3
+    // volume (64 MiB).
     tbb::task_arena arena(f.threads > 0 ? f.threads : tbb::task_arena::automatic);
-    const int T = tile_side(f.width(), f.height(), arena.max_concurrency());
-    const int tiles_x = (f.width() + T - 1) / T, tiles_y = (f.height() + T - 1) / T;
+    const TileGrid tiles(f.width(), f.height(), tile_side(f.width(), f.height(), arena.max_concurrency()));
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
+        parallel_for_tiles(tiles, [&](const PixelRect& tile) {
             Ray world[kMaxPacketRays], rays[kMaxPacketRays];
             std::vector<Interval> intervals[kMaxPacketRays];
             RaySpan spans[kMaxPacketRays];
@@ -267,32 +248,26 @@ void integrate_parts(const Frame& f, PartBuffer& part) {
             std::size_t at[kMaxPacketRays];
             std::vector<Ray> vrays(V);
             std::vector<std::vector<Interval>> vintervals(V);
-            for (int tile = r.begin(); tile != r.end(); ++tile) {
-                const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
-                const int x_end = std::min(x0 + T, f.width()), y_end = std::min(y0 + T, f.height());
-                for (int by = y0; by < y_end; by += kPixelBlockHeight)
-                for (int bx = x0; bx < x_end; bx += kPixelBlockWidth) {
-                    int n = 0;
-                    for (int y = by; y < std::min(by + kPixelBlockHeight, y_end); ++y)
-                        for (int x = bx; x < std::min(bx + kPixelBlockWidth, x_end); ++x) {
-                            if (V > 1) {
-                                one_pixel(x, y, vrays, vintervals);
-                                continue;
-                            }
-                            world[n] = f.camera->pixel_ray(x, y);
-                            at[n++] = std::size_t(y) * W + std::size_t(x);
-                        }
-                    if (n == 0 || !f.meets_brick(world, n)) continue;
-                    const int count = f.owned_rays(world, n, rays, intervals, spans, at, [](std::size_t) { return false; });
-                    if (count == 0) continue;
-                    std::fill(states, states + count, RayState{});
-                    if (first.packets) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
-                    else
-                        for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);
-                    for (int i = 0; i < count; ++i) store(at[i], 0, spans[i].t0, states[i]);
+            for_each_block(tile, [&](const PixelBlock& b) {
+                if (V > 1) {
+                    for (int i = 0; i < b.count; ++i) one_pixel(b.x[i], b.y[i], vrays, vintervals);
+                    return;
                 }
-            }
-        }, tbb::simple_partitioner());
+                const int n = b.count;
+                for (int i = 0; i < n; ++i) {
+                    world[i] = f.camera().pixel_ray(b.x[i], b.y[i]);
+                    at[i] = std::size_t(b.y[i]) * W + std::size_t(b.x[i]);
+                }
+                if (!f.meets_brick(world, n)) return;
+                const int count = f.owned_rays(world, n, rays, intervals, spans, at, [](std::size_t) { return false; });
+                if (count == 0) return;
+                std::fill(states, states + count, RayState{});
+                if (first.packets) first.integrator->integrate_span_packet(rays, intervals, spans, states, count);
+                else
+                    for (int i = 0; i < count; ++i) first.integrator->integrate_span(rays[i], intervals[i], spans[i], states[i]);
+                for (int i = 0; i < count; ++i) store(at[i], 0, spans[i].t0, states[i]);
+            });
+        });
     });
 }
 

@@ -9,7 +9,8 @@
 
 namespace volref {
 
-PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) : scene(scene_) {
+PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options, std::span<const WholeDomain> whole)
+    : scene(scene_) {
     if (scene.volumes.empty()) throw Error("volumes: expected at least one volume");
     const bool several = scene.volumes.size() > 1;
     if (several && !scene.render.reference_integrators())
@@ -18,7 +19,7 @@ PreparedScene::PreparedScene(const Scene& scene_, const RenderOptions& options) 
     view_lo = glm::dvec3(std::numeric_limits<double>::infinity());
     view_hi = -view_lo;
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
-        volumes.push_back(std::make_unique<PreparedVolume>(scene, k, options, held));
+        volumes.push_back(std::make_unique<PreparedVolume>(scene, k, options, held, whole.empty() ? nullptr : &whole[k]));
         held += volumes.back()->bytes;
         view_lo = glm::min(view_lo, volumes.back()->view_lo);
         view_hi = glm::max(view_hi, volumes.back()->view_hi);

@@ -3,10 +3,12 @@
 // sample pipeline -> macrocells -> bounding geometry -> integrator), the camera, and for several
 // volumes the MultiVolumeIntegrator that mixes them; built once and then shared read-only by every
 // pixel. render_scene (Renderer.h) loops over the pixels; `volref trace` and `volref explain ray`
-// follow one pixel through the very same objects.
+// follow one pixel through the very same objects; each volref-mpi rank builds one over its bricks
+// (cli/mpi/Frame.h) and integrates its spans of the rays through the same volumes and mix.
 #pragma once
 #include <array>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -23,8 +25,10 @@
 namespace volref {
 
 struct PreparedScene {
-    // Throws volref::Error for a scene that cannot be rendered (naming the key at fault).
-    PreparedScene(const Scene& scene, const RenderOptions& options);
+    // Throws volref::Error for a scene that cannot be rendered (naming the key at fault). `whole`
+    // (volref-mpi): volume k's data are a brick of the domain whole[k] (PreparedVolume.h WholeDomain);
+    // empty: every volume's data are the whole volume.
+    PreparedScene(const Scene& scene, const RenderOptions& options, std::span<const WholeDomain> whole = {});
     PreparedScene(const PreparedScene&) = delete;
     PreparedScene& operator=(const PreparedScene&) = delete;
     ~PreparedScene();
@@ -60,8 +64,8 @@ struct PreparedScene {
     void integrate(const Ray* rays, int count, PixelValue* out, bool simd, Scratch& scratch) const;
 
     // Pixels (x[i], y[i]) of the image, i < count <= kMaxPacketRays: the camera's rays integrated
-    // (integrate), or the image-space renderer's pixels. The render step's one call (with blocks of
-    // kPacketBlock pixels: Renderer.cpp).
+    // (integrate), or the image-space renderer's pixels. The render step's one call (a block of pixels:
+    // PixelBlocks.h).
     void pixels(const int* x, const int* y, int count, PixelValue* out, bool simd, Scratch& scratch) const;
 
     // The one volume `volref trace` and `volref explain ray` follow; an Error for several volumes.

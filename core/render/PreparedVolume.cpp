@@ -108,13 +108,13 @@ int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const
 
 namespace {
 
-// The box a profile's rays are clipped to (Profile::RayBox): the domain, the texel box (the
-// domain grown by spacing / 2 on every side) or the profile's own box; reads outside the domain are
-// clamped to it (ProfileIntegrator::value). `warnings` gets a line when volume.bounds reaches past the
+// The box a profile's rays are clipped to (Profile::RayBox): the domain [grid_lo, grid_hi], the texel
+// box (the domain grown by spacing / 2 on every side) or the profile's own box; reads outside the
+// domain are clamped to it (ProfileIntegrator::value). `warnings` gets a line when volume.bounds reaches past the
 // domain (the rays are clipped to the domain there).
 int add_profile_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const std::string& key, const Profile& profile,
-                       const Volume& volume, glm::dvec3& lo, glm::dvec3& hi, std::vector<std::string>& warnings) {
-    const glm::dvec3 grid_lo = volume.domain_min(), grid_hi = volume.domain_max();
+                       const Volume& volume, const glm::dvec3& grid_lo, const glm::dvec3& grid_hi, glm::dvec3& lo,
+                       glm::dvec3& hi, std::vector<std::string>& warnings) {
     if (profile.ray_box != Profile::RayBox::Domain) {
         if (vs.bounds.type != BoundsSpec::Type::Box || vs.bounds.min || vs.bounds.max)
             throw Error(std::string("render.profile.ray_box: the profile's ray box replaces ") + key +
@@ -181,7 +181,8 @@ void build_volume_model(const VolumeSpec& vs, VolumeModel& m) {
     m.voxel = m.shell_grid->default_gradient_step();
 }
 
-PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const RenderOptions& options, std::size_t held_bytes)
+PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const RenderOptions& options, std::size_t held_bytes,
+                               const WholeDomain* whole)
     : spec(scene.volumes.at(index)) {
     const VolumeSpec& vs = spec;
     const std::string key = volume_key(scene, index);
@@ -318,7 +319,9 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
         macrocells = std::make_unique<MacrocellGrid>(*model.cartesian, *classifier, MacrocellGrid::Classification::Post);
     }
 
-    // The bounding geometry (in the volume's own space), and the box the default camera frames.
+    // The bounding geometry (in the volume's own space), and the box the default camera frames: over
+    // the data's domain, or the whole volume's whose brick they are.
+    const glm::dvec3 domain_lo = whole ? whole->lo : volume.domain_min(), domain_hi = whole ? whole->hi : volume.domain_max();
     glm::dvec3 lo, hi;
     const Profile resolved = resolve_profile(scene.render);  // the preset with the scene's rules
     if (vs.bounds.type == BoundsSpec::Type::Tetrahedra && vs.bounds.overlap == BoundsSpec::Overlap::Count &&
@@ -354,7 +357,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
                                    : geometry.add_spherical_shell(vs.bounds.sphere);
         }
     } else {
-        geometry_id = add_profile_bounds(geometry, vs, key, resolved, volume, lo, hi, warnings);
+        geometry_id = add_profile_bounds(geometry, vs, key, resolved, volume, domain_lo, domain_hi, lo, hi, warnings);
     }
     geometry.commit();
     world_box(transform ? &*transform : nullptr, lo, hi, view_lo, view_hi);
@@ -368,7 +371,7 @@ PreparedVolume::PreparedVolume(const Scene& scene, std::size_t index, const Rend
     }
     // A profile's own ray box (texel or given) does not move the default camera: it frames the domain.
     if (!shell && resolved.ray_box != Profile::RayBox::Domain)
-        world_box(transform ? &*transform : nullptr, volume.domain_min(), volume.domain_max(), view_lo, view_hi);
+        world_box(transform ? &*transform : nullptr, domain_lo, domain_hi, view_lo, view_hi);
 
     context = std::make_unique<IntegrationContext>(IntegrationContext{*pipeline, step, scene.render, macrocells.get()});
     if (scene.render.profile == ProfileId::Fast) {

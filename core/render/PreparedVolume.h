@@ -87,11 +87,20 @@ int add_cartesian_bounds(BoundingGeometry& geometry, const VolumeSpec& vs, const
 void world_box(const VolumeTransform* transform, const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3& world_lo,
                glm::dvec3& world_hi);
 
+// The data domain of the whole Cartesian volume whose brick a volume's data are (volref-mpi: a rank
+// holds a brick of every volume, VolumeSourceSpec::memory): the rays are bounded, and the default
+// camera frames, by the whole volume's domain, so that every rank's intervals are the single process's.
+struct WholeDomain {
+    glm::dvec3 lo{0.0}, hi{0.0};
+};
+
 struct PreparedVolume {
     // `index` is the volume's position in scene.volumes (for messages); `held_bytes` is the memory
-    // already held by the volumes prepared before it (core/MemoryLimit.h).
+    // already held by the volumes prepared before it (core/MemoryLimit.h); `whole`: the data are a
+    // brick of that domain (null: the data are the whole volume).
     // Throws volref::Error for a volume that cannot be rendered (naming the key at fault).
-    PreparedVolume(const Scene& scene, std::size_t index, const RenderOptions& options, std::size_t held_bytes);
+    PreparedVolume(const Scene& scene, std::size_t index, const RenderOptions& options, std::size_t held_bytes,
+                   const WholeDomain* whole = nullptr);
     PreparedVolume(const PreparedVolume&) = delete;
     PreparedVolume& operator=(const PreparedVolume&) = delete;
     ~PreparedVolume();

@@ -21,7 +21,6 @@
 
 #include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
@@ -51,7 +50,7 @@
 
 namespace volref {
 
-static_assert(kPixelBlockWidth * kPixelBlockHeight <= kMaxPacketRays, "a block is one call to the integrator");
+static_assert(kPixelBlockPixels <= kMaxPacketRays, "a block is one call to the integrator");
 
 std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec) {
     if (spec.source.memory) return spec.source.memory;  // complete: its own origin and spacing
@@ -106,11 +105,11 @@ namespace {
 // are larger than L2, so plain stores read each line back from memory first, and on an Intel Xeon those
 // reads held up the voxel fetches (the film variants: docs/performance.md, "What did not help").
 // The same values either way; a destination not on 16 bytes (an odd channel count on an odd width) is copied.
-void write_tile(Image& image, const double* tile, std::size_t row, int x0, int y0, int x_end, int y_end) {
-    const std::size_t n = std::size_t(x_end - x0) * image.channel_count();
-    for (int y = y0; y < y_end; ++y) {
-        const double* src = tile + std::size_t(y - y0) * row;
-        double* dst = &image.at(x0, y, 0);
+void write_tile(Image& image, const double* tile, std::size_t row, const PixelRect& rect) {
+    const std::size_t n = std::size_t(rect.x1 - rect.x0) * image.channel_count();
+    for (int y = rect.y0; y < rect.y1; ++y) {
+        const double* src = tile + std::size_t(y - rect.y0) * row;
+        double* dst = &image.at(rect.x0, y, 0);
 #if defined(__SSE2__)
         if (reinterpret_cast<std::uintptr_t>(dst) % 16 == 0) {
             std::size_t k = 0;
@@ -242,48 +241,32 @@ Image render_scene(const Scene& scene, const RenderOptions& options, RenderStats
     Image image(W, H, channels);
 
     const int T = options.tile_size > 0 ? options.tile_size : tile_side(W, H, arena.max_concurrency());
-    const int tiles_x = (W + T - 1) / T, tiles_y = (H + T - 1) / T;
+    const TileGrid tiles(W, H, T);
     for (int frame = 0; frame < std::max(1, options.frames); ++frame) {
     const auto frame_start = Clock::now();
-    ProgressReporter progress(options.progress && frame == 0, tiles_x * tiles_y);
+    ProgressReporter progress(options.progress && frame == 0, tiles.count());
     arena.execute([&] {
-        // One task per tile (grain 1, simple_partitioner): a free thread takes the next tile, so an
-        // expensive tile never waits behind others in a chunk (conventions section 12, the tile side).
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
-            // Each tile is integrated in blocks of kPixelBlockWidth x kPixelBlockHeight pixels (Renderer.h:
-            // fewer at the tile's edges, in row order inside a block, one call to the integrator each).
+        parallel_for_tiles(tiles, [&](const PixelRect& tile) {
+            if (cancel_requested()) return;  // SIGINT/SIGTERM: stop at the next tile (Cancellation.h)
             PreparedScene::Scratch scratch;
             PixelValue values[kMaxPacketRays];
-            int px[kMaxPacketRays], py[kMaxPacketRays];
             // The tile's pixels, written to the image when the tile is done (write_tile).
             const std::size_t C = image.channel_count(), row = std::size_t(T) * C;
             std::vector<double> tile_pixels(std::size_t(T) * row);
-            for (int tile = r.begin(); tile != r.end(); ++tile) {
-                if (cancel_requested()) return;  // SIGINT/SIGTERM: stop at the next tile (Cancellation.h)
-                const int x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
-                const int x_end = std::min(x0 + T, W), y_end = std::min(y0 + T, H);
-                for (int by = y0; by < y_end; by += kPixelBlockHeight)
-                    for (int bx = x0; bx < x_end; bx += kPixelBlockWidth) {
-                        int count = 0;
-                        for (int y = by; y < std::min(by + kPixelBlockHeight, y_end); ++y)
-                            for (int x = bx; x < std::min(bx + kPixelBlockWidth, x_end); ++x) {
-                                px[count] = x;
-                                py[count] = y;
-                                ++count;
-                            }
-                        prepared.pixels(px, py, count, values, options.simd, scratch);  // Embree packets per volume
-                        for (int i = 0; i < count; ++i) {
-                            double* p = &tile_pixels[std::size_t(py[i] - y0) * row + std::size_t(px[i] - x0) * C];
-                            for (int c = 0; c < 4; ++c) p[c] = values[i].rgba[c];
-                            if (depth) p[4] = values[i].depth;
-                            if (error) p[error_channel] = values[i].error;
-                            if (fault) p[fault_channel] = values[i].fault ? 1.0 : 0.0;
-                        }
-                    }
-                write_tile(image, tile_pixels.data(), row, x0, y0, x_end, y_end);
-                progress.tile_done();
-            }
-        }, tbb::simple_partitioner());
+            // One call to the integrator a block (PixelBlocks.h).
+            for_each_block(tile, [&](const PixelBlock& b) {
+                prepared.pixels(b.x, b.y, b.count, values, options.simd, scratch);  // Embree packets per volume
+                for (int i = 0; i < b.count; ++i) {
+                    double* p = &tile_pixels[std::size_t(b.y[i] - tile.y0) * row + std::size_t(b.x[i] - tile.x0) * C];
+                    for (int c = 0; c < 4; ++c) p[c] = values[i].rgba[c];
+                    if (depth) p[4] = values[i].depth;
+                    if (error) p[error_channel] = values[i].error;
+                    if (fault) p[fault_channel] = values[i].fault ? 1.0 : 0.0;
+                }
+            });
+            write_tile(image, tile_pixels.data(), row, tile);
+            progress.tile_done();
+        });
     });
     throw_if_cancelled();
     if (stats) stats->frames_s.push_back(std::chrono::duration<double>(Clock::now() - frame_start).count());

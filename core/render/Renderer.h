@@ -12,6 +12,7 @@
 
 #include "core/film/Image.h"
 #include "core/grid/Volume.h"
+#include "core/render/PixelBlocks.h"
 #include "core/scene/Scene.h"
 #include "transfer/Classifier.h"
 
@@ -40,15 +41,9 @@ Volume load_volume(const VolumeSpec& spec);
 std::shared_ptr<const Volume> share_volume(const VolumeSpec& spec);
 
 // The tile side render_scene uses for a width x height image on `threads` threads: conventions::kTileSize,
-// halved down to kMinTileSize while there are fewer than kTilesPerThread tiles per thread.
+// halved down to kMinTileSize while there are fewer than kTilesPerThread tiles per thread. Inside a
+// tile, render_scene (and volref-mpi) hand the integrator blocks of pixels (PixelBlocks.h).
 int tile_side(int width, int height, int threads);
-// Inside a tile, render_scene (and volref-mpi) hand the integrator blocks of kPixelBlockWidth x
-// kPixelBlockHeight pixels (fewer at the tile's edges), in row order inside a block, at once: on 16-lane
-// float vectors two 4 x 4 packets, whose steps the composite kernel interleaves (PacketComposite.cpp); on
-// 8-lane double vectors four 4 x 2 packets. Neighbouring rays read neighbouring voxels; each pixel's
-// value does not depend on its block or packet (lanes are independent). Measured in docs/performance.md.
-inline constexpr int kPixelBlockWidth = 4;
-inline constexpr int kPixelBlockHeight = 8;
 
 // The world-space step: render.step, times the smallest spacing when step_units is voxel.
 double world_step(const RenderSpec& render, const Volume& volume);

@@ -26,8 +26,13 @@ const char* VolumeView::packet_unavailable(bool composite, CompositeOrder order)
     if (composite && preclassified) return "this volume is pre-classified";
     if (interpolation != Interpolation::Trilinear) return "this volume is not trilinear";
     if (composite && order != CompositeOrder::FrontToBack) return "this scene composites back to front";
-    if (!all_finite(volume->values)) return "this volume has non-finite voxels";
+    if (!finite_voxels()) return "this volume has non-finite voxels";
     return composite ? composite_unavailable : nullptr;
+}
+
+bool VolumeView::finite_voxels() const {
+    if (finite_ < 0) finite_ = all_finite(volume->values) ? 1 : 0;
+    return finite_ == 1;
 }
 
 VolumeView describe_volume(const Volume& volume, const VolumeSampler* cartesian, const ShellGrid* shell_grid,

@@ -125,6 +125,11 @@ struct VolumeView {
     // also a transfer function, post-classification, front-to-back order, a gradient the kernels take
     // and at most kMaxPacketLights lights. The checks in this order.
     const char* packet_unavailable(bool composite, CompositeOrder order) const;
+    // Every voxel finite: scanned on the first ask and kept (set-up asks from one thread).
+    bool finite_voxels() const;
+
+private:
+    mutable signed char finite_ = -1;  // -1: not scanned yet
 };
 
 // What a view holds that the volume and its stages do not: the float lanes' copies, the

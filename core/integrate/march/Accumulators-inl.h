@@ -232,7 +232,7 @@ struct NoCompositeHooks {
 // `on` observes the step: on.transparent(acc) when no live lane is visible (nothing changes),
 // on.composited(o, acc) after accumulating. Returns the lanes to retire.
 template <class L, class Acc, class Sample, class Hooks>
-inline typename L::M composite_step(Acc& acc, Sample& sample, typename L::M alive, typename L::V d, typename L::V l,
+[[gnu::always_inline]] inline typename L::M composite_step(Acc& acc, Sample& sample, typename L::M alive, typename L::V d, typename L::V l,
                                     const ::volref::Termination* stop, Hooks& on) {
     using V = typename L::V;
     const V a = sample.opacity();

@@ -9,9 +9,7 @@
 // through these, so all four take the same blocks in the same order.
 #pragma once
 #include <algorithm>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <functional>
 
 namespace volref {
 
@@ -65,15 +63,8 @@ struct TileGrid {
 
 // f(tile) for every tile, one task each (grain 1, simple_partitioner): a free thread takes the next
 // tile, so an expensive tile never waits behind others in a chunk (conventions section 12, the tile
-// side). Run it inside the caller's task arena (its thread count).
-template <class F>
-void parallel_for_tiles(const TileGrid& tiles, F&& f) {
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tiles.count(), 1),
-        [&](const tbb::blocked_range<int>& r) {
-            for (int i = r.begin(); i != r.end(); ++i) f(tiles.tile(i));
-        },
-        tbb::simple_partitioner());
-}
+// side). Run it inside the caller's task arena (its thread count). Defined in PixelBlocks.cpp, so that
+// this header (public through Renderer.h) asks nothing of TBB's headers or library of its users.
+void parallel_for_tiles(const TileGrid& tiles, const std::function<void(const PixelRect&)>& f);
 
 }  // namespace volref

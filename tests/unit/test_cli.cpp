@@ -210,13 +210,13 @@ TEST_F(Cli, WritesPngAndTiff) {
 }
 
 // A render longer than about a second shows progress when stderr is a terminal (`script` gives the
-// command a pseudo-terminal), and nothing when it is not. 600 x 600 at step 0.1 keeps the render near 4 s in
-// a Release build (at step 0.5 it took 1.0 s once the packet path got faster, and printed nothing; 1200 x
-// 1200 took 13 s per render, 54 s for the test under the sanitizers: trimmed for CI time, issue 32).
+// command a pseudo-terminal), and nothing when it is not. 600 x 600 at step 0.025 keeps the frame near
+// 1.5 s at one thread in a Release build (at step 0.04 it took 0.95 s, under the one second after which
+// progress is shown), a few times that under the sanitizers.
 TEST_F(Cli, ProgressOnlyOnATerminal) {
     const std::string render = std::string(VOLREF_CLI) + " render " + std::string(VOLREF_SOURCE_DIR) +
                                "/reference_scenes/default.json -o " + (dir_ / "p.exr").string() +
-                               " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.04";
+                               " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.025";
     const fs::path log = dir_ / "tty.txt";
     const std::string cmd = "script -qec '" + render + "' " + log.string() + " > /dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
@@ -226,7 +226,7 @@ TEST_F(Cli, ProgressOnlyOnATerminal) {
     EXPECT_NE(ss.str().find("volref: rendering"), std::string::npos) << ss.str();
     const Result r = run("render " + std::string(VOLREF_SOURCE_DIR) + "/reference_scenes/default.json -o " +
                          (dir_ / "q.exr").string() +
-                         " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.04");
+                         " --threads 1 --set image.width=600 --set image.height=600 --set render.step=0.025");
     EXPECT_EQ(r.status, 0);
     EXPECT_EQ(r.err.find("volref: rendering"), std::string::npos) << r.err;
 }

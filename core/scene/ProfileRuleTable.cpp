@@ -3,6 +3,7 @@
 #include <initializer_list>
 #include <type_traits>
 
+#include "core/scene/JsonReader.h"
 #include "core/scene/SceneNames.h"
 
 namespace volref {
@@ -28,11 +29,48 @@ std::vector<Json> values_of(std::string_view key, std::initializer_list<Json> va
     return d;
 }
 
+// An entry being built: the makers below give its scene form and resolved value; these members add when
+// it is read, its search, its explain option and the option it also is.
+struct Rule {
+    ProfileRule r;
+
+    Rule& read_by(PlacementMask placements, ReadIn read_in = ReadIn::EveryScene) {
+        r.placements = placements;
+        r.read_in = read_in;
+        return *this;
+    }
+    // Tried at `rank` with the values `dimensions` gives.
+    Rule& tried(int rank, std::function<Dimensions(const Scene&, bool slicer)> dimensions) {
+        r.search.rank = rank;
+        r.search.dimensions = std::move(dimensions);
+        return *this;
+    }
+    // Tried on ray casters only (or slicers only), one dimension of `values`.
+    Rule& tried_on_ray_casters(int rank, std::initializer_list<Json> values) {
+        std::vector<Json> d = values_of(r.key, values);
+        return tried(rank, [d](const Scene&, bool slicer) { return slicer ? Dimensions{} : Dimensions{d}; });
+    }
+    Rule& tried_on_slicers(int rank, std::initializer_list<Json> values) {
+        std::vector<Json> d = values_of(r.key, values);
+        return tried(rank, [d](const Scene&, bool slicer) { return slicer ? Dimensions{d} : Dimensions{}; });
+    }
+    Rule& explained_as(std::string_view option, int rank) {
+        r.explain = {option, rank};
+        return *this;
+    }
+    // A rule that is render.profile_options.`option` too.
+    Rule& also_option(std::string_view option, std::function<void(const ProfileRules&, ProfileOptions&)> to_options) {
+        r.option = option;
+        r.to_options = std::move(to_options);
+        return *this;
+    }
+};
+
 // An enumerated rule, read and written by its names (SceneNames.h). `value`: the resolved profile's
 // field (null: a rule a Profile does not hold).
 template <class E>
-ProfileRule choice_rule(std::string_view key, std::optional<E> ProfileRules::*rule, Exactly<E> ProfileRuleValues::*value,
-                        std::span<const Choice<Exactly<E>>> table) {
+Rule choice_rule(std::string_view key, std::optional<E> ProfileRules::*rule, Exactly<E> ProfileRuleValues::*value,
+                 std::span<const Choice<Exactly<E>>> table) {
     ProfileRule r;
     r.key = key;
     r.read = [=](ObjectReader& o, ProfileRules& out) { out.*rule = o.optional_choice<E>(key, table); };
@@ -52,17 +90,16 @@ ProfileRule choice_rule(std::string_view key, std::optional<E> ProfileRules::*ru
         return v.has_value();
     };
     r.names = [=] { return names::listing(table); };
-    return r;
+    return {r};
 }
 template <class E, std::size_t N>
-ProfileRule choice_rule(std::string_view key, std::optional<E> ProfileRules::*rule, Exactly<E> ProfileRuleValues::*value,
-                        const Choice<Exactly<E>> (&table)[N]) {
+Rule choice_rule(std::string_view key, std::optional<E> ProfileRules::*rule, Exactly<E> ProfileRuleValues::*value,
+                 const Choice<Exactly<E>> (&table)[N]) {
     return choice_rule<E>(key, rule, value, std::span<const Choice<E>>(table));
 }
 
 // A number in `range`.
-ProfileRule number_rule(std::string_view key, std::optional<double> ProfileRules::*rule, double ProfileRuleValues::*value,
-                        Range range) {
+Rule number_rule(std::string_view key, std::optional<double> ProfileRules::*rule, double ProfileRuleValues::*value, Range range) {
     ProfileRule r;
     r.key = key;
     r.read = [=](ObjectReader& o, ProfileRules& out) { out.*rule = o.optional_number(key, range); };
@@ -74,45 +111,13 @@ ProfileRule number_rule(std::string_view key, std::optional<double> ProfileRules
         if (in.*rule) v.*value = *(in.*rule);
     };
     r.capture = [=](const ProfileRuleValues& v, ProfileRules& out) { out.*rule = v.*value; };
-    return r;
-}
-
-// The rule's search: tried at `rank` with the values `dimensions` gives.
-ProfileRule searched(ProfileRule r, int rank, std::function<Dimensions(const Scene&, bool slicer)> dimensions) {
-    r.search.rank = rank;
-    r.search.dimensions = std::move(dimensions);
-    return r;
-}
-
-// Tried on ray casters only, one dimension of `values`.
-ProfileRule searched_on_ray_casters(ProfileRule r, int rank, std::initializer_list<Json> values) {
-    const std::string_view key = r.key;
-    std::vector<Json> d = values_of(key, values);
-    return searched(std::move(r), rank, [d](const Scene&, bool slicer) { return slicer ? Dimensions{} : Dimensions{d}; });
-}
-
-// Tried on slicers only, one dimension of `values`.
-ProfileRule searched_on_slicers(ProfileRule r, int rank, std::initializer_list<Json> values) {
-    const std::string_view key = r.key;
-    std::vector<Json> d = values_of(key, values);
-    return searched(std::move(r), rank, [d](const Scene&, bool slicer) { return slicer ? Dimensions{d} : Dimensions{}; });
-}
-
-ProfileRule read_by(ProfileRule r, PlacementMask placements, ReadIn read_in = ReadIn::EveryScene) {
-    r.placements = placements;
-    r.read_in = read_in;
-    return r;
-}
-
-ProfileRule explained_as(ProfileRule r, std::string_view option, int rank) {
-    r.explain = {option, rank};
-    return r;
+    return {r};
 }
 
 // --- the rules whose value is not one name or one number -----------------------------------------------
 
 // "domain", "texel", or a given box {"min": [x, y, z], "max": [x, y, z]}.
-ProfileRule ray_box_rule() {
+Rule ray_box_rule() {
     ProfileRule r;
     r.key = "ray_box";
     r.read = [](ObjectReader& o, ProfileRules& out) {
@@ -146,12 +151,12 @@ ProfileRule ray_box_rule() {
         out.ray_box = v.ray_box;
         if (v.ray_box == P::RayBox::Given) out.box = v.box;
     };
-    return r;
+    return {std::move(r)};
 }
 
 // "none" or {"alpha_above" | "alpha_at_least" | "transmittance_at_most": x}. Profile.cpp sets and reads
 // back Profile::termination (the accumulators' type).
-ProfileRule termination_rule() {
+Rule termination_rule() {
     ProfileRule r;
     r.key = "termination";
     r.read = [](ObjectReader& o, ProfileRules& out) {
@@ -180,11 +185,11 @@ ProfileRule termination_rule() {
         else
             j["termination"] = {{names::name_of(names::kStops, *in.termination), in.termination_value}};
     };
-    return r;
+    return {std::move(r)};
 }
 
 // The number of table entries: 0 (the transfer function read exactly) or at least 2.
-ProfileRule table_rule() {
+Rule table_rule() {
     ProfileRule r;
     r.key = "table";
     r.read = [](ObjectReader& o, ProfileRules& out) {
@@ -199,13 +204,14 @@ ProfileRule table_rule() {
         if (in.table_entries) v.table_entries = *in.table_entries;
     };
     r.capture = [](const ProfileRuleValues& v, ProfileRules& out) { out.table_entries = v.table_entries; };
-    return r;
+    return {std::move(r)};
 }
 
 // The gradients' offset in voxels, or (gradient_offset_texture) as a fraction of the domain's extent per
 // axis: one of the two, setting one clears the other.
-ProfileRule gradient_offset_rule() {
-    ProfileRule r = number_rule("gradient_offset", &ProfileRules::gradient_offset, &ProfileRuleValues::gradient_offset, Range::positive());
+Rule gradient_offset_rule() {
+    Rule rule = number_rule("gradient_offset", &ProfileRules::gradient_offset, &ProfileRuleValues::gradient_offset, Range::positive());
+    ProfileRule& r = rule.r;
     r.apply = [](const ProfileRules& in, ProfileRuleValues& v) {
         if (!in.gradient_offset) return;
         v.gradient_offset = *in.gradient_offset;
@@ -214,11 +220,12 @@ ProfileRule gradient_offset_rule() {
     r.capture = [](const ProfileRuleValues& v, ProfileRules& out) {
         if (!(v.gradient_offset_texture > 0.0)) out.gradient_offset = v.gradient_offset;
     };
-    return r;
+    return rule;
 }
-ProfileRule gradient_offset_texture_rule() {
-    ProfileRule r = number_rule("gradient_offset_texture", &ProfileRules::gradient_offset_texture,
-                                &ProfileRuleValues::gradient_offset_texture, Range::left_open(0.0, 1.0));
+Rule gradient_offset_texture_rule() {
+    Rule rule = number_rule("gradient_offset_texture", &ProfileRules::gradient_offset_texture,
+                            &ProfileRuleValues::gradient_offset_texture, Range::left_open(0.0, 1.0));
+    ProfileRule& r = rule.r;
     r.read = [](ObjectReader& o, ProfileRules& out) {  // after gradient_offset (the table's order)
         out.gradient_offset_texture = o.optional_number("gradient_offset_texture", Range::left_open(0.0, 1.0));
         if (out.gradient_offset && out.gradient_offset_texture)
@@ -232,10 +239,10 @@ ProfileRule gradient_offset_texture_rule() {
     r.capture = [](const ProfileRuleValues& v, ProfileRules& out) {
         if (v.gradient_offset_texture > 0.0) out.gradient_offset_texture = v.gradient_offset_texture;
     };
-    return r;
+    return rule;
 }
 
-ProfileRule clamp_shaded_rule() {
+Rule clamp_shaded_rule() {
     ProfileRule r;
     r.key = "clamp_shaded";
     r.read = [](ObjectReader& o, ProfileRules& out) {
@@ -249,23 +256,23 @@ ProfileRule clamp_shaded_rule() {
         if (in.clamp_shaded) v.clamp_shaded = *in.clamp_shaded;
     };
     r.capture = [](const ProfileRuleValues& v, ProfileRules& out) { out.clamp_shaded = v.clamp_shaded; };
-    return r;
+    return {std::move(r)};
 }
 
 // volref never jitters (every pixel its own deterministic ray): "off" is the only value.
-ProfileRule jitter_rule() {
+Rule jitter_rule() {
     ProfileRule r;
     r.key = "jitter";
     r.read = [](ObjectReader& o, ProfileRules&) { o.choice<bool>("jitter", false, {{"off", false}}); };
     r.is_set = [](const ProfileRules&) { return false; };
     r.write = [](const ProfileRules&, Json&) {};
     r.only_value = "off";
-    return r;
+    return {std::move(r)};
 }
 
 // The slicer's surfaces: an object of orientation, range, one of spacing / count / period, max_count,
 // first, order (each absent key its default).
-ProfileRule slices_rule() {
+Rule slices_rule() {
     using S = P::Slices;
     ProfileRule r;
     r.key = "slices";
@@ -309,31 +316,33 @@ ProfileRule slices_rule() {
         if (in.slices) v.slices = *in.slices;
     };
     r.capture = [](const ProfileRuleValues& v, ProfileRules& out) { out.slices = v.slices; };
-    // Tried one key of the object at a time ("slices.KEY"), set over the scene's surfaces.
-    r = searched(std::move(r), 5, [](const Scene& scene, bool slicer) {
-        if (!slicer) return Dimensions{};
-        const double h = scene.render.step;
-        Dimensions d;
-        std::vector<Json> orientation = values_of("slices.orientation", {"viewport", "axis"});
-        if (scene.camera.type != CameraSpec::Type::Orthographic) orientation.push_back({{"slices.orientation", "spherical"}});
-        d.push_back(orientation);
-        if (scene.camera.near) d.push_back(values_of("slices.range", {"object", "view_volume"}));
-        d.push_back(values_of("slices.first", {"bound", "half"}));
-        std::vector<Json> spacing = values_of("slices.spacing", {h / 2.0, h, 2.0 * h});
-        for (const Json& c : values_of("slices.count", {128, 256})) spacing.push_back(c);
-        d.push_back(spacing);
-        return d;
-    });
+    // A search candidate "slices.KEY" sets one key over the scene's surfaces (slice_candidates).
     r.search.set_part = [](Json& object, const std::string& part, const Json& value) {
         if (part == "spacing" || part == "count" || part == "period")  // one of the three
             for (const char* other : {"spacing", "count", "period"}) object.erase(other);
         object[part] = value;
     };
-    return r;
+    return {std::move(r)};
+}
+
+// A slicer's surfaces as the search tries them, one key of `slices` at a time.
+Dimensions slice_candidates(const Scene& scene, bool slicer) {
+    if (!slicer) return Dimensions{};
+    const double h = scene.render.step;
+    Dimensions d;
+    std::vector<Json> orientation = values_of("slices.orientation", {"viewport", "axis"});
+    if (scene.camera.type != CameraSpec::Type::Orthographic) orientation.push_back({{"slices.orientation", "spherical"}});
+    d.push_back(orientation);
+    if (scene.camera.near) d.push_back(values_of("slices.range", {"object", "view_volume"}));
+    d.push_back(values_of("slices.first", {"bound", "half"}));
+    std::vector<Json> spacing = values_of("slices.spacing", {h / 2.0, h, 2.0 * h});
+    for (const Json& c : values_of("slices.count", {128, 256})) spacing.push_back(c);
+    d.push_back(spacing);
+    return d;
 }
 
 // The texels' window: "transfer-rows", "data-range", or a given [lo, hi] with lo < hi.
-ProfileRule texture_window_rule() {
+Rule texture_window_rule() {
     ProfileRule r;
     r.key = "texture_window";
     r.read = [](ObjectReader& o, ProfileRules& out) {
@@ -364,142 +373,133 @@ ProfileRule texture_window_rule() {
         out.texture_window = v.texture_window;
         out.texture_window_given = v.texture_window_given;
     };
-    return r;
+    return {std::move(r)};
 }
 
-// A rule that is render.profile_options.`option` too.
-ProfileRule also_option(ProfileRule r, std::string_view option, std::function<void(const ProfileRules&, ProfileOptions&)> to_options) {
-    r.option = option;
-    r.to_options = std::move(to_options);
-    return r;
+// The placement's candidates: midpoints, and from the entry at three first samples with each step count
+// (step_count alone cannot be set over midpoints).
+Dimensions placement_candidates(const Scene&, bool slicer) {
+    if (slicer) return Dimensions{};
+    return Dimensions{{{{"placement", "midpoints"}},
+                       {{"placement", "from-entry"}, {"first", 0.0}},
+                       {{"placement", "from-entry"}, {"first", 0.5}},
+                       {{"placement", "from-entry"}, {"first", 1.0}},
+                       {{"placement", "from-entry"}, {"first", 0.0}, {"step_count", "before-exit"}},
+                       {{"placement", "from-entry"}, {"first", 0.5}, {"step_count", "before-exit"}},
+                       {{"placement", "from-entry"}, {"first", 1.0}, {"step_count", "before-exit"}}}};
 }
 
+// The table, in render.profile's order of reading. The search ranks (tried(N, ...)) give the search's
+// own order: a ray caster's placement, step count, ray box, table, voxel length, correction,
+// termination, then the shading rules; a slicer's surfaces, frame buffer, correction, rounding,
+// products, blend alpha, then the fragment's rules.
 std::vector<ProfileRule> make_table() {
     using R = ProfileRules;
     using V = ProfileRuleValues;
     constexpr PlacementMask kFromEntry = placement_bit(P::Placement::FromEntry);
     constexpr PlacementMask kFromEntryOrExit = kFromEntry | placement_bit(P::Placement::FromExit);
     std::vector<ProfileRule> t;
+    auto add = [&t](const Rule& rule) { t.push_back(rule.r); };
 
     // --- where the samples lie ------------------------------------------------------------------------
-    ProfileRule placement = searched(choice_rule("placement", &R::placement, &V::placement, names::kPlacements), 0,
-                                     [](const Scene&, bool slicer) {
-                                         if (slicer) return Dimensions{};
-                                         // (from-entry with each step count: step_count alone cannot be set over midpoints)
-                                         return Dimensions{{{{"placement", "midpoints"}},
-                                                            {{"placement", "from-entry"}, {"first", 0.0}},
-                                                            {{"placement", "from-entry"}, {"first", 0.5}},
-                                                            {{"placement", "from-entry"}, {"first", 1.0}},
-                                                            {{"placement", "from-entry"}, {"first", 0.0}, {"step_count", "before-exit"}},
-                                                            {{"placement", "from-entry"}, {"first", 0.5}, {"step_count", "before-exit"}},
-                                                            {{"placement", "from-entry"}, {"first", 1.0}, {"step_count", "before-exit"}}}};
-                                     });
-    placement.search.carried = {"first", "step_count"};
-    placement.search.joined = {"first"};
-    t.push_back(placement);
-    t.push_back(read_by(number_rule("first", &R::first, &V::first, Range::closed(0.0, 1e6)), kFromEntry));
-    t.push_back(read_by(searched_on_ray_casters(choice_rule("step_count", &R::step_count, &V::step_count, names::kStepCounts), 1,
-                                                {"through-exit", "before-exit"}),
-                        kFromEntryOrExit));
-    t.push_back(searched(ray_box_rule(), 2, [](const Scene& scene, bool slicer) {
+    Rule placement = choice_rule("placement", &R::placement, &V::placement, names::kPlacements).tried(0, placement_candidates);
+    placement.r.search.carried = {"first", "step_count"};
+    placement.r.search.joined = {"first"};
+    add(placement);
+    add(number_rule("first", &R::first, &V::first, Range::closed(0.0, 1e6)).read_by(kFromEntry));
+    add(choice_rule("step_count", &R::step_count, &V::step_count, names::kStepCounts)
+            .read_by(kFromEntryOrExit)
+            .tried_on_ray_casters(1, {"through-exit", "before-exit"}));
+    add(ray_box_rule().tried(2, [](const Scene& scene, bool slicer) {
         const BoundsSpec& b = scene.volume().bounds;
-        const bool box = b.type == BoundsSpec::Type::Box && !b.min && !b.max;  // a texel box needs the domain's own
+        const bool box = b.type == BoundsSpec::Type::Box && !b.min && !b.max;  // bounds that are the domain
         return slicer || !box ? Dimensions{} : Dimensions{values_of("ray_box", {"domain", "texel"})};
     }));
-    t.push_back(searched(choice_rule("step_voxel", &R::step_voxel, &V::voxel_length, names::kVoxelLengths), 4,
-                         [](const Scene& scene, bool slicer) {
-                             return slicer || scene.render.step_units != StepUnits::Voxel
-                                        ? Dimensions{}
-                                        : Dimensions{values_of("step_voxel", {"spacing", "extent-over-samples"})};
-                         }));
+    add(choice_rule("step_voxel", &R::step_voxel, &V::voxel_length, names::kVoxelLengths).tried(4, [](const Scene& scene, bool slicer) {
+        return slicer || scene.render.step_units != StepUnits::Voxel ? Dimensions{}
+                                                                     : Dimensions{values_of("step_voxel", {"spacing", "extent-over-samples"})};
+    }));
 
-    // --- opacity correction and compositing -----------------------------------------------------------
-    t.push_back(read_by(searched(choice_rule("correction", &R::correction, &V::correction, names::kCorrections), 7,
-                                 [](const Scene&, bool slicer) {
-                                     return slicer ? Dimensions{values_of("correction", {"none", "exact"})}
-                                                   : Dimensions{values_of("correction", {"pow", "exact", "none", "extinction"})};
-                                 }),
-                        kEveryPlacement, ReadIn::Composite));
-    t.push_back(read_by(number_rule("correction_floor", &R::correction_floor, &V::correction_floor, Range::closed(0.0, 1.0)),
-                        kEveryPlacement, ReadIn::Composite));
-    t.push_back(read_by(number_rule("density_scale", &R::density_scale, &V::density_scale, Range::non_negative()), kEveryPlacement,
-                        ReadIn::Composite));
-    // A slicer's compositing is its frame buffer's blend.
-    t.push_back(read_by(choice_rule("compositing", &R::compositing, &V::compositing, names::kCompositings), kRayCasterPlacements,
-                        ReadIn::Composite));
-    t.push_back(read_by(searched_on_ray_casters(termination_rule(), 16,
-                                                {"none",
-                                                 {{"alpha_above", 1.0 - 1.0 / 255.0}},
-                                                 {{"alpha_at_least", 0.999}},
-                                                 {{"alpha_above", 0.99}},
-                                                 {{"alpha_above", 0.95}}}),
-                        kRayCasterPlacements, ReadIn::Composite));
+    // --- opacity correction and compositing (a slicer's compositing is its frame buffer's blend) -------
+    add(choice_rule("correction", &R::correction, &V::correction, names::kCorrections)
+            .read_by(kEveryPlacement, ReadIn::Composite)
+            .tried(7, [](const Scene&, bool slicer) {
+                return slicer ? Dimensions{values_of("correction", {"none", "exact"})}
+                              : Dimensions{values_of("correction", {"pow", "exact", "none", "extinction"})};
+            }));
+    add(number_rule("correction_floor", &R::correction_floor, &V::correction_floor, Range::closed(0.0, 1.0))
+            .read_by(kEveryPlacement, ReadIn::Composite));
+    add(number_rule("density_scale", &R::density_scale, &V::density_scale, Range::non_negative()).read_by(kEveryPlacement, ReadIn::Composite));
+    add(choice_rule("compositing", &R::compositing, &V::compositing, names::kCompositings).read_by(kRayCasterPlacements, ReadIn::Composite));
+    add(termination_rule()
+            .read_by(kRayCasterPlacements, ReadIn::Composite)
+            .tried_on_ray_casters(16, {"none",
+                                       {{"alpha_above", 1.0 - 1.0 / 255.0}},
+                                       {{"alpha_at_least", 0.999}},
+                                       {{"alpha_above", 0.99}},
+                                       {{"alpha_above", 0.95}}}));
 
     // --- classification -------------------------------------------------------------------------------
-    t.push_back(searched_on_ray_casters(table_rule(), 3, {0, 256, 1024}));
-    t.push_back(choice_rule("table_coordinate", &R::table_coordinate, &V::table_coordinate, names::kTableCoordinates));
+    add(table_rule().tried_on_ray_casters(3, {0, 256, 1024}));
+    add(choice_rule("table_coordinate", &R::table_coordinate, &V::table_coordinate, names::kTableCoordinates));
 
     // --- render.profile_options too -------------------------------------------------------------------
     // The canonical names only: "hardware" is render.profile_options' deprecated alias, not a rule's.
-    t.push_back(also_option(choice_rule<ProfileOptions::TextureUnit>("texture_unit", &R::texture_unit, nullptr,
-                                                                     std::span<const Choice<ProfileOptions::TextureUnit>>(names::kTextureUnits).first(2)),
-                            "texture_unit", [](const ProfileRules& in, ProfileOptions& o) { o.texture_unit = *in.texture_unit; }));
-    t.push_back(also_option(choice_rule("arithmetic", &R::arithmetic, nullptr, names::kArithmetics), "kernel",
-                            [](const ProfileRules& in, ProfileOptions& o) {
-                                o.kernel = *in.arithmetic == P::Arithmetic::Float32 ? ProfileOptions::Kernel::Float32
-                                                                                    : ProfileOptions::Kernel::Double;
-                            }));
+    add(choice_rule<ProfileOptions::TextureUnit>("texture_unit", &R::texture_unit, nullptr,
+                                                 std::span<const Choice<ProfileOptions::TextureUnit>>(names::kTextureUnits).first(2))
+            .also_option("texture_unit", [](const ProfileRules& in, ProfileOptions& o) { o.texture_unit = *in.texture_unit; }));
+    add(choice_rule("arithmetic", &R::arithmetic, nullptr, names::kArithmetics).also_option("kernel", [](const ProfileRules& in, ProfileOptions& o) {
+        o.kernel = *in.arithmetic == P::Arithmetic::Float32 ? ProfileOptions::Kernel::Float32 : ProfileOptions::Kernel::Double;
+    }));
 
     // --- gradients and shading ------------------------------------------------------------------------
-    t.push_back(read_by(searched_on_ray_casters(choice_rule("normal", &R::normal_along_gradient, &V::normal_along_gradient, names::kNormals),
-                                                17, {"-gradient", "+gradient"}),
-                        kEveryPlacement, ReadIn::ShadedComposite));
-    t.push_back(read_by(searched_on_ray_casters(choice_rule("gradient", &R::gradient, &V::gradient, names::kRuleGradients), 18,
-                                                {"central", "forward", "central-in-domain"}),
-                        kEveryPlacement, ReadIn::ShadedComposite));
-    t.push_back(read_by(searched_on_ray_casters(gradient_offset_rule(), 20, {0.5, 1.0, 2.0}), kEveryPlacement, ReadIn::ShadedComposite));
-    // seed 002's +-0.1 of the domain's extent
-    t.push_back(read_by(searched_on_ray_casters(gradient_offset_texture_rule(), 21, {0.1}), kEveryPlacement, ReadIn::ShadedComposite));
-    t.push_back(read_by(searched_on_ray_casters(clamp_shaded_rule(), 19, {false, true}), kEveryPlacement, ReadIn::ShadedComposite));
-    t.push_back(jitter_rule());
+    add(choice_rule("normal", &R::normal_along_gradient, &V::normal_along_gradient, names::kNormals)
+            .read_by(kEveryPlacement, ReadIn::ShadedComposite)
+            .tried_on_ray_casters(17, {"-gradient", "+gradient"}));
+    add(choice_rule("gradient", &R::gradient, &V::gradient, names::kRuleGradients)
+            .read_by(kEveryPlacement, ReadIn::ShadedComposite)
+            .tried_on_ray_casters(18, {"central", "forward", "central-in-domain"}));
+    add(gradient_offset_rule().read_by(kEveryPlacement, ReadIn::ShadedComposite).tried_on_ray_casters(20, {0.5, 1.0, 2.0}));
+    add(gradient_offset_texture_rule()  // seed 002's +-0.1 of the domain's extent
+            .read_by(kEveryPlacement, ReadIn::ShadedComposite)
+            .tried_on_ray_casters(21, {0.1}));
+    add(clamp_shaded_rule().read_by(kEveryPlacement, ReadIn::ShadedComposite).tried_on_ray_casters(19, {false, true}));
+    add(jitter_rule());
 
     // --- the slicers' rules (placement "slices"; conventions section 9, "Slice-order renderers") ----------
-    t.push_back(read_by(slices_rule(), kSlicesOnly));
-    t.push_back(read_by(searched_on_slicers(choice_rule("texture", &R::texture, &V::texture, names::kTextures), 15, {"3d", "2d"}),
-                        kSlicesOnly));
-    t.push_back(read_by(searched_on_slicers(choice_rule("texture_format", &R::texture_format, &V::texel_format, names::kTexelFormats), 12,
-                                            {"unorm8", "unorm16", "float"}),
-                        kSlicesOnly));
-    t.push_back(read_by(texture_window_rule(), kSlicesOnly));
-    t.push_back(read_by(searched_on_slicers(choice_rule("table_lookup", &R::table_lookup, &V::table_lookup, names::kTableLookups), 11,
-                                            {"nearest", "linear", "texture"}),
-                        kSlicesOnly));
-    t.push_back(read_by(searched_on_slicers(choice_rule("table_format", &R::table_format, &V::table_format, names::kTableFormats), 13,
-                                            {"unorm8", "float"}),
-                        kSlicesOnly));
-    t.push_back(read_by(searched_on_slicers(choice_rule("classify", &R::classify, &V::classify, names::kSliceClassifies), 14,
-                                            {"post", "pre-unweighted"}),
-                        kSlicesOnly));
-    t.push_back(read_by(explained_as(searched_on_slicers(choice_rule("framebuffer", &R::framebuffer, &V::framebuffer, names::kFrameBuffers),
-                                                         6, {"rgba8", "rgba16f", "rgba32f", "double"}),
-                                     "--framebuffer", 0),
-                        kSlicesOnly));
-    t.push_back(read_by(explained_as(searched_on_slicers(choice_rule("framebuffer_rounding", &R::framebuffer_rounding,
-                                                                     &V::framebuffer_rounding, names::kRoundings),
-                                                         8, {"nearest", "truncate"}),
-                                     "--rounding", 3),
-                        kSlicesOnly));
-    t.push_back(read_by(explained_as(searched_on_slicers(choice_rule("blend_products", &R::blend_products, &V::blend_products,
-                                                                     names::kBlendProducts),
-                                                         9, {"exact", "rounded"}),
-                                     "--products", 4),
-                        kSlicesOnly));
-    t.push_back(read_by(explained_as(choice_rule("blend", &R::blend, &V::blend, names::kBlends), "--blend", 1), kSlicesOnly));
-    t.push_back(read_by(explained_as(searched_on_slicers(choice_rule("blend_alpha", &R::blend_alpha, &V::blend_alpha, names::kBlendAlphas),
-                                                         10, {"src-alpha", "one"}),
-                                     "--blend-alpha", 2),
-                        kSlicesOnly));
-    t.push_back(read_by(choice_rule("texture_filter", &R::texture_filter, &V::texture_filter, names::kTextureFilters), kSlicesOnly));
+    add(slices_rule().read_by(kSlicesOnly).tried(5, slice_candidates));
+    add(choice_rule("texture", &R::texture, &V::texture, names::kTextures).read_by(kSlicesOnly).tried_on_slicers(15, {"3d", "2d"}));
+    add(choice_rule("texture_format", &R::texture_format, &V::texel_format, names::kTexelFormats)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(12, {"unorm8", "unorm16", "float"}));
+    add(texture_window_rule().read_by(kSlicesOnly));
+    add(choice_rule("table_lookup", &R::table_lookup, &V::table_lookup, names::kTableLookups)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(11, {"nearest", "linear", "texture"}));
+    add(choice_rule("table_format", &R::table_format, &V::table_format, names::kTableFormats)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(13, {"unorm8", "float"}));
+    add(choice_rule("classify", &R::classify, &V::classify, names::kSliceClassifies)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(14, {"post", "pre-unweighted"}));
+    add(choice_rule("framebuffer", &R::framebuffer, &V::framebuffer, names::kFrameBuffers)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(6, {"rgba8", "rgba16f", "rgba32f", "double"})
+            .explained_as("--framebuffer", 0));
+    add(choice_rule("framebuffer_rounding", &R::framebuffer_rounding, &V::framebuffer_rounding, names::kRoundings)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(8, {"nearest", "truncate"})
+            .explained_as("--rounding", 3));
+    add(choice_rule("blend_products", &R::blend_products, &V::blend_products, names::kBlendProducts)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(9, {"exact", "rounded"})
+            .explained_as("--products", 4));
+    add(choice_rule("blend", &R::blend, &V::blend, names::kBlends).read_by(kSlicesOnly).explained_as("--blend", 1));
+    add(choice_rule("blend_alpha", &R::blend_alpha, &V::blend_alpha, names::kBlendAlphas)
+            .read_by(kSlicesOnly)
+            .tried_on_slicers(10, {"src-alpha", "one"})
+            .explained_as("--blend-alpha", 2));
+    add(choice_rule("texture_filter", &R::texture_filter, &V::texture_filter, names::kTextureFilters).read_by(kSlicesOnly));
     return t;
 }
 

@@ -24,10 +24,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/scene/JsonReader.h"
 #include "core/scene/Scene.h"
 
 namespace volref {
+
+namespace json_reader {
+class ObjectReader;  // core/scene/JsonReader.h (internal: not installed)
+}
 
 // The placements that read a rule, a bit (1 << Placement) for each.
 using PlacementMask = unsigned;

@@ -213,14 +213,6 @@ private:
     M seen_ = L::no_lanes();
 };
 
-// The hooks of a composite step that reports nothing (the render); a trace's hooks fill its records.
-struct NoCompositeHooks {
-    template <class Acc>
-    void transparent(const Acc&) const {}
-    template <class O, class Acc>
-    void composited(const O&, const Acc&) const {}
-};
-
 // One sample of emission-absorption compositing on the lanes `alive`: the one sequence every
 // reference composite path takes once its sample's value is fetched, on any lanes and either order.
 //   classify    a = sample.opacity()            the transfer function's opacity per unit distance l
